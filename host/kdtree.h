@@ -1,0 +1,82 @@
+// SAH kd-trees (Wald & Havran 2006, O(N log N) with perfect splits): one builder for the
+// bottom-level trees over an object's triangles and the top-level tree over instance bounds
+// (paper section 2: a top-level index over objects, rebuilt whenever an object moves).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <glm/glm.hpp>
+#include <span>
+#include <vector>
+
+#include "fixedfloat/format.h"
+
+namespace saarcor::host {
+
+struct Aabb {
+  glm::vec3 lo{std::numeric_limits<float>::infinity()};
+  glm::vec3 hi{-std::numeric_limits<float>::infinity()};
+  bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
+  void grow(const glm::vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void grow(const Aabb& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
+  float area() const {
+    const glm::vec3 d = hi - lo;
+    return empty() ? 0.0f : 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
+  }
+};
+
+struct KdBuildParams {
+  // Wald & Havran's cost model defaults.
+  float traversal_cost = 15.0f;
+  float intersection_cost = 20.0f;
+  float empty_bonus = 0.8f;  // cost factor for a split that cuts off empty space
+  int max_depth = 24;        // per level; top + bottom must fit the 64-entry traversal stack
+  int leaf_size = 2;         // never split a node with this many items or fewer
+  // Split planes are rounded (nearest even) into this format before items are classified, so the
+  // tree is exact for the plane the hardware stores (DESIGN.md section 4: split position in fp24).
+  ff::Format split_format = ff::kFp24;
+};
+
+struct KdTreeNode {
+  bool leaf = false;
+  std::uint8_t axis = 0;     // inner
+  float split = 0.0f;        // inner: exactly representable in split_format
+  std::uint32_t child = 0;   // inner: left child index; right child = child + 1
+  std::uint32_t first = 0;   // leaf: first index into KdTree::items
+  std::uint32_t count = 0;   // leaf: number of items
+};
+
+struct KdTreeStats {
+  std::uint32_t nodes = 0;
+  std::uint32_t leaves = 0;
+  std::uint32_t empty_leaves = 0;
+  std::uint32_t depth = 0;
+  double items_per_leaf = 0.0;  // average over non-empty leaves
+  double sah_cost = 0.0;
+  // SAH-expected per ray (surface-area probabilities relative to the root box).
+  double expected_traversal_steps = 0.0;
+  double expected_leaf_visits = 0.0;
+  double expected_item_tests = 0.0;
+  double build_seconds = 0.0;
+};
+
+struct KdTree {
+  std::vector<KdTreeNode> nodes;     // node 0 is the root; children adjacent
+  std::vector<std::uint32_t> items;  // leaf lists: triangle ids or instance indices
+  Aabb bounds;
+  KdTreeStats stats;
+};
+
+// Bottom level: triangles (positions indexed by tris) with skip[i] != 0 left out (degenerate).
+KdTree build_kdtree(std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
+                    std::span<const std::uint8_t> skip, const KdBuildParams& params = {});
+// Top level: boxes (instance world bounds); item i is box i.
+KdTree build_kdtree(std::span<const Aabb> boxes, const KdBuildParams& params = {});
+
+}  // namespace saarcor::host
