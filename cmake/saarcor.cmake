@@ -23,6 +23,12 @@ function(saarcor_folder)
   file(GLOB _all CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   file(GLOB _tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_test.cpp)
   file(GLOB _benches CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_bench.cpp)
+  # foo_deep_test.cpp: full-size runs, in <folder>_deep_tests with the ctest label "deep", left
+  # out of the default test presets (ctest --preset deep runs them).
+  file(GLOB _deep CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_deep_test.cpp)
+  if(_deep)
+    list(REMOVE_ITEM _tests ${_deep})
+  endif()
   set(_lib ${_all})
   if(_tests)
     list(REMOVE_ITEM _lib ${_tests})
@@ -33,6 +39,9 @@ function(saarcor_folder)
   foreach(_ex ${F_EXCLUDE})
     list(REMOVE_ITEM _lib ${CMAKE_CURRENT_SOURCE_DIR}/${_ex})
   endforeach()
+  if(_deep)
+    list(REMOVE_ITEM _lib ${_deep})
+  endif()
   if(_lib)
     add_library(saarcor_${F_NAME} STATIC ${_lib})
     target_include_directories(saarcor_${F_NAME} PUBLIC ${PROJECT_SOURCE_DIR})
@@ -53,6 +62,17 @@ function(saarcor_folder)
       SAARCOR_BIN_DIR="${CMAKE_RUNTIME_OUTPUT_DIRECTORY}")
     gtest_discover_tests(${F_NAME}_tests DISCOVERY_TIMEOUT 60
       PROPERTIES LABELS ${F_NAME})
+  endif()
+  if(_deep)
+    add_executable(${F_NAME}_deep_tests ${_deep})
+    target_link_libraries(${F_NAME}_deep_tests PRIVATE saarcor::${F_NAME} ${F_TEST_DEPS}
+      GTest::gtest_main GTest::gmock saarcor_warnings)
+    target_compile_definitions(${F_NAME}_deep_tests PRIVATE
+      SAARCOR_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+      SAARCOR_SHARED_SCENES="${PROJECT_SOURCE_DIR}/../shared/scenes"
+      SAARCOR_BIN_DIR="${CMAKE_RUNTIME_OUTPUT_DIRECTORY}")
+    gtest_discover_tests(${F_NAME}_deep_tests DISCOVERY_TIMEOUT 60
+      PROPERTIES LABELS "deep;${F_NAME}")
   endif()
   if(_benches AND SAARCOR_BENCHMARKS)
     add_executable(${F_NAME}_bench ${_benches})
