@@ -192,6 +192,7 @@ struct FrameRegisters {
   std::uint32_t instance_row_base = 0;  // row index of instance record 0
   std::uint32_t instance_count = 0;
   std::uint32_t material_base = 0;  // shading-bank word address of material record 0
+  std::uint32_t shading_record_base = 0;  // shading-bank word address of shading record 0
   std::uint32_t light_base = 0;     // shading-bank word address of light record 0
   std::uint32_t light_count = 0;
   std::uint32_t ambient_rgb = 0x202020u;  // RGB8
