@@ -1,0 +1,337 @@
+// Float reference renderer (DESIGN.md section 9, model 1): the unit-triangle test and the
+// two-level traversal on hand-made trees, where every answer is known in advance.
+#include "host/float_reference.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace saarcor::host {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+Affine64 identity64() {
+  Affine64 a;
+  a.rows = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
+  return a;
+}
+
+// A tree with one leaf listing `items`.
+KdTree leaf_tree(std::vector<std::uint32_t> items, Aabb bounds) {
+  KdTree t;
+  KdTreeNode leaf;
+  leaf.leaf = true;
+  leaf.first = 0;
+  leaf.count = static_cast<std::uint32_t>(items.size());
+  t.nodes.push_back(leaf);
+  t.items = std::move(items);
+  t.bounds = bounds;
+  return t;
+}
+
+// A tree with one split (axis, split): left leaf lists `left`, right leaf `right`.
+KdTree split_tree(int axis, float split, std::vector<std::uint32_t> left,
+                  std::vector<std::uint32_t> right, Aabb bounds) {
+  KdTree t;
+  KdTreeNode root;
+  root.axis = static_cast<std::uint8_t>(axis);
+  root.split = split;
+  root.child = 1;
+  KdTreeNode l;
+  l.leaf = true;
+  l.first = 0;
+  l.count = static_cast<std::uint32_t>(left.size());
+  KdTreeNode r;
+  r.leaf = true;
+  r.first = l.count;
+  r.count = static_cast<std::uint32_t>(right.size());
+  t.nodes = {root, l, r};
+  t.items = left;
+  t.items.insert(t.items.end(), right.begin(), right.end());
+  t.bounds = bounds;
+  return t;
+}
+
+Aabb box(glm::vec3 lo, glm::vec3 hi) {
+  Aabb b;
+  b.lo = lo;
+  b.hi = hi;
+  return b;
+}
+
+// A quad in the plane z = z0 over [x0, x1] x [0, 1] as two triangles.
+std::vector<std::optional<Affine64>> quad_z(float z0, float x0, float x1) {
+  return {triangle_matrix(glm::dvec3(x0, 0, z0), glm::dvec3(x1, 0, z0), glm::dvec3(x0, 1, z0)),
+          triangle_matrix(glm::dvec3(x1, 1, z0), glm::dvec3(x0, 1, z0), glm::dvec3(x1, 0, z0))};
+}
+
+TEST(FloatIntersection, UnitTriangleIdentity) {
+  const Affine32 id = to_float(identity64());
+  float t, u, v, c;
+  ASSERT_TRUE(
+      intersect_unit_triangle(id, {{0.25f, 0.5f, 2.0f}, {0, 0, -1}}, 0.0f, kInf, t, u, v, c));
+  EXPECT_EQ(t, 2.0f);
+  EXPECT_EQ(u, 0.25f);
+  EXPECT_EQ(v, 0.5f);
+  EXPECT_EQ(c, -1.0f);
+  // Edges and vertices are inside (DIGEST D13): u = 0, v = 0, u + v = 1.
+  EXPECT_TRUE(intersect_unit_triangle(id, {{0, 0.5f, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
+  EXPECT_TRUE(intersect_unit_triangle(id, {{0.5f, 0, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
+  EXPECT_TRUE(intersect_unit_triangle(id, {{0.5f, 0.5f, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
+  EXPECT_TRUE(intersect_unit_triangle(id, {{1, 0, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
+  // Just outside each edge.
+  EXPECT_FALSE(intersect_unit_triangle(id, {{-1e-6f, 0.5f, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
+  EXPECT_FALSE(intersect_unit_triangle(id, {{0.5f, -1e-6f, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
+  EXPECT_FALSE(intersect_unit_triangle(id, {{0.5f, 0.5001f, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
+  // Both sides hit (no back-face culling); the cosine keeps the sign.
+  ASSERT_TRUE(intersect_unit_triangle(id, {{0.2f, 0.2f, -3}, {0, 0, 2}}, 0, kInf, t, u, v, c));
+  EXPECT_EQ(t, 1.5f);
+  EXPECT_EQ(c, 2.0f);
+}
+
+TEST(FloatIntersection, IntervalIsOpenAndParallelRaysMiss) {
+  const Affine32 id = to_float(identity64());
+  float t, u, v, c;
+  const FloatRay r{{0.25f, 0.25f, 2.0f}, {0, 0, -1}};
+  EXPECT_FALSE(intersect_unit_triangle(id, r, 2.0f, kInf, t, u, v, c));  // t_min < t
+  EXPECT_FALSE(intersect_unit_triangle(id, r, 0.0f, 2.0f, t, u, v, c));  // t < t_best
+  EXPECT_TRUE(intersect_unit_triangle(id, r, 0.0f, std::nextafter(2.0f, 3.0f), t, u, v, c));
+  // Behind the origin.
+  EXPECT_FALSE(intersect_unit_triangle(id, {{0.25f, 0.25f, 2.0f}, {0, 0, 1}}, 0, kInf, t, u, v, c));
+  // In the plane (D'z = 0, O'z = 0 gives NaN) and parallel above it (inf).
+  EXPECT_FALSE(intersect_unit_triangle(id, {{-1, 0.25f, 0}, {1, 0, 0}}, 0, kInf, t, u, v, c));
+  EXPECT_FALSE(intersect_unit_triangle(id, {{-1, 0.25f, 1}, {1, 0, 0}}, 0, kInf, t, u, v, c));
+}
+
+// A general triangle through its T_delta against a binary64 Moeller-Trumbore.
+TEST(FloatIntersection, MatchesBinary64GeometryOnATiltedTriangle) {
+  const glm::dvec3 a(1.0, -0.5, 2.0), b(-0.3, 1.7, 2.5), cc(0.2, 0.1, 4.0);
+  const auto m = triangle_matrix(a, b, cc);
+  ASSERT_TRUE(m);
+  const Affine32 tf = to_float(*m);
+  const glm::dvec3 o(0.1, 0.2, -1.0);
+  int hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    // Points spread over and around the triangle: barycentrics in [-0.2, 1.2].
+    const double bu = -0.2 + 1.4 * ((i * 37) % 101) / 100.0;
+    const double bv = -0.2 + 1.4 * ((i * 61) % 97) / 96.0;
+    const glm::dvec3 p = a * bu + b * bv + cc * (1.0 - bu - bv);
+    const glm::dvec3 d = p - o;
+    float t, u, v, c;
+    const bool inside = bu >= 0 && bv >= 0 && bu + bv <= 1;
+    const double margin = std::min({bu, bv, 1 - bu - bv});
+    const bool got = intersect_unit_triangle(tf, {glm::vec3(o), glm::vec3(d)}, 0, kInf, t, u, v, c);
+    if (std::abs(margin) < 1e-4) continue;  // too close to an edge to call
+    ASSERT_EQ(got, inside) << "i=" << i << " u=" << bu << " v=" << bv;
+    if (!got) continue;
+    ++hits;
+    EXPECT_NEAR(t, 1.0, 1e-5);
+    EXPECT_NEAR(u, bu, 1e-5);
+    EXPECT_NEAR(v, bv, 1e-5);
+    const glm::dvec3 n = glm::normalize(glm::cross(a - cc, b - cc));
+    const glm::dvec3 df = glm::dvec3(glm::vec3(d));
+    EXPECT_NEAR(c, glm::dot(df, n), 1e-5 * glm::length(df));
+  }
+  EXPECT_GT(hits, 50);
+}
+
+// Op order check: the transform is (m0*x + m1*y) + (m2*z + t), bit for bit.
+TEST(FloatIntersection, TransformOpOrderIsTheDatapaths) {
+  Affine64 m = identity64();
+  m.rows[1] = {0.0, 0.0, 0.0, 0.25};
+  m.rows[2] = {1.0, 1e8, -1e8, 0.5};
+  const Affine32 f = to_float(m);
+  // O = (0.25, 1, 1): O'z = (0.25 + 1e8) + (-1e8 + 0.5) = 1e8 - 1e8 = 0 in binary32 (the ulp at
+  // 1e8 is 8), where a left-to-right sum ((0.25 + 1e8) - 1e8) + 0.5 would give 0.5.
+  // D = (0, 0, 1e-8): D'z = -1e8 * 1e-8 ~ -1, so t = -0 / -1 = 0.
+  float t, u, v, c;
+  ASSERT_TRUE(
+      intersect_unit_triangle(f, {{0.25f, 1.0f, 1.0f}, {0, 0, 1e-8f}}, -1.0f, kInf, t, u, v, c));
+  EXPECT_EQ(t, 0.0f);
+  EXPECT_EQ(u, 0.25f);
+  EXPECT_EQ(v, 0.25f);
+  const float left_to_right = ((0.25f + 1e8f) - 1e8f) + 0.5f;
+  EXPECT_EQ(left_to_right, 0.5f);
+}
+
+// ---- traversal ------------------------------------------------------------------------------
+
+// One object with two quads: near quad at z = 1 over x in [0, 1] (left of split x = 1), far quad
+// at z = 3 over x in [1, 2] (right), and a big back quad at z = 5 in both leaves.
+struct TwoLeafScene {
+  FloatScene scene;
+  TwoLeafScene() {
+    auto m = quad_z(1, 0, 1);      // triangles 0, 1
+    auto far = quad_z(3, 1, 2);    // 2, 3
+    auto back = quad_z(5, -1, 3);  // 4, 5
+    m.insert(m.end(), far.begin(), far.end());
+    m.insert(m.end(), back.begin(), back.end());
+    const Aabb b = box({-1, 0, 1}, {3, 1, 5});
+    const KdTree tree = split_tree(0, 1.0f, {0, 1, 4, 5}, {2, 3, 4, 5}, b);
+    scene.add_object(tree, m);
+    scene.add_instance(0, identity64(), 7);
+    scene.set_top(leaf_tree({0}, b));
+  }
+};
+
+TEST(FloatTraversal, ClosestHitAcrossLeavesAndEarlyTermination) {
+  TwoLeafScene s;
+  FloatTraceStats st;
+  // Straight down z through the near quad.
+  FloatHit h = s.scene.trace({{0.5f, 0.3f, 0.0f}, {0, 0, 1}}, 0, kInf, false, &st);
+  ASSERT_TRUE(h.hit());
+  EXPECT_EQ(h.t, 1.0f);
+  EXPECT_LT(h.triangle, 2u);
+  EXPECT_EQ(h.instance, 0u);
+  // Through the far quad.
+  h = s.scene.trace({{1.5f, 0.3f, 0.0f}, {0, 0, 1}}, 0, kInf);
+  EXPECT_EQ(h.t, 3.0f);
+  EXPECT_TRUE(h.triangle == 2 || h.triangle == 3);
+  // Outside both quads: the back quad.
+  h = s.scene.trace({{-0.5f, 0.3f, 0.0f}, {0, 0, 1}}, 0, kInf);
+  EXPECT_EQ(h.t, 5.0f);
+  EXPECT_TRUE(h.triangle == 4 || h.triangle == 5);
+  // A diagonal ray from the right leaf into the left one (near child = right): at z = 1 it is at
+  // x = 1.9 (the near quad is x <= 1), at z = 3 at x = 0.9 (the far quad is x >= 1), and it
+  // reaches the back quad at x = -0.1, t = 5.
+  h = s.scene.trace({{2.4f, 0.5f, 0.0f}, {-0.5f, 0, 1}}, 0, kInf);
+  EXPECT_EQ(h.t, 5.0f);
+  EXPECT_TRUE(h.triangle == 4 || h.triangle == 5);
+  // The ray from the near quad side: hits the near quad at t = 1; the right leaf starts at
+  // x = 1 (t = 2 for direction +0.5 from x = 0) so it is never entered.
+  FloatTraceStats one;
+  h = s.scene.trace({{0.0f, 0.5f, 0.0f}, {0.5f, 0, 1}}, 0, kInf, false, &one);
+  // x at t=1 is 0.5, inside the near quad.
+  EXPECT_EQ(h.t, 1.0f);
+  EXPECT_EQ(one.leaves, 2u);  // the top leaf and the left bottom leaf only
+  EXPECT_EQ(one.intersections, 4u);
+  EXPECT_EQ(one.transformations, 1u);
+}
+
+TEST(FloatTraversal, MissesOutsideTheSceneBox) {
+  TwoLeafScene s;
+  FloatTraceStats st;
+  const FloatHit h = s.scene.trace({{0.5f, 2.0f, 0.0f}, {0, 0, 1}}, 0, kInf, false, &st);
+  EXPECT_FALSE(h.hit());
+  EXPECT_EQ(h.t, kInf);
+  EXPECT_EQ(st.leaves, 0u);
+  EXPECT_EQ(st.intersections, 0u);
+}
+
+TEST(FloatTraversal, TMaxAndAnyHit) {
+  TwoLeafScene s;
+  EXPECT_FALSE(s.scene.trace({{0.5f, 0.3f, 0.0f}, {0, 0, 1}}, 0, 1.0f).hit());
+  EXPECT_TRUE(s.scene.trace({{0.5f, 0.3f, 0.0f}, {0, 0, 1}}, 0, 1.001f).hit());
+  // t_min skips the near quad.
+  EXPECT_EQ(s.scene.trace({{0.5f, 0.3f, 0.0f}, {0, 0, 1}}, 1.0f, kInf).t, 5.0f);
+  // Any-hit stops at the first accepted hit in list order (near quad listed first).
+  FloatTraceStats st;
+  const FloatHit h = s.scene.trace({{0.5f, 0.3f, 0.0f}, {0, 0, 1}}, 0, kInf, true, &st);
+  EXPECT_TRUE(h.hit());
+  EXPECT_LE(st.intersections, 2u);
+}
+
+// Ties: two coincident triangles in one leaf. The first listed wins (strict t < t_best).
+TEST(FloatTraversal, TieKeepsTheEarlierHitInTraversalOrder) {
+  std::vector<std::optional<Affine64>> m = quad_z(2, 0, 1);
+  m.push_back(m[0]);  // triangle 2 = a copy of triangle 0
+  const Aabb b = box({0, 0, 2}, {1, 1, 2});
+  for (const auto& order : {std::vector<std::uint32_t>{0, 2, 1}, {2, 1, 0}}) {
+    FloatScene s;
+    s.add_object(leaf_tree(order, b), m);
+    s.add_instance(0, identity64(), 0);
+    s.set_top(leaf_tree({0}, b));
+    const FloatHit h = s.trace({{0.2f, 0.2f, 0.0f}, {0, 0, 1}}, 0, kInf);
+    EXPECT_EQ(h.triangle, order[0]);
+  }
+}
+
+// Two instances of one object: a translated copy and a scaled copy. t is the world t.
+TEST(FloatTraversal, InstancesTransformTheRayAndKeepWorldT) {
+  FloatScene s;
+  const auto m = quad_z(0, 0, 1);  // unit quad at z = 0
+  const Aabb ob = box({0, 0, 0}, {1, 1, 0});
+  s.add_object(leaf_tree({0, 1}, ob), m);
+  // Instance 0 (node 10): moved to z = 4. Instance 1 (node 20): scaled by 2 and moved to z = 2,
+  // so it spans x, y in [0, 2].
+  const glm::dmat4 w0 = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 4));
+  const glm::dmat4 w1 =
+      glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 2)), glm::dvec3(2.0));
+  s.add_instance(0, *world_to_object(w0), 10);
+  s.add_instance(0, *world_to_object(w1), 20);
+  const Aabb top = box({0, 0, 2}, {2, 2, 4});
+  // Both instances in both leaves of a split at z = 3: the mailbox skips the second visit.
+  s.set_top(split_tree(2, 3.0f, {0, 1}, {1, 0}, top));
+  FloatTraceStats st;
+  FloatHit h = s.trace({{0.5f, 0.5f, 0.0f}, {0, 0, 1}}, 0, kInf, false, &st);
+  EXPECT_EQ(h.instance, 1u);
+  EXPECT_EQ(s.instances()[h.instance].id, 20u);
+  EXPECT_EQ(h.t, 2.0f);
+  EXPECT_EQ(h.cos, 0.5f);  // object-space direction is (0, 0, 0.5): D'z = D.N scaled
+  EXPECT_EQ(st.transformations, 2u);
+  // From the other side: the leaf z in [3, 4] comes first and lists instance 1 before 0; the
+  // ray ends after that leaf (its hit at z = 4, t = 3, lies inside it).
+  FloatTraceStats back;
+  h = s.trace({{0.5f, 0.5f, 10.0f}, {0, 0, -2}}, 0, kInf, false, &back);
+  EXPECT_EQ(h.instance, 0u);
+  EXPECT_EQ(h.t, 3.0f);
+  EXPECT_EQ(back.transformations, 2u);
+  EXPECT_EQ(back.leaves, 3u);  // one top-level leaf, one bottom-level leaf per instance
+  EXPECT_EQ(back.mailbox_skips, 0u);
+  // x in (1, 2): only the scaled instance.
+  h = s.trace({{1.5f, 1.5f, 10.0f}, {0, 0, -1}}, 0, kInf, false, &back);
+  EXPECT_EQ(h.instance, 1u);
+  EXPECT_EQ(h.t, 8.0f);
+  // Its best hit (t = 8) lies beyond the first leaf (t in [6, 7]), so the second leaf is
+  // visited too, and both of its entries are mailbox skips.
+  FloatTraceStats twice;
+  s.trace({{1.5f, 1.5f, 10.0f}, {0, 0, -1}}, 0, kInf, false, &twice);
+  EXPECT_EQ(twice.mailbox_skips, 2u);
+  EXPECT_EQ(twice.transformations, 2u);
+}
+
+// Axis-parallel rays (D = 0 on the split axis) take the side their origin is on.
+TEST(FloatTraversal, AxisParallelRays) {
+  TwoLeafScene s;
+  EXPECT_EQ(s.scene.trace({{0.5f, 0.5f, 0.0f}, {0, 0, 1}}, 0, kInf).t, 1.0f);
+  EXPECT_EQ(s.scene.trace({{1.5f, 0.5f, 0.0f}, {-0.0f, 0, 1}}, 0, kInf).t, 3.0f);
+  EXPECT_EQ(s.scene.trace({{0.5f, 0.5f, 9.0f}, {-0.0f, 0, -1}}, 0, kInf).t, 4.0f);
+}
+
+TEST(FloatTraversal, PrimaryRayUsesTheDatapathOrder) {
+  PrimaryBasis32 b;
+  b.cr = {0.5f, 0, 0};
+  b.cu = {0, -0.25f, 0};
+  b.cd = {-1, 1, 1};
+  b.cp = {1, 2, 3};
+  const FloatRay r = primary_ray(b, 3, 4);
+  EXPECT_EQ(r.origin, glm::vec3(1, 2, 3));
+  EXPECT_EQ(r.direction, glm::vec3(0.5f, 0.0f, 1.0f));
+  EXPECT_EQ(r.direction, b.direction(3, 4));
+}
+
+TEST(FloatScene, RefusesMalformedInput) {
+  const auto m = quad_z(0, 0, 1);
+  const Aabb b = box({0, 0, 0}, {1, 1, 0});
+  FloatScene s;
+  EXPECT_THROW(s.add_object(leaf_tree({0, 5}, b), m), std::runtime_error);  // no triangle 5
+  std::vector<std::optional<Affine64>> with_degenerate = m;
+  with_degenerate.push_back(std::nullopt);
+  EXPECT_THROW(s.add_object(leaf_tree({2}, b), with_degenerate), std::runtime_error);
+  KdTree bad = split_tree(0, 0.5f, {0}, {1}, b);
+  bad.nodes[0].child = 7;
+  EXPECT_THROW(s.add_object(bad, m), std::runtime_error);
+  EXPECT_THROW(s.add_object(KdTree{}, m), std::runtime_error);
+  EXPECT_THROW(s.add_instance(3, identity64(), 0), std::runtime_error);
+  s.add_object(leaf_tree({0, 1}, b), m);
+  EXPECT_THROW(s.set_top(leaf_tree({0}, b)), std::runtime_error);              // no instance 0 yet
+  EXPECT_THROW(s.trace({{0, 0, 0}, {0, 0, 1}}, 0, kInf), std::runtime_error);  // no top tree
+}
+
+}  // namespace
+}  // namespace saarcor::host
