@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "fixedfloat/format.h"
+#include "fixedfloat/ops.h"
 
 namespace saarcor::ff {
 
@@ -22,9 +23,7 @@ struct Float {
   std::uint32_t bits = 0;
 
   static constexpr Float from_bits(std::uint32_t b) { return Float{b & kFormat.bits_mask()}; }
-  static Float from_double(double v, Mode m = {}) {
-    return Float{ff::from_double(v, kFormat, m)};
-  }
+  static Float from_double(double v, Mode m = {}) { return Float{fast::from_double<E, M>(v, m)}; }
   static Float from_float(float v, Mode m = {}) { return from_double(static_cast<double>(v), m); }
   static Float from_int(std::int64_t v, Mode m = {}) { return Float{ff::from_int(v, kFormat, m)}; }
   static constexpr Float zero() { return Float{0}; }
@@ -34,7 +33,7 @@ struct Float {
   static constexpr Float max_finite() { return Float{kFormat.max_finite_bits()}; }
 
   // Exact; in flush mode (the default) a subnormal encoding reads as +-0.
-  double to_double(Subnormals s = Subnormals::kFlush) const { return decode(bits, kFormat, s); }
+  double to_double(Subnormals s = Subnormals::kFlush) const { return fast::decode<E, M>(bits, s); }
   float to_float(Subnormals s = Subnormals::kFlush) const {
     return static_cast<float>(to_double(s));
   }
@@ -83,47 +82,49 @@ class FpUnit {
 
   F add(F a, F b) const {
     if (counts_) ++counts_->add;
-    return F{op_add(a.bits, b.bits, F::kFormat, mode_)};
+    return F{fast::add<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
   }
   F sub(F a, F b) const {
     if (counts_) ++counts_->add;
-    return F{op_sub(a.bits, b.bits, F::kFormat, mode_)};
+    return F{fast::sub<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
   }
   F mul(F a, F b) const {
     if (counts_) ++counts_->mul;
-    return F{op_mul(a.bits, b.bits, F::kFormat, mode_)};
+    return F{fast::mul<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
   }
   F div(F a, F b) const {
     if (counts_) ++counts_->div;
-    return F{op_div(a.bits, b.bits, F::kFormat, mode_)};
+    return F{fast::div<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
   }
   F sqrt(F a) const {
     if (counts_) ++counts_->sqrt;
-    return F{op_sqrt(a.bits, F::kFormat, mode_)};
+    return F{fast::sqrt<F::kExpBits, F::kManBits>(a.bits, mode_)};
   }
   bool lt(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return op_lt(a.bits, b.bits, F::kFormat, mode_);
+    return fast::lt<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_);
   }
   bool le(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return op_le(a.bits, b.bits, F::kFormat, mode_);
+    return fast::le<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_);
   }
   bool eq(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return op_eq(a.bits, b.bits, F::kFormat, mode_);
+    return fast::eq<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_);
   }
   F min(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return F{op_min(a.bits, b.bits, F::kFormat, mode_)};
+    return F{fast::min<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
   }
   F max(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return F{op_max(a.bits, b.bits, F::kFormat, mode_)};
+    return F{fast::max<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
   }
-  F from_double(double v) const { return F{ff::from_double(v, F::kFormat, mode_)}; }
+  F from_double(double v) const { return F{fast::from_double<F::kExpBits, F::kManBits>(v, mode_)}; }
   F from_int(std::int64_t v) const { return F{ff::from_int(v, F::kFormat, mode_)}; }
-  double to_double(F a) const { return decode(a.bits, F::kFormat, mode_.subnormals); }
+  double to_double(F a) const {
+    return fast::decode<F::kExpBits, F::kManBits>(a.bits, mode_.subnormals);
+  }
 
   const Mode& mode() const { return mode_; }
   OpCounts* counts() const { return counts_; }
