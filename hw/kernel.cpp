@@ -1,0 +1,245 @@
+// The simulation kernel (DESIGN.md section 8): clock, two-phase cycle, idle skip, watchdog.
+// Also the out-of-line parts of Module and ChannelBase, which register with the kernel.
+#include "hw/kernel.h"
+
+#include <algorithm>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "hw/vcd.h"
+
+namespace saarcor::hw {
+
+// ---- ChannelBase ------------------------------------------------------------------------------
+
+ChannelBase::ChannelBase(Kernel& kernel, std::string name, int capacity, int latency, int width)
+    : name_(std::move(name)),
+      capacity_(capacity),
+      latency_(latency),
+      width_(width),
+      now_(&kernel.cycle_),
+      dirty_list_(&kernel.dirty_) {
+  if (capacity < 1 || latency < 1 || width < 1) {
+    throw std::logic_error("channel '" + name_ +
+                           "': capacity, latency and width must be >= 1 (got " +
+                           std::to_string(capacity) + ", " + std::to_string(latency) + ", " +
+                           std::to_string(width) + ")");
+  }
+  ready_at_.assign(static_cast<std::size_t>(capacity), 0);
+  last_change_ = kernel.cycle_;
+  kernel.add_channel(this);
+}
+
+void ChannelBase::misuse(const char* what) const {
+  throw std::logic_error("channel '" + name_ + "' at cycle " + std::to_string(*now_) + ": " + what);
+}
+
+int ChannelBase::reserve_push() {
+  if (!can_push()) misuse("push while !can_push() (full, or port width used up)");
+  const int s = slot(count_ + pushes_);
+  ready_at_[static_cast<std::size_t>(s)] = *now_ + static_cast<std::uint64_t>(latency_);
+  ++pushes_;
+  if (!dirty_) {
+    dirty_ = true;
+    dirty_list_->push_back(this);
+  }
+  return s;
+}
+
+int ChannelBase::reserve_pop() {
+  if (!can_pop()) misuse("pop while !can_pop() (empty, not yet visible, or width used up)");
+  const int s = slot(pops_);
+  ++pops_;
+  if (!dirty_) {
+    dirty_ = true;
+    dirty_list_->push_back(this);
+  }
+  return s;
+}
+
+int ChannelBase::front_slot() const {
+  if (!can_pop()) misuse("peek while !can_pop()");
+  return slot(pops_);
+}
+
+int ChannelBase::commit() {
+  const int moved = pushes_ + pops_;
+  if (pushes_ != pops_) {
+    // The old occupancy held from last_change_ through this cycle.
+    occupancy_area_ += static_cast<std::uint64_t>(count_) * (*now_ + 1 - last_change_);
+    last_change_ = *now_ + 1;
+  }
+  head_ = slot(pops_);
+  count_ += pushes_ - pops_;
+  *pushes_stat_ += static_cast<std::uint64_t>(pushes_);
+  max_occupancy_stat_->set_max(static_cast<std::uint64_t>(count_));
+  pushes_ = pops_ = 0;
+  dirty_ = false;
+  return moved;
+}
+
+std::uint64_t ChannelBase::total_pushes() const {
+  return pushes_stat_->value;
+}
+
+// ---- Module -------------------------------------------------------------------------------------
+
+Module::Module(Kernel& kernel, std::string name)
+    : name_(std::move(name)), kernel_(&kernel), now_(&kernel.cycle_) {
+  kernel.add_module(this);
+}
+
+Stats& Module::stats() const {
+  return kernel_->stats();
+}
+
+// ---- Kernel -------------------------------------------------------------------------------------
+
+Kernel::Kernel(KernelConfig config) : config_(config), rng_(config.shuffle_seed) {}
+
+Kernel::~Kernel() = default;
+
+void Kernel::add_module(Module* m) {
+  if (m->name().empty()) throw std::logic_error("kernel: a module needs a name");
+  m->busy_stat_ = &stats_.counter(m->name() + ".busy_cycles", "cycles",
+                                  "cycles in which the module made progress");
+  m->stall_stat_ = &stats_.counter(m->name() + ".stall_cycles", "cycles",
+                                   "cycles in which the module had work but was blocked");
+  modules_.push_back(m);
+  order_.push_back(m);
+}
+
+void Kernel::add_channel(ChannelBase* c) {
+  c->pushes_stat_ = &stats_.counter(c->name() + ".pushes", "items", "items pushed");
+  c->max_occupancy_stat_ =
+      &stats_.counter(c->name() + ".max_occupancy", "items", "largest committed occupancy");
+  stats_.formula(
+      c->name() + ".avg_occupancy", "items", "committed occupancy averaged over cycles", [this, c] {
+        if (cycle_ == 0) return 0.0;
+        const std::uint64_t area =
+            c->occupancy_area_ + static_cast<std::uint64_t>(c->count_) * (cycle_ - c->last_change_);
+        return static_cast<double>(area) / static_cast<double>(cycle_);
+      });
+  channels_.push_back(c);
+}
+
+int Kernel::step() {
+  if (config_.shuffle_seed != 0) std::shuffle(order_.begin(), order_.end(), rng_);
+  int progress = 0;
+  for (Module* m : order_) {
+    m->stalled_ = false;
+    const int p = m->evaluate();
+    m->last_progress_ = p;
+    progress += p;
+  }
+  evaluations_ += order_.size();
+  ++evaluated_;
+  if (tracer_) tracer_->sample(cycle_, modules_, channels_);
+  for (Module* m : modules_) {
+    m->commit();
+    m->busy_stat_->value += m->last_progress_ > 0;
+    m->stall_stat_->value += m->stalled_;
+  }
+  int activity = 0;
+  for (ChannelBase* c : dirty_)
+    activity += c->commit();
+  dirty_.clear();
+  const int total = progress + activity;
+  ++cycle_;
+  if (total > 0) progress_mark_ = cycle_;
+  if (config_.time_series_period != 0 && cycle_ % config_.time_series_period == 0) {
+    stats_.set_time_series_period(config_.time_series_period);
+    stats_.sample(cycle_);
+  }
+  return total;
+}
+
+std::uint64_t Kernel::next_event() const {
+  const std::uint64_t last = cycle_ - 1;  // the idle cycle just evaluated
+  std::uint64_t t = kNever;
+  for (const Module* m : modules_)
+    t = std::min(t, m->next_wakeup(last));
+  for (const ChannelBase* c : channels_) {
+    const std::uint64_t r = c->front_ready_cycle();
+    if (r > last) t = std::min(t, r);
+  }
+  return std::max(t, cycle_);
+}
+
+void Kernel::skip_to(std::uint64_t target) {
+  const std::uint64_t n = target - cycle_;
+  for (Module* m : modules_) {
+    if (m->stalled_) m->stall_stat_->value += n;
+    m->skipped(n);
+  }
+  skipped_ += n;
+  cycle_ = target;
+  if (config_.time_series_period != 0 && cycle_ % config_.time_series_period == 0) {
+    stats_.set_time_series_period(config_.time_series_period);
+    stats_.sample(cycle_);
+  }
+}
+
+RunResult Kernel::run(const std::function<bool()>& done, std::uint64_t max_cycles) {
+  const std::uint64_t limit = max_cycles > kNever - cycle_ ? kNever : cycle_ + max_cycles;
+  progress_mark_ = cycle_;
+  const std::uint64_t wd = config_.watchdog_cycles;
+  for (;;) {
+    if (done()) return {RunResult::Status::kDone, cycle_, {}};
+    if (cycle_ >= limit) return {RunResult::Status::kCycleLimit, cycle_, {}};
+    if (wd != 0 && cycle_ - progress_mark_ >= wd) {
+      return {RunResult::Status::kWatchdog, cycle_, state_report()};
+    }
+    if (step() != 0 || !config_.idle_skip) continue;
+    // Idle cycle: jump to the earliest cycle where anything (or anything we report) can change.
+    std::uint64_t target = std::min(next_event(), limit);
+    if (wd != 0) target = std::min(target, progress_mark_ + wd);
+    const std::uint64_t period = config_.time_series_period;
+    if (period != 0) target = std::min(target, (cycle_ / period + 1) * period);
+    if (tracer_ && cycle_ < trace_from_) target = std::min(target, trace_from_);
+    if (target > cycle_) skip_to(target);
+  }
+}
+
+std::uint64_t Kernel::run_to_completion(const std::function<bool()>& done,
+                                        std::uint64_t max_cycles) {
+  const RunResult r = run(done, max_cycles);
+  if (r.status == RunResult::Status::kWatchdog) {
+    throw std::runtime_error("simulation stopped by the watchdog at cycle " +
+                             std::to_string(r.cycles) + "\n" + r.report);
+  }
+  if (r.status == RunResult::Status::kCycleLimit) {
+    throw std::runtime_error("simulation reached its cycle limit at cycle " +
+                             std::to_string(r.cycles) + " without completing\n" + state_report());
+  }
+  return r.cycles;
+}
+
+std::string Kernel::state_report() const {
+  std::ostringstream os;
+  os << "cycle " << cycle_ << ", no progress since cycle " << progress_mark_ << "\n";
+  for (const Module* m : modules_) {
+    os << "module " << m->name() << (m->stalled_ ? " [stalled]" : "") << ":";
+    const std::string s = m->dump_state();
+    os << (s.empty() ? " (no state dump)" : " " + s) << "\n";
+  }
+  for (const ChannelBase* c : channels_) {
+    os << "channel " << c->name() << ": " << c->occupancy() << "/" << c->capacity();
+    if (!c->empty()) os << ", front ready at cycle " << c->front_ready_cycle();
+    os << "\n";
+  }
+  return os.str();
+}
+
+void Kernel::trace_vcd(std::ostream& out, std::uint64_t from, std::uint64_t to) {
+  if (to < from) throw std::runtime_error("VCD window ends before it starts");
+  tracer_ = std::make_unique<VcdTracer>(out, from, to);
+  trace_from_ = from;
+}
+
+void Kernel::finish_trace() {
+  if (tracer_) tracer_->finish(cycle_);
+}
+
+}  // namespace saarcor::hw

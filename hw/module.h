@@ -1,0 +1,88 @@
+// Clocked modules of the simulation kernel (DESIGN.md section 8; STYLE.md habits 1-2, ChampSim's
+// operable): one unit shape for every piece of hardware.
+//
+// A cycle is two phases. evaluate(): read only state committed at the end of the previous cycle
+// (own registers via Reg::get, input channels via can_pop/peek/pop, output channels via
+// can_push/push) and stage writes; return how much progress was made. commit(): make the staged
+// register writes visible (channels are committed by the kernel). The result of a cycle must not
+// depend on the order in which modules are evaluated; Reg and Channel make that hold by
+// construction as long as modules share state only through them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "hw/channel.h"
+#include "hw/stats.h"
+
+namespace saarcor::hw {
+
+class Kernel;
+
+class Module {
+ public:
+  // Registers the module with the kernel; it is evaluated in registration order unless the kernel
+  // shuffles. Modules and channels must outlive the kernel's runs and dumps.
+  Module(Kernel& kernel, std::string name);
+  virtual ~Module() = default;
+  Module(const Module&) = delete;
+  Module& operator=(const Module&) = delete;
+
+  const std::string& name() const { return name_; }
+
+  // One cycle's combinational work. Returns the progress made: > 0 whenever any state changed
+  // (item moved, register staged with a new value, counter advanced). 0 means "this cycle changed
+  // nothing"; the kernel's idle skip and watchdog rely on it being truthful.
+  virtual int evaluate() = 0;
+  // Makes staged register writes visible. Called for every module after all evaluate()s.
+  virtual void commit() {}
+  // One or more lines for the watchdog report: what the module holds and what it waits for.
+  virtual std::string dump_state() const { return {}; }
+  // Earliest cycle > now at which evaluate() could make progress if no channel changes, given
+  // that it made none in cycle now (internal timers, e.g. a memory latency). kNever: only a
+  // channel change can wake it. The default (now + 1) is always safe but disables idle skipping.
+  virtual std::uint64_t next_wakeup(std::uint64_t now) const { return now + 1; }
+  // Called when the kernel skipped `cycles` idle cycles after the last evaluated one; those
+  // cycles would each have repeated the last one exactly (progress 0). A module that counts
+  // something per cycle in evaluate() adds it here, so statistics do not depend on skipping.
+  // busy/stall cycles are kept by the kernel already.
+  virtual void skipped(std::uint64_t /*cycles*/) {}
+
+  // Kernel-kept per-module statistics: <name>.busy_cycles, <name>.stall_cycles.
+  bool busy() const { return last_progress_ > 0; }
+  bool stalled() const { return stalled_; }
+
+ protected:
+  // Marks this cycle as a stall: the module has work but is blocked (full output, no credit).
+  void stall() { stalled_ = true; }
+  Kernel& kernel() const { return *kernel_; }
+  Stats& stats() const;
+  std::uint64_t now() const { return *now_; }
+
+ private:
+  friend class Kernel;
+  std::string name_;
+  Kernel* kernel_;
+  const std::uint64_t* now_;
+  int last_progress_ = 0;
+  bool stalled_ = false;
+  Counter* busy_stat_ = nullptr;
+  Counter* stall_stat_ = nullptr;
+};
+
+// A register inside a module: get() returns the value committed last cycle, set() stages the next
+// value, commit() (called from the owning module's commit()) makes it current.
+template <class T>
+class Reg {
+ public:
+  explicit Reg(T init = T{}) : cur_(init), next_(init) {}
+  const T& get() const { return cur_; }
+  void set(const T& v) { next_ = v; }
+  T& next() { return next_; }  // stage a partial update of a struct register
+  void commit() { cur_ = next_; }
+
+ private:
+  T cur_, next_;
+};
+
+}  // namespace saarcor::hw
