@@ -65,10 +65,34 @@ class ChannelBase {
     const int s = head_ + k;
     return s >= capacity_ ? s - capacity_ : s;
   }
-  int reserve_push();  // checks and books a push, returns its slot
-  int reserve_pop();   // checks and books a pop, returns its slot
-  int front_slot() const;
-  [[noreturn]] void misuse(const char* what) const;
+  // Checks and books a push, returns its slot.
+  int reserve_push() {
+    if (!can_push()) misuse("push while !can_push() (full, or port width used up)");
+    const int s = slot(count_ + pushes_);
+    ready_at_[static_cast<std::size_t>(s)] = *now_ + static_cast<std::uint64_t>(latency_);
+    ++pushes_;
+    mark_dirty();
+    return s;
+  }
+  // Checks and books a pop, returns its slot.
+  int reserve_pop() {
+    if (!can_pop()) misuse("pop while !can_pop() (empty, not yet visible, or width used up)");
+    const int s = slot(pops_);
+    ++pops_;
+    mark_dirty();
+    return s;
+  }
+  int front_slot() const {
+    if (!can_pop()) misuse("peek while !can_pop()");
+    return slot(pops_);
+  }
+  void mark_dirty() {
+    if (!dirty_) {
+      dirty_ = true;
+      dirty_list_->push_back(this);
+    }
+  }
+  [[noreturn, gnu::cold, gnu::noinline]] void misuse(const char* what) const;
 
   std::string name_;
   int capacity_, latency_, width_;

@@ -35,34 +35,6 @@ void ChannelBase::misuse(const char* what) const {
   throw std::logic_error("channel '" + name_ + "' at cycle " + std::to_string(*now_) + ": " + what);
 }
 
-int ChannelBase::reserve_push() {
-  if (!can_push()) misuse("push while !can_push() (full, or port width used up)");
-  const int s = slot(count_ + pushes_);
-  ready_at_[static_cast<std::size_t>(s)] = *now_ + static_cast<std::uint64_t>(latency_);
-  ++pushes_;
-  if (!dirty_) {
-    dirty_ = true;
-    dirty_list_->push_back(this);
-  }
-  return s;
-}
-
-int ChannelBase::reserve_pop() {
-  if (!can_pop()) misuse("pop while !can_pop() (empty, not yet visible, or width used up)");
-  const int s = slot(pops_);
-  ++pops_;
-  if (!dirty_) {
-    dirty_ = true;
-    dirty_list_->push_back(this);
-  }
-  return s;
-}
-
-int ChannelBase::front_slot() const {
-  if (!can_pop()) misuse("peek while !can_pop()");
-  return slot(pops_);
-}
-
 int ChannelBase::commit() {
   const int moved = pushes_ + pops_;
   if (pushes_ != pops_) {
