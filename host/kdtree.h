@@ -4,8 +4,8 @@
 #pragma once
 
 #include <cstdint>
-#include <limits>
 #include <glm/glm.hpp>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -45,11 +45,11 @@ struct KdBuildParams {
 
 struct KdTreeNode {
   bool leaf = false;
-  std::uint8_t axis = 0;     // inner
-  float split = 0.0f;        // inner: exactly representable in split_format
-  std::uint32_t child = 0;   // inner: left child index; right child = child + 1
-  std::uint32_t first = 0;   // leaf: first index into KdTree::items
-  std::uint32_t count = 0;   // leaf: number of items
+  std::uint8_t axis = 0;    // inner
+  float split = 0.0f;       // inner: exactly representable in split_format
+  std::uint32_t child = 0;  // inner: left child index; right child = child + 1
+  std::uint32_t first = 0;  // leaf: first index into KdTree::items
+  std::uint32_t count = 0;  // leaf: number of items
 };
 
 struct KdTreeStats {
@@ -76,7 +76,19 @@ struct KdTree {
 // Bottom level: triangles (positions indexed by tris) with skip[i] != 0 left out (degenerate).
 KdTree build_kdtree(std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
                     std::span<const std::uint8_t> skip, const KdBuildParams& params = {});
-// Top level: boxes (instance world bounds); item i is box i.
+// Top level: boxes (instance world bounds); item i is box i. Empty boxes (lo > hi) are left out.
 KdTree build_kdtree(std::span<const Aabb> boxes, const KdBuildParams& params = {});
+
+// Additions (docs/kdtree.md). Both builders throw std::runtime_error on bad input: a non-finite
+// coordinate, a coordinate outside split_format's range, an index beyond the positions, a skip
+// list of the wrong length, more than 2^30 - 1 items, or invalid parameters.
+//
+// The statistics of a tree (what build_kdtree stores in KdTree::stats; build_seconds is copied).
+KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params = {});
+// Directed rounding onto the split grid (the values representable in `f` with subnormals
+// flushed): the builder rounds item bounds outward with these, so every candidate plane is a
+// stored plane. KdTree::bounds is rounded outward the same way.
+float kd_split_round_down(float v, const ff::Format& f);
+float kd_split_round_up(float v, const ff::Format& f);
 
 }  // namespace saarcor::host
