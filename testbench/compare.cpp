@@ -326,10 +326,11 @@ std::string compare_summary(const CompareResult& r) {
       }
     }
     if (r.t_rel_err_max) {
-      line("t rel. error:     ", "max " + fmt("%.3g", *r.t_rel_err_max) + " (--pixel " +
-                                     pix(r.worst_t) + "), median " +
-                                     fmt("%.3g", *r.t_rel_err_median) + " over " +
-                                     std::to_string(r.t_compared) + " pixels");
+      line("t rel. error:     ",
+           "max " + fmt("%.3g", *r.t_rel_err_max) +
+               (*r.t_rel_err_max > 0 ? " (--pixel " + pix(r.worst_t) + ")" : std::string()) +
+               ", median " + fmt("%.3g", *r.t_rel_err_median) + " over " +
+               std::to_string(r.t_compared) + " pixels");
     } else {
       line("t rel. error:     ", "no pixel hits the same triangle in both");
     }

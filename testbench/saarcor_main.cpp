@@ -8,15 +8,51 @@
 
 #include "testbench/version.h"
 // [subcommand headers]
+#include "testbench/compare.h"
+#include "testbench/render_cmd.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"saarcor: cycle-level, bit-accurate model of the SaarCOR dynamic ray tracing "
-               "pipeline (Schmittler, Woop et al., 2004)"};
+  CLI::App app{
+      "saarcor: cycle-level, bit-accurate model of the SaarCOR dynamic ray tracing "
+      "pipeline (Schmittler, Woop et al., 2004)"};
   app.set_version_flag("--version", std::string("saarcor ") + saarcor::kVersion);
   app.require_subcommand(1);
   int status = 0;
 
   // [subcommands]
+  saarcor::RenderOptions render_opts;
+  {
+    auto* sub = app.add_subcommand(
+        "render", "render one frame with a model; write PNG, EXR, hit EXR, report");
+    sub->add_option("scene", render_opts.scene, "glTF file or builtin:NAME")->required();
+    sub->add_option("--model", render_opts.model, "float | fp24 | e7m10..e7m23 (cycle: later)")
+        ->capture_default_str();
+    sub->add_option("--res", render_opts.res, "resolution WxH")->capture_default_str();
+    sub->add_option("--time", render_opts.time, "animation time in seconds");
+    sub->add_option("--out", render_opts.out, "output prefix (PREFIX.png, PREFIX.exr)")
+        ->capture_default_str();
+    sub->add_flag("--exr", render_opts.exr, "also write PREFIX.exr");
+    sub->add_option("--hits", render_opts.hits, "write the per-pixel hit records as a hit EXR");
+    sub->add_option("--report", render_opts.report, "write a JSON report");
+    sub->add_option("--pixel", render_opts.pixel, "trace one pixel x,y and print its hit record");
+    sub->add_flag("--shadows", render_opts.shadows, "shadow rays");
+    sub->add_option("--depth", render_opts.depth, "secondary-ray depth (0 = primary only)");
+    sub->callback([&] { status = saarcor::run_render(render_opts); });
+  }
+  saarcor::CompareOptions compare_opts;
+  {
+    auto* sub = app.add_subcommand("compare", "compare two hit EXRs or two images (B = reference)");
+    sub->add_option("a", compare_opts.a, "hit EXR or image A")->required();
+    sub->add_option("b", compare_opts.b, "hit EXR or image B (the reference)")->required();
+    sub->add_option("--report", compare_opts.report, "write the metrics as JSON");
+    sub->add_option("--diff", compare_opts.diff, "write a false-colour difference PNG");
+    sub->add_option("--bary-tol", compare_opts.params.bary_tolerance,
+                    "edge-tie tolerance on min(u, v, 1-u-v)")
+        ->capture_default_str();
+    sub->add_option("--grazing", compare_opts.params.grazing_cos, "grazing threshold on |cos|/|D|")
+        ->capture_default_str();
+    sub->callback([&] { status = saarcor::run_compare(compare_opts); });
+  }
 
   try {
     app.parse(argc, argv);

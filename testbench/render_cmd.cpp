@@ -1,0 +1,357 @@
+// `saarcor render` (issue 4; DESIGN.md section 9): load, set the time, build the memory image,
+// run one model, write PNG / EXR / hit EXR / JSON report. docs/compare.md lists the outputs.
+#include "testbench/render_cmd.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "host/float_reference.h"
+#include "host/primary_rays.h"
+#include "testbench/hit_exr.h"
+#include "testbench/image_io.h"
+
+namespace saarcor {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+bool parse_int(const std::string& s, int& out) {
+  if (s.empty() || s.size() > 9) return false;
+  for (char c : s) {
+    if (c < '0' || c > '9') return false;
+  }
+  out = std::stoi(s);
+  return true;
+}
+
+std::uint32_t float_bits(float f) {
+  std::uint32_t b;
+  std::memcpy(&b, &f, 4);
+  return b;
+}
+
+std::string describe_format(ff::Format f) {
+  return "Float<" + std::to_string(f.exp_bits) + "," + std::to_string(f.man_bits) + "> (" +
+         ff::format_name(f) + ")";
+}
+
+// ---- float reference ---------------------------------------------------------------------------
+
+host::FloatParams float_params(const RenderSettings& s) {
+  host::FloatParams p;
+  p.shadows = s.shadows;
+  p.secondary = s.depth > 0;
+  return p;
+}
+
+PixelHit to_pixel_hit(const host::FloatHit& h, std::uint32_t instance_id, const host::FloatRay& r) {
+  PixelHit p;
+  p.t = h.t;
+  p.u = h.u;
+  p.v = h.v;
+  p.cos = h.cos;
+  p.instance = h.hit() ? instance_id : 0xFFFFFFFFu;
+  p.triangle = h.hit() ? h.triangle : 0xFFFFFFFFu;
+  if (!h.hit()) {
+    p.t = std::numeric_limits<float>::infinity();
+    p.u = p.v = p.cos = 0.0f;
+  }
+  p.ox = r.origin.x;
+  p.oy = r.origin.y;
+  p.oz = r.origin.z;
+  p.dx = r.direction.x;
+  p.dy = r.direction.y;
+  p.dz = r.direction.z;
+  return p;
+}
+
+nlohmann::json counter_json(const std::vector<std::pair<const char*, std::uint64_t>>& totals,
+                            std::uint64_t rays) {
+  nlohmann::json j;
+  for (const auto& [name, total] : totals) {
+    j[name] = {{"total", total},
+               {"per_ray", rays ? static_cast<double>(total) / static_cast<double>(rays) : 0.0}};
+  }
+  return j;
+}
+
+FrameResult render_float_frame(const PreparedScene& prep, const RenderSettings& settings) {
+  FrameResult r;
+  r.model = "float";
+  const auto t0 = Clock::now();
+  const host::FloatFrame frame = host::render_float(prep.built, prep.scene, float_params(settings));
+  r.seconds = seconds_since(t0);
+  r.hits.width = frame.width;
+  r.hits.height = frame.height;
+  r.hits.pixels.resize(frame.pixels.size());
+  for (std::size_t i = 0; i < frame.pixels.size(); ++i) {
+    const host::FloatPixel& p = frame.pixels[i];
+    r.hits.pixels[i] = to_pixel_hit(p.hit, p.instance_id, p.ray);
+  }
+  r.image.width = frame.width;
+  r.image.height = frame.height;
+  r.image.rgb = frame.rgb;
+  const host::FloatTraceStats& s = frame.stats;
+  r.rays = s.rays;
+  r.counters["per_ray"] = counter_json({{"traversal_steps", s.traversal_steps},
+                                        {"leaves", s.leaves},
+                                        {"list_entries", s.list_entries},
+                                        {"mailbox_skips", s.mailbox_skips},
+                                        {"transformations", s.transformations},
+                                        {"intersections", s.intersections}},
+                                       s.rays);
+  r.counters["note"] = "float reference: counters of primary rays; binary32 ops are not counted";
+  return r;
+}
+
+PixelHit trace_float_pixel(const PreparedScene& prep, PixelCoord px) {
+  const host::FloatScene fs(prep.built);
+  const host::FloatRay ray = host::primary_ray(host::to_float(prep.built.basis), px.x, px.y);
+  // Primary rays: t_min = 0 (strict), t_max = +inf (docs/shading.md section 2).
+  const host::FloatHit h = fs.trace(ray, 0.0f, std::numeric_limits<float>::infinity());
+  const std::uint32_t id = h.hit() ? prep.built.instances.at(h.instance).id : 0xFFFFFFFFu;
+  return to_pixel_hit(h, id, ray);
+}
+
+void check_functional_format(const ModelSpec& model, const PreparedScene& prep) {
+  const ff::Format want{7, model.mantissa};
+  if (!(prep.built.params.format == want)) {
+    throw std::runtime_error("model " + model.name + " needs a memory image in " +
+                             describe_format(want) + ", the image was built in " +
+                             describe_format(prep.built.params.format));
+  }
+}
+
+}  // namespace
+
+void progress(const std::string& line) {
+  if (isatty(fileno(stderr))) std::fprintf(stderr, "%s\n", line.c_str());
+}
+
+Resolution parse_resolution(const std::string& text) {
+  const auto x = text.find('x');
+  Resolution r;
+  if (x == std::string::npos || !parse_int(text.substr(0, x), r.width) ||
+      !parse_int(text.substr(x + 1), r.height)) {
+    throw std::runtime_error("bad --res '" + text + "': expected WxH, e.g. 512x384");
+  }
+  if (r.width < 1 || r.height < 1 || r.width > 16384 || r.height > 16384) {
+    throw std::runtime_error("bad --res '" + text + "': width and height must be 1..16384");
+  }
+  return r;
+}
+
+PixelCoord parse_pixel(const std::string& text, const Resolution& res) {
+  const auto c = text.find(',');
+  PixelCoord p;
+  if (c == std::string::npos || !parse_int(text.substr(0, c), p.x) ||
+      !parse_int(text.substr(c + 1), p.y)) {
+    throw std::runtime_error("bad --pixel '" + text + "': expected x,y, e.g. 10,20");
+  }
+  if (p.x >= res.width || p.y >= res.height) {
+    throw std::runtime_error("bad --pixel '" + text + "': outside the " +
+                             std::to_string(res.width) + "x" + std::to_string(res.height) +
+                             " frame");
+  }
+  return p;
+}
+
+ModelSpec parse_model(const std::string& name) {
+  ModelSpec m;
+  m.name = name;
+  if (name == "float") {
+    m.kind = ModelKind::kFloat;
+    m.mantissa = 23;
+    return m;
+  }
+  if (name == "fp24") {
+    m.kind = ModelKind::kFunctional;
+    m.mantissa = 16;
+    return m;
+  }
+  int mant = 0;
+  if (name.rfind("e7m", 0) == 0 && parse_int(name.substr(3), mant) && mant >= kMinMantissa &&
+      mant <= kMaxMantissa) {
+    m.kind = ModelKind::kFunctional;
+    m.mantissa = mant;
+    return m;
+  }
+  if (name == "cycle") {
+    throw std::runtime_error(
+        "model 'cycle' is not available yet (the cycle model comes in a later issue); use "
+        "--model float or --model fp24");
+  }
+  throw std::runtime_error("unknown model '" + name + "': expected float, fp24, or e7m10..e7m23");
+}
+
+PreparedScene prepare_scene(const std::string& spec, const RenderSettings& settings,
+                            ff::Format format) {
+  if (settings.depth < 0 || settings.depth > 16) {
+    throw std::runtime_error("bad --depth " + std::to_string(settings.depth) + ": expected 0..16");
+  }
+  if (!std::isfinite(settings.time) || settings.time < 0.0) {
+    throw std::runtime_error("bad --time " + std::to_string(settings.time) +
+                             ": expected a time >= 0 in seconds");
+  }
+  PreparedScene p;
+  p.spec = spec;
+  auto t0 = Clock::now();
+  progress("loading " + spec);
+  p.scene = host::load_scene(spec);
+  if (settings.time != 0.0) p.scene.set_time(settings.time);
+  p.load_seconds = seconds_since(t0);
+  host::ImageParams ip;
+  ip.format = format;
+  ip.width = settings.res.width;
+  ip.height = settings.res.height;
+  ip.max_depth = static_cast<std::uint32_t>(settings.depth);
+  t0 = Clock::now();
+  progress("building the memory image (" + describe_format(format) + ")");
+  p.built = host::build_image(p.scene, ip);
+  p.build_seconds = seconds_since(t0);
+  return p;
+}
+
+FrameResult render_model(const ModelSpec& model, const PreparedScene& prep,
+                         const RenderSettings& settings) {
+  switch (model.kind) {
+    case ModelKind::kFloat:
+      return render_float_frame(prep, settings);
+    case ModelKind::kFunctional:
+      check_functional_format(model, prep);
+      throw std::runtime_error("the functional model is not built into this saarcor yet");
+    case ModelKind::kCycle:
+      break;
+  }
+  throw std::runtime_error("model '" + model.name + "' is not available yet");
+}
+
+PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prep,
+                     const RenderSettings& settings, PixelCoord pixel) {
+  (void)settings;
+  switch (model.kind) {
+    case ModelKind::kFloat:
+      return trace_float_pixel(prep, pixel);
+    case ModelKind::kFunctional:
+      check_functional_format(model, prep);
+      throw std::runtime_error("the functional model is not built into this saarcor yet");
+    case ModelKind::kCycle:
+      break;
+  }
+  throw std::runtime_error("model '" + model.name + "' is not available yet");
+}
+
+std::string format_pixel_hit(PixelCoord px, const PixelHit& h) {
+  char buf[1024];
+  std::string s;
+  std::snprintf(buf, sizeof buf, "pixel %d,%d: ", px.x, px.y);
+  s += buf;
+  if (h.hit()) {
+    std::snprintf(buf, sizeof buf,
+                  "hit instance %" PRIu32 " triangle %" PRIu32
+                  "\n"
+                  "  t   = %.9g (0x%08x)\n  u   = %.9g (0x%08x)\n  v   = %.9g (0x%08x)\n"
+                  "  cos = %.9g (0x%08x)\n",
+                  h.instance, h.triangle, h.t, float_bits(h.t), h.u, float_bits(h.u), h.v,
+                  float_bits(h.v), h.cos, float_bits(h.cos));
+  } else {
+    std::snprintf(buf, sizeof buf, "miss\n");
+  }
+  s += buf;
+  std::snprintf(buf, sizeof buf,
+                "  ray origin    (%.9g, %.9g, %.9g)\n  ray direction (%.9g, %.9g, %.9g)\n", h.ox,
+                h.oy, h.oz, h.dx, h.dy, h.dz);
+  s += buf;
+  return s;
+}
+
+int run_render(const RenderOptions& opts) {
+  const ModelSpec model = parse_model(opts.model);
+  RenderSettings settings;
+  settings.res = parse_resolution(opts.res);
+  settings.time = opts.time;
+  settings.shadows = opts.shadows;
+  settings.depth = opts.depth;
+  std::optional<PixelCoord> pixel;
+  if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
+  if (opts.out.empty()) throw std::runtime_error("bad --out '': expected a file prefix");
+
+  const ff::Format format =
+      model.kind == ModelKind::kFunctional ? ff::Format{7, model.mantissa} : ff::kFp24;
+  const PreparedScene prep = prepare_scene(opts.scene, settings, format);
+
+  if (pixel) {
+    const PixelHit h = trace_pixel(model, prep, settings, *pixel);
+    std::printf("saarcor render %s --model %s --res %dx%d --time %g\n%s", opts.scene.c_str(),
+                model.name.c_str(), settings.res.width, settings.res.height, settings.time,
+                format_pixel_hit(*pixel, h).c_str());
+    return 0;
+  }
+
+  progress("rendering " + std::to_string(settings.res.width) + "x" +
+           std::to_string(settings.res.height) + " with the " + model.name + " model");
+  const FrameResult frame = render_model(model, prep, settings);
+
+  const std::string png = opts.out + ".png";
+  write_rgb8(png, frame.image);
+  std::vector<std::pair<std::string, std::string>> outputs = {{"image", png}};
+  if (opts.exr) {
+    const std::string exr = opts.out + ".exr";
+    write_float_image(exr, to_float_image(frame.image));
+    outputs.push_back({"image_exr", exr});
+  }
+  if (!opts.hits.empty()) {
+    write_hit_exr(opts.hits, frame.hits);
+    outputs.push_back({"hits", opts.hits});
+  }
+  const double rays_per_s = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
+  if (!opts.report.empty()) {
+    nlohmann::json j;
+    j["scene"] = opts.scene;
+    j["model"] = model.name;
+    j["resolution"] = {{"width", settings.res.width}, {"height", settings.res.height}};
+    j["seconds"] = frame.seconds;
+    j["rays"] = frame.rays;
+    j["rays_per_second"] = rays_per_s;
+    j["counters"] = frame.counters;
+    const auto& st = prep.built.stats;
+    j["configuration"] = {{"time", settings.time},
+                          {"shadows", settings.shadows},
+                          {"depth", settings.depth},
+                          {"image_format", describe_format(prep.built.params.format)},
+                          {"bank_words", prep.built.params.bank_words},
+                          {"instances", prep.scene.instances.size()},
+                          {"objects", prep.scene.objects.size()},
+                          {"triangles_unique", prep.scene.unique_triangles()},
+                          {"triangles_instanced", prep.scene.instanced_triangles()},
+                          {"triangles_dropped", st.dropped_triangles},
+                          {"scene_bytes", st.scene_bytes()},
+                          {"light_defaulted", prep.scene.light_defaulted},
+                          {"load_seconds", prep.load_seconds},
+                          {"build_seconds", prep.build_seconds}};
+    nlohmann::json out;
+    for (const auto& [k, v] : outputs)
+      out[k] = v;
+    j["outputs"] = out;
+    write_text_file(opts.report, j.dump(2) + "\n");
+    outputs.push_back({"report", opts.report});
+  }
+  std::printf("saarcor render: %s, model %s, %dx%d, %.3f s, %" PRIu64 " rays (%.3g rays/s)\n",
+              opts.scene.c_str(), model.name.c_str(), settings.res.width, settings.res.height,
+              frame.seconds, frame.rays, rays_per_s);
+  for (const auto& [k, v] : outputs)
+    std::printf("  %-10s %s\n", (k + ":").c_str(), v.c_str());
+  return 0;
+}
+
+}  // namespace saarcor

@@ -1,0 +1,103 @@
+// `saarcor render`: one frame of a scene through one of the models of DESIGN.md section 9 (float
+// reference, functional model in Float<7,m>; the cycle model comes later), written as image, hit
+// EXR and JSON report (docs/compare.md). The pieces are public so `saarcor precision` and the
+// tests reuse them.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "fixedfloat/format.h"
+#include "host/image_builder.h"
+#include "host/scene.h"
+#include "testbench/hit_buffer.h"
+
+namespace saarcor {
+
+struct Resolution {
+  int width = 512;
+  int height = 384;
+};
+// "WxH" with 1 <= W, H <= 16384; throws "bad --res 'TEXT': ..." otherwise.
+Resolution parse_resolution(const std::string& text);
+
+struct PixelCoord {
+  int x = 0;
+  int y = 0;
+};
+// "x,y" inside the frame; throws "bad --pixel 'TEXT': ..." otherwise.
+PixelCoord parse_pixel(const std::string& text, const Resolution& res);
+
+enum class ModelKind { kFloat, kFunctional, kCycle };
+struct ModelSpec {
+  ModelKind kind = ModelKind::kFunctional;
+  int mantissa = 16;  // functional model: Float<7, mantissa>
+  std::string name = "fp24";
+};
+// "float", "fp24" (= "e7m16"), "e7m<M>" (Float<7,M>, M = 10..23). "cycle" throws "not available
+// yet" until the cycle model exists.
+ModelSpec parse_model(const std::string& name);
+inline constexpr int kMinMantissa = 10;
+inline constexpr int kMaxMantissa = 23;
+
+struct RenderSettings {
+  Resolution res;
+  double time = 0.0;     // seconds into the scene's animation
+  bool shadows = false;  // shadow rays (docs/shading.md section 6)
+  int depth = 0;         // secondary rays (reflection, transparency) up to this depth; 0 = none
+};
+
+// The scene loaded, set to the time, with its memory image built in `format`.
+struct PreparedScene {
+  std::string spec;
+  host::Scene scene;
+  host::BuiltImage built;
+  double load_seconds = 0.0;
+  double build_seconds = 0.0;
+};
+PreparedScene prepare_scene(const std::string& spec, const RenderSettings& settings,
+                            ff::Format format = ff::kFp24);
+
+// One frame of one model: hit records (hit.instance = glTF node index, values converted exactly
+// to binary32), the shaded RGB8 image, and what it cost.
+struct FrameResult {
+  std::string model;
+  HitBuffer hits;
+  Rgb8Image image;
+  double seconds = 0.0;     // the model's run time (wall clock)
+  std::uint64_t rays = 0;   // rays traced (primary, plus shadow and secondary when on)
+  nlohmann::json counters;  // per-ray counters and op counts, totals and per ray
+};
+
+// Runs the model on a prepared scene. The functional model needs the image built in
+// Format{7, mantissa}; it throws when the prepared image has another format.
+FrameResult render_model(const ModelSpec& model, const PreparedScene& prepared,
+                         const RenderSettings& settings);
+
+// The hit record of one pixel traced alone (the replay recipe of a failing check).
+PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prepared,
+                     const RenderSettings& settings, PixelCoord pixel);
+std::string format_pixel_hit(PixelCoord pixel, const PixelHit& hit);
+
+struct RenderOptions {
+  std::string scene;
+  std::string model = "fp24";
+  std::string res = "512x384";
+  double time = 0.0;
+  std::string out = "out/render";
+  bool exr = false;
+  std::string hits;    // hit EXR path, optional
+  std::string report;  // JSON path, optional
+  std::string pixel;   // "x,y": trace one pixel and print its record instead of a frame
+  bool shadows = false;
+  int depth = 0;
+};
+
+// Returns 0; throws std::runtime_error with one line on bad input.
+int run_render(const RenderOptions& opts);
+
+// Writes one line of progress to stderr when it is a terminal (and nothing otherwise).
+void progress(const std::string& line);
+
+}  // namespace saarcor
