@@ -1,0 +1,173 @@
+// Datapath unit tests with hand-computed fp24 values (units/datapath.h, units/mailbox.h).
+#include "units/datapath.h"
+
+#include <gtest/gtest.h>
+
+#include "units/mailbox.h"
+
+namespace saarcor::units {
+namespace {
+
+using F = ff::fp24;
+
+F f(double v) { return F::from_double(v); }
+
+TEST(TransformStep, OpOrderIsM0XPlusM1YThenM2ZPlusT) {
+  ff::OpCounts ops;
+  ff::FpUnit<F> fp({}, &ops);
+  const double e = std::ldexp(1.0, -17);  // half an ulp of 1.0 in fp24
+  // Row 0: (1*1 + e*1) + (e*1 + 0): 1 + e ties to even (1), e + 0 = e, 1 + e -> 1 again. Any
+  // other association (1 + (e + e) = 1 + 2^-16) would give the next float above 1.
+  Mat34<F> m{};
+  m[0] = {f(1), f(e), f(e), f(0)};
+  m[1] = {f(2), f(3), f(4), f(5)};
+  m[2] = {f(0.5), f(-1), f(0.25), f(-8)};
+  const Vec3<F> v{f(1), f(1), f(1)};
+  const Vec3<F> o = transform_step(fp, m, v, true);
+  EXPECT_EQ(o[0].bits, f(1).bits);
+  EXPECT_EQ(o[1].bits, f(14).bits);    // (2 + 3) + (4 + 5)
+  EXPECT_EQ(o[2].bits, f(-8.25).bits);  // (0.5 - 1) + (0.25 - 8)
+  EXPECT_EQ(ops.mul, 9u);
+  EXPECT_EQ(ops.add, 9u);
+  // Direction step: the translation is replaced by zero, the adder still runs: -0 + +0 = +0.
+  const Vec3<F> d = transform_step(fp, m, Vec3<F>{f(-0.0), f(-0.0), f(-0.0)}, false);
+  EXPECT_EQ(d[1].bits, 0u);  // +0, not the -0 of the products
+  EXPECT_EQ(ops.mul, 18u);
+  EXPECT_EQ(ops.add, 18u);
+  EXPECT_EQ(dot_step(fp, Vec3<F>{f(1), f(2), f(3)}, Vec3<F>{f(4), f(5), f(6)}).bits, f(32).bits);
+}
+
+TEST(TraversalLane, BothChildrenSplitTheSegmentAtD) {
+  ff::OpCounts ops;
+  ff::FpUnit<F> fp({}, &ops);
+  const TraversalLane<F> r = traversal_lane(fp, f(2), f(0), f(1), f(0), f(10));
+  EXPECT_TRUE(r.go_near);
+  EXPECT_TRUE(r.go_far);
+  EXPECT_EQ(r.near_tf.bits, f(2).bits);
+  EXPECT_EQ(r.far_tn.bits, f(2).bits);
+  EXPECT_EQ(ops.add, 1u);
+  EXPECT_EQ(ops.div, 1u);
+  EXPECT_EQ(ops.cmp, 2u);
+}
+
+TEST(TraversalLane, OneSideAndRounding) {
+  ff::FpUnit<F> fp;
+  // Plane behind the segment start (d = -3 < tn): far child only.
+  TraversalLane<F> r = traversal_lane(fp, f(2), f(5), f(1), f(0), f(10));
+  EXPECT_FALSE(r.go_near);
+  EXPECT_TRUE(r.go_far);
+  EXPECT_EQ(r.far_tn.bits, f(0).bits);  // unchanged start
+  // Plane beyond the segment end (d = 20 > tf): near child only.
+  r = traversal_lane(fp, f(20), f(0), f(1), f(0), f(10));
+  EXPECT_TRUE(r.go_near);
+  EXPECT_FALSE(r.go_far);
+  EXPECT_EQ(r.near_tf.bits, f(10).bits);
+  // d = 1/3 rounded to 17 significant bits: 1.0101010101010101|01.. x 2^-2 rounds down.
+  r = traversal_lane(fp, f(1), f(0), f(3), f(0), f(10));
+  EXPECT_EQ(r.near_tf.bits, 0x3D5555u);
+  // Direction parallel to the plane, origin on it: 0/0 = NaN, both children keep [tn, tf].
+  r = traversal_lane(fp, f(2), f(2), f(0), f(1), f(4));
+  EXPECT_TRUE(r.go_near && r.go_far);
+  EXPECT_EQ(r.near_tf.bits, f(4).bits);
+  EXPECT_EQ(r.far_tn.bits, f(1).bits);
+  // Parallel, origin below the plane: d = +inf, near only.
+  r = traversal_lane(fp, f(2), f(1), f(0), f(1), f(4));
+  EXPECT_TRUE(r.go_near);
+  EXPECT_FALSE(r.go_far);
+  // Early termination: only a segment starting strictly beyond the closest hit is dropped.
+  EXPECT_TRUE(terminated(fp, f(1), f(2)));
+  EXPECT_FALSE(terminated(fp, f(2), f(2)));
+}
+
+TEST(ClipFace, EntryRaisesStartExitLowersEnd) {
+  ff::OpCounts ops;
+  ff::FpUnit<F> fp({}, &ops);
+  F tn = f(0), tf = F::infinity();
+  clip_face(fp, f(1), f(-1), f(2), true, tn, tf);  // (1 - -1) / 2 = 1
+  clip_face(fp, f(5), f(-1), f(2), false, tn, tf);  // (5 + 1) / 2 = 3
+  EXPECT_EQ(tn.bits, f(1).bits);
+  EXPECT_EQ(tf.bits, f(3).bits);
+  EXPECT_EQ(ops.add, 2u);
+  EXPECT_EQ(ops.div, 2u);
+  EXPECT_EQ(ops.cmp, 2u);
+  // Origin on a face of a parallel slab: NaN keeps the old bounds.
+  clip_face(fp, f(1), f(1), f(0), true, tn, tf);
+  EXPECT_EQ(tn.bits, f(1).bits);
+}
+
+Ray<F> unit_ray(double ox, double oy, double oz, double dx, double dy, double dz) {
+  return {{f(ox), f(oy), f(oz)}, {f(dx), f(dy), f(dz)}};
+}
+
+TEST(Intersection, HitMissEdge) {
+  ff::OpCounts ops;
+  ff::FpUnit<F> fp({}, &ops);
+  Candidate<F> c = intersect_unit_triangle(fp, unit_ray(0.25, 0.125, 2, 0.5, 0.25, -4));
+  // t = 2/4 = 0.5, u = 0.25 + 0.25 = 0.5, v = 0.125 + 0.125 = 0.25.
+  EXPECT_TRUE(c.inside);
+  EXPECT_EQ(c.t.bits, f(0.5).bits);
+  EXPECT_EQ(c.u.bits, f(0.5).bits);
+  EXPECT_EQ(c.v.bits, f(0.25).bits);
+  EXPECT_EQ(c.c.bits, f(-4).bits);
+  EXPECT_EQ(ops.add, 3u);
+  EXPECT_EQ(ops.mul, 2u);
+  EXPECT_EQ(ops.div, 1u);
+  EXPECT_EQ(ops.cmp, 0u);  // acceptance is bit tests and magnitude compares (D13)
+  // u + v = 1.5: outside.
+  EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(0.75, 0.75, 1, 0, 0, -1)).inside);
+  // Edge u + v = 1 and vertex u = 0: inside (edges inclusive).
+  EXPECT_TRUE(intersect_unit_triangle(fp, unit_ray(0.5, 0.5, 1, 0, 0, -1)).inside);
+  EXPECT_TRUE(intersect_unit_triangle(fp, unit_ray(0, 0, 1, 0, 0, -1)).inside);
+  // u + v one ulp of 1 above 1: outside. Half an ulp above rounds (ties to even) back to 1 in
+  // the third adder: inside, a precision effect of the format.
+  EXPECT_FALSE(
+      intersect_unit_triangle(fp, unit_ray(0.5, 0.5 + std::ldexp(1.0, -16), 1, 0, 0, -1)).inside);
+  EXPECT_TRUE(
+      intersect_unit_triangle(fp, unit_ray(0.5, 0.5 + std::ldexp(1.0, -17), 1, 0, 0, -1)).inside);
+  // u one ulp below zero.
+  EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(-std::ldexp(1.0, -30), 0.5, 1, 0, 0, -1)).inside);
+  // Behind the origin (t = -1), parallel (D'z = 0), and t = 0 are misses.
+  EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(0.25, 0.25, -1, 0, 0, -1)).inside);
+  EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(0.25, 0.25, 1, 0, 0, 0)).inside);
+  EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(0.25, 0.25, 0, 0, 0, -1)).inside);
+  // -0 counts as 0 for u: t * D'x = 1 * -0.
+  EXPECT_TRUE(intersect_unit_triangle(fp, unit_ray(-0.0, 0.5, 1, -0.0, 0, -1)).inside);
+}
+
+TEST(Intersection, TieRuleSmallerInstanceThenTriangle) {
+  ff::FpUnit<F> fp;
+  const Candidate<F> c = intersect_unit_triangle(fp, unit_ray(0.25, 0.25, 1, 0, 0, -1));
+  HitRecord<F> best;
+  EXPECT_TRUE(accepts(c, 5, 9, best));  // anything beats no hit
+  best.t = f(1);
+  best.instance = 5;
+  best.triangle = 9;
+  EXPECT_TRUE(accepts(c, 4, 100, best));   // equal t, smaller instance
+  EXPECT_TRUE(accepts(c, 5, 8, best));     // equal t, same instance, smaller triangle
+  EXPECT_FALSE(accepts(c, 5, 9, best));    // the same triangle again changes nothing
+  EXPECT_FALSE(accepts(c, 5, 10, best));
+  EXPECT_FALSE(accepts(c, 6, 0, best));
+  best.t = F::from_bits(f(1).bits + 1);  // one ulp further: any instance wins
+  EXPECT_TRUE(accepts(c, 99, 99, best));
+  best.t = F::from_bits(f(1).bits - 1);  // one ulp nearer: nothing wins
+  EXPECT_FALSE(accepts(c, 0, 0, best));
+}
+
+TEST(Mailbox, SkipsVisitedRaysOnlyAndEvictsOldest) {
+  Mailbox mb(2);
+  EXPECT_EQ(mb.filter(5, 0b0011), 0b0011u);
+  EXPECT_EQ(mb.filter(5, 0b0110), 0b0100u);  // ray 1 visited 5 already
+  EXPECT_EQ(mb.filter(5, 0b0111), 0u);       // skip: every ray visited it
+  EXPECT_EQ(mb.filter(7, 0b0001), 0b0001u);
+  EXPECT_EQ(mb.filter(9, 0b0001), 0b0001u);  // evicts 5 (oldest)
+  EXPECT_EQ(mb.filter(7, 0b0001), 0u);
+  EXPECT_EQ(mb.filter(5, 0b0001), 0b0001u);  // a revisit after eviction
+  mb.clear();
+  EXPECT_EQ(mb.filter(9, 0b0001), 0b0001u);
+  Mailbox off(0);
+  EXPECT_EQ(off.filter(1, 3), 3u);
+  EXPECT_EQ(off.filter(1, 3), 3u);
+}
+
+}  // namespace
+}  // namespace saarcor::units

@@ -1,0 +1,92 @@
+// The functional fp24 model (DESIGN.md section 9, model 2): the DynRTP's algorithms, untimed, in
+// the hardware's float format with the datapath op orders of DESIGN.md sections 5 and 7. The RGC
+// (paper section 3.1) hands screen-space packets of P pixels to one thread program
+// (units/thread_program.h) that runs each to completion, packet after packet. The cycle model
+// drives the same thread program with timing and must match this model bit for bit.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fixedfloat/float.h"
+#include "memif/image_format.h"
+#include "units/thread_program.h"
+
+namespace saarcor::units {
+
+// Work and float ops of one frame, per unit (paper Table 2 names the units).
+struct UnitStats {
+  ff::OpCounts traversal_ops, transformation_ops, intersection_ops, rgs_ops;
+  std::uint64_t traversal_steps = 0;
+  std::uint64_t inner_steps = 0;
+  std::uint64_t clip_steps = 0;
+  std::uint64_t list_steps = 0;
+  std::uint64_t transformation_steps = 0;
+  std::uint64_t shading_transformation_steps = 0;
+  std::uint64_t intersection_packets = 0;
+  std::uint64_t sub_packets = 0;
+  std::uint64_t packets = 0;   // primary packets handed out by the RGC
+  std::uint64_t requests = 0;  // thread-program requests served (all units)
+};
+
+struct FunctionalFrame {
+  ff::Format format = ff::kFp24;
+  int width = 0;
+  int height = 0;
+  FunctionalParams params;
+  // Per pixel (row-major, row 0 at the top): the primary ray's closest hit as encodings of
+  // `format` (miss: t = +inf, instance = triangle = memif::kNone), its world ray, its counters.
+  std::vector<FrameSink::Pixel> pixels;
+  std::vector<std::uint8_t> rgb;  // 3 bytes per pixel (R, G, B), row 0 at the top
+  std::array<RayCounters, kRayKinds> by_kind{};  // per ray kind, summed over rays
+  std::array<std::uint64_t, kRayKinds> rays_issued{};
+  std::array<std::uint64_t, kRayKinds> rays_returned{};
+  UnitStats units;
+  double seconds = 0.0;  // host time of the run
+
+  const FrameSink::Pixel& at(int x, int y) const {
+    return pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                  static_cast<std::size_t>(x)];
+  }
+};
+
+// The RGC's packets (D38, row-major tiles): P pixels in a tile of tile_width x tile_height
+// (2x2 for P = 4; 4x4 for 16; 2x1 for 2), lanes row-major inside the tile, tiles row-major over
+// the image; lanes outside the image are memif::kNone.
+struct PacketTiling {
+  int tile_width = 1;
+  int tile_height = 1;
+  int tiles_x = 0;
+  int tiles_y = 0;
+  int count() const { return tiles_x * tiles_y; }
+};
+PacketTiling packet_tiling(int width, int height, int packet);
+// Pixel indices (y*width + x) of packet `index`.
+std::vector<std::uint32_t> packet_pixels(const PacketTiling& tiling, int width, int height,
+                                         int index);
+
+using ProgressFn = std::function<void(int packets_done, int packets_total)>;
+
+// Renders the frame of `image` (FrameRegisters: resolution, camera, lights). F must be the image's
+// format (throws std::runtime_error otherwise). Instantiated for Float<7, 10..23> and Float<8,23>.
+template <class F>
+FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
+                               const ProgressFn& progress = {});
+// The same, choosing F from image.format() (the formats above; others throw).
+FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
+                               const ProgressFn& progress = {});
+
+// Replays the packet holding pixel (x, y) (`--pixel x,y`): that pixel's record, and one log line
+// per thread-program request (unit, phase, item, mask) in execution order.
+struct PixelTrace {
+  FrameSink::Pixel pixel;
+  std::array<std::uint8_t, 3> rgb{};
+  std::vector<std::string> log;
+};
+PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& params, int x,
+                       int y);
+
+}  // namespace saarcor::units

@@ -1,0 +1,1060 @@
+// One DynRTP thread: a packet of P rays and all its state (DESIGN.md section 5: rays in world and
+// current space, closest hit per ray, traversal stack, current level, list cursor, mailbox), and
+// its control flow as an explicit state machine, the "thread program" (paper section 3.1, Figure 2,
+// paths a-g; docs/functional-model.md). `request()` says which unit the thread needs next and
+// what for; `execute()` performs that unit's work with the unit's datapath (units/datapath.h) and
+// moves to the next state. The functional model runs a thread to completion; the cycle model
+// queues the thread at the requested unit and calls execute() when the unit serves it. Both run
+// the same code in the same per-thread order, so their results are bit-identical by construction.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fixedfloat/float.h"
+#include "memif/image_format.h"
+#include "units/datapath.h"
+#include "units/mailbox.h"
+#include "units/shading.h"
+
+namespace saarcor::units {
+
+inline constexpr int kMaxPacket = 64;  // lane masks are 64-bit
+
+struct FunctionalParams {
+  int packet = 4;          // P rays per packet (thread); a power of two, 1..64
+  int stack_depth = 64;    // traversal stack entries per packet (D26)
+  int mailbox = 8;         // object mailbox entries per thread (D28), 0 = off
+  int triangle_mailbox = 0;  // triangle mailbox entries (D28 option), 0 = off
+  bool shared_origin = true;  // the n+1 rule for packets with one origin (D31)
+  bool shade = true;        // run the RGS; false leaves the image black (hit records only)
+  bool shadows = false;     // shadow rays (docs/shading.md 6.4); Table 3 setting: off
+  bool secondary = false;   // reflection and transparency rays; Table 3 setting: off
+  int max_depth = -1;       // secondary-ray depth bound, -1 = FrameRegisters::max_depth
+  ff::Mode mode{};          // rounding of every FP unit
+};
+
+// Work counted per ray (DESIGN.md section 5; issue 4).
+struct RayCounters {
+  std::uint64_t traversal_steps = 0;  // kd-node visits in which the ray was active
+  std::uint64_t list_entries = 0;     // list entries fetched for the ray
+  std::uint64_t mailbox_skips = 0;    // entries skipped because the ray already visited them
+  std::uint64_t transformations = 0;  // ray transforms (generation, object, triangle)
+  std::uint64_t intersections = 0;    // unit-triangle tests
+  RayCounters& operator+=(const RayCounters& o) {
+    traversal_steps += o.traversal_steps;
+    list_entries += o.list_entries;
+    mailbox_skips += o.mailbox_skips;
+    transformations += o.transformations;
+    intersections += o.intersections;
+    return *this;
+  }
+  friend bool operator==(const RayCounters&, const RayCounters&) = default;
+};
+
+enum class RayKind : std::uint8_t { kPrimary = 0, kShadow = 1, kReflection = 2, kTransparency = 3 };
+inline constexpr int kRayKinds = 4;
+inline const char* ray_kind_name(RayKind k) {
+  constexpr const char* kNames[] = {"primary", "shadow", "reflection", "transparency"};
+  return kNames[static_cast<int>(k)];
+}
+
+// The hardware units of one DynRTP a thread may ask for.
+enum class UnitId : std::uint8_t {
+  kRgs,
+  kTransformation,
+  kTraversal,
+  kList,
+  kIntersection,
+  kNone,
+};
+inline const char* unit_name(UnitId u) {
+  constexpr const char* kNames[] = {"rgs", "transformation", "traversal", "list", "intersection",
+                                    "none"};
+  return kNames[static_cast<int>(u)];
+}
+
+// The states of the thread program. Each names the unit that serves it.
+enum class Phase : std::uint8_t {
+  kGenerate,           // transformation (path a): R' through the RGS's T into world rays
+  kClipTop,            // traversal: one face of the scene box (6 steps, D29)
+  kTraverse,           // traversal (paths b, f): one kd-node step of the packet
+  kList,               // list (path c): one list entry, mailboxed at the top level
+  kTransformObject,    // transformation (path d): world -> object with the instance matrix
+  kClipBottom,         // traversal: one face of the object box (6 steps)
+  kTransformTriangle,  // transformation (path d): object -> unit-triangle space with T_delta
+  kIntersect,          // intersection (path e): the packet's rays one per cycle
+  kShadeSurface,       // RGS (path g): the surface hits of a primary/secondary packet
+  kShadeLight,         // RGS: cosines of one light from its generated shadow rays
+  kShadeShadow,        // RGS: shadow-ray results of one light
+  kDone,
+};
+inline const char* phase_name(Phase p) {
+  constexpr const char* kNames[] = {
+      "generate",           "clip_top",  "traverse",      "list",         "transform_object",
+      "clip_bottom",        "transform_triangle", "intersect", "shade_surface", "shade_light",
+      "shade_shadow",       "done"};
+  return kNames[static_cast<int>(p)];
+}
+inline UnitId phase_unit(Phase p) {
+  switch (p) {
+    case Phase::kGenerate:
+    case Phase::kTransformObject:
+    case Phase::kTransformTriangle:
+      return UnitId::kTransformation;
+    case Phase::kClipTop:
+    case Phase::kTraverse:
+    case Phase::kClipBottom:
+      return UnitId::kTraversal;
+    case Phase::kList:
+      return UnitId::kList;
+    case Phase::kIntersect:
+      return UnitId::kIntersection;
+    case Phase::kShadeSurface:
+    case Phase::kShadeLight:
+    case Phase::kShadeShadow:
+      return UnitId::kRgs;
+    case Phase::kDone:
+      return UnitId::kNone;
+  }
+  return UnitId::kNone;
+}
+
+// What the thread asks of a unit next: enough for a cycle model to fetch the item through the
+// unit's cache and to know how many pipeline slots the work takes.
+struct Request {
+  UnitId unit = UnitId::kNone;
+  Phase phase = Phase::kDone;
+  std::uint32_t item = memif::kNone;  // kTraverse: node; kList: list entry; kTransform*: first
+                                      // matrix row; kClip*: face 0..5; otherwise kNone
+  int steps = 0;  // transformation steps (n+1 or 2n), intersection cycles (P), else 1
+  std::uint64_t mask = 0;  // the rays concerned
+};
+
+// The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is
+// DIGEST D10's optional shading helper (cosines: mul, sqrt, div).
+template <class F>
+class PipelineUnits {
+ public:
+  explicit PipelineUnits(ff::Mode mode = {})
+      : traversal(mode, &traversal_ops),
+        transformation(mode, &transformation_ops),
+        intersection(mode, &intersection_ops),
+        rgs(mode, &rgs_ops) {}
+  PipelineUnits(const PipelineUnits&) = delete;
+  PipelineUnits& operator=(const PipelineUnits&) = delete;
+
+  ff::OpCounts traversal_ops, transformation_ops, intersection_ops, rgs_ops;
+  ff::FpUnit<F> traversal, transformation, intersection, rgs;
+
+  // Work counted per unit, in the unit's own steps.
+  std::uint64_t traversal_steps = 0;       // kd-node steps (inner + leaf + empty)
+  std::uint64_t inner_steps = 0;           // steps on inner nodes (P add, P div, 3P cmp)
+  std::uint64_t clip_steps = 0;            // box-face steps (P add, P div, P (+P) cmp)
+  std::uint64_t list_steps = 0;            // list entries fetched
+  std::uint64_t transformation_steps = 0;  // ray transformation steps (generation, object, tri)
+  std::uint64_t shading_transformation_steps = 0;  // normal and dot-product steps of the RGS
+  std::uint64_t intersection_packets = 0;  // packets intersected (P rays each)
+  std::uint64_t sub_packets = 0;           // masked sub-packets from mixed direction signs (D27)
+};
+
+// Where a thread's results go: the frame the RGC hands pixels from.
+struct FrameSink {
+  int width = 0;
+  int height = 0;
+  // Per pixel: the primary ray's closest hit (encodings), its world ray, its counters.
+  struct Pixel {
+    std::uint32_t t = 0, u = 0, v = 0, cos = 0;
+    std::uint32_t instance = memif::kNone, triangle = memif::kNone;
+    std::array<std::uint32_t, 3> o{}, d{};
+    RayCounters counters;
+  };
+  std::vector<Pixel> pixels;
+  std::vector<std::array<std::uint32_t, 3>> colour_sum;  // sum of weight * colour (docs 7)
+  std::array<RayCounters, kRayKinds> by_kind{};
+  std::array<std::uint64_t, kRayKinds> rays_issued{};
+  std::array<std::uint64_t, kRayKinds> rays_returned{};
+
+  void reset(int w, int h) {
+    width = w;
+    height = h;
+    pixels.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), Pixel{});
+    colour_sum.assign(pixels.size(), {0u, 0u, 0u});
+    by_kind = {};
+    rays_issued = {};
+    rays_returned = {};
+  }
+};
+
+template <class F>
+class ThreadProgram {
+ public:
+  ThreadProgram(const memif::MemoryImage& image, const FunctionalParams& params,
+                PipelineUnits<F>& units, FrameSink& sink)
+      : image_(image),
+        params_(params),
+        u_(units),
+        sink_(sink),
+        p_(params.packet),
+        mailbox_(params.mailbox),
+        tri_mailbox_(params.triangle_mailbox) {
+    if (!(F::kFormat == image.format()))
+      throw std::runtime_error("functional model: the image's float format " +
+                               ff::format_name(image.format()) +
+                               " does not match the model's " + ff::format_name(F::kFormat));
+    if (p_ < 1 || p_ > kMaxPacket || (p_ & (p_ - 1)) != 0)
+      throw std::runtime_error("functional model: packet width " + std::to_string(p_) +
+                               " is not a power of two in 1..64");
+    if (params.stack_depth < 1)
+      throw std::runtime_error("functional model: stack depth must be at least 1");
+    lanes_.resize(static_cast<std::size_t>(p_));
+    surf_.resize(static_cast<std::size_t>(p_));
+    stack_node_.reserve(static_cast<std::size_t>(params.stack_depth));
+    stack_mask_.reserve(static_cast<std::size_t>(params.stack_depth));
+    stack_t_.reserve(static_cast<std::size_t>(params.stack_depth) * 2u * lanes_.size());
+    const auto& regs = image.registers();
+    max_depth_ = params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth)
+                                       : regs.max_depth;
+    for (int i = 0; i < 3; ++i) {
+      cam_[i] = {F::from_bits(regs.cam_r[i]), F::from_bits(regs.cam_u[i]),
+                 F::from_bits(regs.cam_d[i]), F::from_bits(regs.cam_p[i])};
+      scene_lo_[i] = F::from_bits(regs.scene_min[i]);
+      scene_hi_[i] = F::from_bits(regs.scene_max[i]);
+    }
+    epsilon_ = F::from_bits(regs.epsilon);
+    shadow_t_max_ = F::from_double(1.0 - 1.0 / 512.0);
+  }
+
+  // The RGC hands the thread the primary packet of pixels `pixel[i]` (memif::kNone = empty lane).
+  void start_primary(const std::vector<std::uint32_t>& pixel) {
+    pending_.clear();
+    const auto width = static_cast<std::uint32_t>(sink_.width);
+    Packet pk;
+    pk.kind = RayKind::kPrimary;
+    pk.depth = 0;
+    pk.shared_origin = params_.shared_origin;
+    pk.lanes.resize(lanes_.size());
+    for (int i = 0; i < p_; ++i) {
+      auto& g = pk.lanes[static_cast<std::size_t>(i)];
+      g.t = cam_;
+      g.ro = {F::zero(), F::zero(), F::zero()};
+      const std::uint32_t px = i < static_cast<int>(pixel.size()) ? pixel[i] : memif::kNone;
+      if (px == memif::kNone) continue;
+      g.valid = true;
+      g.pixel = px;
+      g.weight = 255;
+      g.rd = {F::from_int(px % width), F::from_int(px / width), F::one()};
+    }
+    begin_packet(pk);
+  }
+
+  bool done() const { return phase_ == Phase::kDone; }
+  Phase phase() const { return phase_; }
+
+  Request request() const {
+    Request r;
+    r.phase = phase_;
+    r.unit = phase_unit(phase_);
+    r.steps = 1;
+    switch (phase_) {
+      case Phase::kGenerate:
+        r.mask = valid_mask();
+        r.steps = transform_steps();
+        break;
+      case Phase::kClipTop:
+      case Phase::kClipBottom:
+        r.item = static_cast<std::uint32_t>(clip_face_);
+        r.mask = clip_mask_;
+        break;
+      case Phase::kTraverse:
+        r.item = node_;
+        r.mask = mask_;
+        break;
+      case Phase::kList: {
+        const ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
+        r.item = c.next;
+        r.mask = c.mask;
+        break;
+      }
+      case Phase::kTransformObject:
+        r.item = image_.registers().instance_row_base + memif::kInstanceRows * instance_;
+        r.mask = entry_mask_;
+        r.steps = transform_steps();
+        break;
+      case Phase::kTransformTriangle:
+        r.item = header_.triangle_row_base + memif::kTriangleRows * triangle_;
+        r.mask = entry_mask_;
+        r.steps = transform_steps();
+        break;
+      case Phase::kIntersect:
+        r.mask = entry_mask_;
+        r.steps = p_;
+        break;
+      case Phase::kShadeSurface:
+      case Phase::kShadeLight:
+      case Phase::kShadeShadow:
+        r.mask = valid_mask();
+        break;
+      case Phase::kDone:
+        r.steps = 0;
+        break;
+    }
+    return r;
+  }
+
+  // Performs the requested unit's work and advances the program.
+  void execute() {
+    switch (phase_) {
+      case Phase::kGenerate:
+        return do_generate();
+      case Phase::kClipTop:
+      case Phase::kClipBottom:
+        return do_clip();
+      case Phase::kTraverse:
+        return do_traverse();
+      case Phase::kList:
+        return do_list();
+      case Phase::kTransformObject:
+        return do_transform_object();
+      case Phase::kTransformTriangle:
+        return do_transform_triangle();
+      case Phase::kIntersect:
+        return do_intersect();
+      case Phase::kShadeSurface:
+        return do_shade_surface();
+      case Phase::kShadeLight:
+        return do_shade_light();
+      case Phase::kShadeShadow:
+        return do_shade_shadow();
+      case Phase::kDone:
+        return;
+    }
+  }
+
+  // Runs to completion (the functional model). Returns the number of requests served.
+  std::uint64_t run() {
+    std::uint64_t n = 0;
+    while (phase_ != Phase::kDone) {
+      execute();
+      ++n;
+    }
+    return n;
+  }
+
+  RayKind kind() const { return kind_; }
+  int packet_width() const { return p_; }
+
+ private:
+  enum class Level : std::uint8_t { kTop, kBottom };
+
+  // What the RGS hands the transformation unit for one lane (path a): T and R'.
+  struct GenLane {
+    bool valid = false;
+    std::uint32_t pixel = memif::kNone;
+    std::uint32_t weight = 0;
+    Mat34<F> t{};
+    Vec3<F> ro{}, rd{};
+  };
+  struct Packet {
+    RayKind kind = RayKind::kPrimary;
+    std::uint32_t depth = 0;
+    bool shared_origin = false;
+    std::vector<GenLane> lanes;
+  };
+
+  struct Lane {
+    bool valid = false;  // carries a ray of the current packet
+    bool done = false;   // any-hit satisfied (shadow rays, D15)
+    std::uint32_t pixel = memif::kNone;
+    std::uint32_t weight = 0;
+    Ray<F> world, current, tri;
+    F tn{}, tf{};          // segment of the node being visited
+    F clip_tn{}, clip_tf{};  // the level's clipped segment (restart of a sign group)
+    HitRecord<F> hit;      // hit.t = t_best (starts at the ray's t_max)
+    RayCounters counters;
+  };
+
+  // The RGS's per-lane surface context while it shades a packet's hits.
+  struct Surface {
+    bool hit = false;
+    std::uint32_t pixel = memif::kNone;
+    std::uint32_t weight = 0;
+    std::uint32_t depth = 0;
+    Ray<F> ray;
+    HitRecord<F> rec;
+    Vec3<F> n{};
+    F nn{}, kk{}, rr{};
+    Vec3<F> r{};  // reflected view direction (specular)
+    bool spec = false;
+    memif::MaterialRecord mat;
+    Rgb8 base{}, spec_rgb{};
+    std::array<std::uint32_t, 3> acc{};
+    F cos{}, cos_s{};
+    bool lit = false, highlight = false;
+  };
+
+  struct ListCursor {
+    std::uint32_t next = 0, end = 0;
+    std::uint64_t mask = 0;
+  };
+
+  std::uint64_t valid_mask() const {
+    std::uint64_t m = 0;
+    for (int i = 0; i < p_; ++i)
+      if (lanes_[static_cast<std::size_t>(i)].valid) m |= std::uint64_t{1} << i;
+    return m;
+  }
+  int transform_steps() const { return shared_origin_ ? p_ + 1 : 2 * p_; }
+  Lane& lane(int i) { return lanes_[static_cast<std::size_t>(i)]; }
+  static bool has(std::uint64_t m, int i) { return ((m >> i) & 1u) != 0; }
+
+  // ---- packet start (path a) ------------------------------------------------------------------
+  void begin_packet(const Packet& pk) {
+    mailbox_.clear();  // a mailbox belongs to one packet's rays (D28)
+    kind_ = pk.kind;
+    depth_ = pk.depth;
+    shared_origin_ = pk.shared_origin;
+    gen_ = pk;
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      const GenLane& g = pk.lanes[static_cast<std::size_t>(i)];
+      l = Lane{};
+      l.valid = g.valid;
+      l.pixel = g.pixel;
+      l.weight = g.weight;
+    }
+    phase_ = Phase::kGenerate;
+  }
+
+  void do_generate() {
+    const auto& fp = u_.transformation;
+    u_.transformation_steps += static_cast<std::uint64_t>(transform_steps());
+    const auto& g0 = gen_.lanes[0];
+    Vec3<F> shared{};
+    if (shared_origin_) shared = transform_step(fp, g0.t, g0.ro, true);
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
+      l.world.o = shared_origin_ ? shared : transform_step(fp, g.t, g.ro, true);
+      l.world.d = transform_step(fp, g.t, g.rd, false);
+      l.current = l.world;
+      l.hit = HitRecord<F>{};
+      if (kind_ == RayKind::kShadow) l.hit.t = shadow_t_max_;
+      if (l.valid) ++l.counters.transformations;
+    }
+    if (kind_ == RayKind::kShadow) {
+      phase_ = Phase::kShadeLight;  // the RGS decides which shadow rays to trace
+      return;
+    }
+    issue_rays();
+  }
+
+  void issue_rays() {
+    for (int i = 0; i < p_; ++i)
+      if (lane(i).valid) ++sink_.rays_issued[static_cast<int>(kind_)];
+    start_level(Level::kTop);
+  }
+
+  // ---- levels, clipping and sign groups (D27, D29) --------------------------------------------
+  void start_level(Level level) {
+    level_ = level;
+    clip_face_ = 0;
+    if (level == Level::kTop) {
+      clip_mask_ = 0;
+      for (int i = 0; i < p_; ++i)
+        if (lane(i).valid && !lane(i).done) clip_mask_ |= std::uint64_t{1} << i;
+      for (int i = 0; i < p_; ++i) {
+        lane(i).current = lane(i).world;
+        lane(i).clip_tn = F::zero();
+        lane(i).clip_tf = lane(i).hit.t;
+      }
+      phase_ = Phase::kClipTop;
+    } else {
+      clip_mask_ = entry_mask_;
+      for (int i = 0; i < p_; ++i) {
+        lane(i).clip_tn = F::zero();
+        lane(i).clip_tf = lane(i).hit.t;
+      }
+      phase_ = Phase::kClipBottom;
+    }
+  }
+
+  void do_clip() {
+    const auto& fp = u_.traversal;
+    ++u_.clip_steps;
+    const int axis = clip_face_ / 2;
+    const bool exit_face = (clip_face_ % 2) == 1;
+    std::array<F, 3> lo, hi;
+    if (level_ == Level::kTop) {
+      lo = scene_lo_;
+      hi = scene_hi_;
+    } else {
+      const auto rlo = read_row<F>(image_, instance_row_ + 4);
+      const auto rhi = read_row<F>(image_, instance_row_ + 5);
+      lo = {rlo[0], rlo[1], rlo[2]};
+      hi = {rhi[0], rhi[1], rhi[2]};
+    }
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      const bool neg = l.current.d[axis].sign();
+      const bool entry = !exit_face;
+      // Entry face: lo for a positive direction, hi for a negative one; exit face the other.
+      const F plane = (entry != neg) ? lo[axis] : hi[axis];
+      F tn = l.clip_tn, tf = l.clip_tf;
+      clip_face(fp, plane, l.current.o[axis], l.current.d[axis], entry, tn, tf);
+      l.clip_tn = tn;
+      l.clip_tf = tf;
+    }
+    if (++clip_face_ < 6) return;
+    // Last face: a ray misses the box when its segment is empty (1 cmp per lane).
+    std::uint64_t inside = 0;
+    for (int i = 0; i < p_; ++i) {
+      const Lane& l = lane(i);
+      if (!fp.lt(l.clip_tf, l.clip_tn) && has(clip_mask_, i)) inside |= std::uint64_t{1} << i;
+    }
+    // Sign groups: rays with equal direction signs share one front-to-back order (D27). Groups
+    // in increasing sign-pattern order; each is a masked sub-packet traversed to the end.
+    n_groups_ = 0;
+    for (int pattern = 0; pattern < 8; ++pattern) {
+      std::uint64_t g = 0;
+      for (int i = 0; i < p_; ++i) {
+        const Lane& l = lane(i);
+        const int s = (l.current.d[0].sign() ? 1 : 0) | (l.current.d[1].sign() ? 2 : 0) |
+                      (l.current.d[2].sign() ? 4 : 0);
+        if (has(inside, i) && s == pattern) g |= std::uint64_t{1} << i;
+      }
+      if (g != 0) groups_[n_groups_++] = g;
+    }
+    if (n_groups_ > 1) u_.sub_packets += n_groups_ - 1;
+    group_ = 0;
+    stack_base_ = stack_node_.size();
+    if (n_groups_ == 0) {
+      finish_level();
+      return;
+    }
+    start_group();
+  }
+
+  void start_group() {
+    const std::uint64_t g = groups_[group_];
+    for (int i = 0; i < p_; ++i) {
+      if (!has(g, i)) continue;
+      lane(i).tn = lane(i).clip_tn;
+      lane(i).tf = lane(i).clip_tf;
+    }
+    node_ = level_ == Level::kTop ? image_.registers().top_root : header_.root;
+    mask_ = g;
+    // Groups of a level live on the stack one after another: a level keeps its base.
+    phase_ = Phase::kTraverse;
+  }
+
+  // ---- traversal unit (paths b, f) -----------------------------------------------------------
+  void do_traverse() {
+    const auto& fp = u_.traversal;
+    ++u_.traversal_steps;
+    const memif::KdNode node = image_.node(node_);
+    // Early termination at node entry (1 cmp per lane).
+    std::uint64_t active = 0;
+    for (int i = 0; i < p_; ++i) {
+      const Lane& l = lane(i);
+      const bool term = terminated(fp, l.hit.t, l.tn);
+      if (has(mask_, i) && !l.done && !term) active |= std::uint64_t{1} << i;
+    }
+    for (int i = 0; i < p_; ++i)
+      if (has(active, i)) ++lane(i).counters.traversal_steps;
+    if (active == 0) return pop();
+    if (node.leaf) {
+      if (node.count == 0) return pop();
+      ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
+      c.next = node.first;
+      c.end = node.first + node.count;
+      c.mask = active;
+      phase_ = Phase::kList;
+      return;
+    }
+    ++u_.inner_steps;
+    const int axis = static_cast<int>(node.axis);
+    const F split = F::from_bits(node.split);
+    // The group's shared direction sign on this axis picks the near child.
+    bool neg = false;
+    for (int i = 0; i < p_; ++i)
+      if (has(active, i)) {
+        neg = lane(i).current.d[axis].sign();
+        break;
+      }
+    std::uint64_t near_mask = 0, far_mask = 0;
+    std::array<F, kMaxPacket> near_tf{}, far_tn{};
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      const TraversalLane<F> r =
+          traversal_lane(fp, split, l.current.o[axis], l.current.d[axis], l.tn, l.tf);
+      if (!has(active, i)) continue;
+      if (r.go_near) near_mask |= std::uint64_t{1} << i;
+      if (r.go_far) far_mask |= std::uint64_t{1} << i;
+      near_tf[static_cast<std::size_t>(i)] = r.near_tf;
+      far_tn[static_cast<std::size_t>(i)] = r.far_tn;
+    }
+    const std::uint32_t near_child = neg ? node.child_pair + 1 : node.child_pair;
+    const std::uint32_t far_child = neg ? node.child_pair : node.child_pair + 1;
+    if (far_mask != 0 && near_mask != 0) {
+      push(far_child, far_mask, far_tn);
+      for (int i = 0; i < p_; ++i)
+        if (has(near_mask, i)) lane(i).tf = near_tf[static_cast<std::size_t>(i)];
+      node_ = near_child;
+      mask_ = near_mask;
+    } else if (near_mask != 0) {
+      node_ = near_child;
+      mask_ = near_mask;
+    } else {
+      node_ = far_child;
+      mask_ = far_mask;
+    }
+  }
+
+  void push(std::uint32_t node, std::uint64_t mask, const std::array<F, kMaxPacket>& far_tn) {
+    if (stack_node_.size() >= static_cast<std::size_t>(params_.stack_depth))
+      throw std::runtime_error("functional model: traversal stack overflow (depth " +
+                               std::to_string(params_.stack_depth) +
+                               "); the kd-trees are deeper than the stack");
+    stack_node_.push_back(node);
+    stack_mask_.push_back(mask);
+    for (int i = 0; i < p_; ++i) {
+      stack_t_.push_back(far_tn[static_cast<std::size_t>(i)]);
+      stack_t_.push_back(lane(i).tf);
+    }
+  }
+
+  // Pops the next node of the current group, or ends the group.
+  void pop() {
+    // Entries whose rays have all finished (any-hit) are dropped without a node fetch.
+    while (stack_node_.size() > stack_base_ && (stack_mask_.back() & ~done_mask()) == 0)
+      drop_top();
+    if (stack_node_.size() == stack_base_) return finish_group();
+    node_ = stack_node_.back();
+    mask_ = stack_mask_.back();
+    const std::size_t base = stack_t_.size() - 2u * static_cast<std::size_t>(p_);
+    for (int i = 0; i < p_; ++i) {
+      if (!has(mask_, i)) continue;
+      lane(i).tn = stack_t_[base + 2u * static_cast<std::size_t>(i)];
+      lane(i).tf = stack_t_[base + 2u * static_cast<std::size_t>(i) + 1u];
+    }
+    drop_top();
+    phase_ = Phase::kTraverse;
+  }
+
+  void drop_top() {
+    stack_node_.pop_back();
+    stack_mask_.pop_back();
+    stack_t_.resize(stack_t_.size() - 2u * static_cast<std::size_t>(p_));
+  }
+
+  std::uint64_t done_mask() const {
+    std::uint64_t m = 0;
+    for (int i = 0; i < p_; ++i)
+      if (lanes_[static_cast<std::size_t>(i)].done) m |= std::uint64_t{1} << i;
+    return m;
+  }
+
+  void finish_group() {
+    if (++group_ < n_groups_) return start_group();
+    finish_level();
+  }
+
+  void finish_level() {
+    if (level_ == Level::kBottom) {
+      // Back to the top level: its groups, stack base and list cursor were saved at entry.
+      level_ = Level::kTop;
+      groups_ = top_groups_;
+      n_groups_ = top_n_groups_;
+      group_ = top_group_;
+      stack_base_ = top_stack_base_;
+      for (int i = 0; i < p_; ++i) lane(i).current = lane(i).world;
+      return list_continue();
+    }
+    phase_ = kind_ == RayKind::kShadow ? Phase::kShadeShadow : Phase::kShadeSurface;
+    for (int i = 0; i < p_; ++i)
+      if (lane(i).valid) ++sink_.rays_returned[static_cast<int>(kind_)];
+  }
+
+  // ---- mailboxed list unit (paths c, d) ------------------------------------------------------
+  void list_continue() {
+    ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
+    std::uint64_t live = 0;
+    for (int i = 0; i < p_; ++i)
+      if (has(c.mask, i) && !lane(i).done) live |= std::uint64_t{1} << i;
+    c.mask = live;
+    if (c.next < c.end && live != 0) {
+      phase_ = Phase::kList;
+      return;
+    }
+    pop();
+  }
+
+  void do_list() {
+    ++u_.list_steps;
+    ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
+    const std::uint32_t entry = image_.list_entry(c.next++);
+    for (int i = 0; i < p_; ++i)
+      if (has(c.mask, i)) ++lane(i).counters.list_entries;
+    Mailbox& mb = level_ == Level::kTop ? mailbox_ : tri_mailbox_;
+    const std::uint64_t todo = mb.filter(entry, c.mask);
+    for (int i = 0; i < p_; ++i)
+      if (has(c.mask & ~todo, i)) ++lane(i).counters.mailbox_skips;
+    if (todo == 0) return list_continue();
+    entry_mask_ = todo;
+    if (level_ == Level::kTop) {
+      instance_ = entry;
+      phase_ = Phase::kTransformObject;
+    } else {
+      triangle_ = entry;
+      phase_ = Phase::kTransformTriangle;
+    }
+  }
+
+  // ---- transformation unit (path d) -----------------------------------------------------------
+  // Transforms `in` of every lane with m (n+1 or 2n steps whatever the mask, D30).
+  void transform_lanes(const Mat34<F>& m, Ray<F> Lane::*in, Ray<F> Lane::*out) {
+    const auto& fp = u_.transformation;
+    u_.transformation_steps += static_cast<std::uint64_t>(transform_steps());
+    Vec3<F> shared{};
+    if (shared_origin_) shared = transform_step(fp, m, (lanes_[0].*in).o, true);
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      const Ray<F> src = l.*in;
+      (l.*out).o = shared_origin_ ? shared : transform_step(fp, m, src.o, true);
+      (l.*out).d = transform_step(fp, m, src.d, false);
+      if (has(entry_mask_, i)) ++l.counters.transformations;
+    }
+  }
+
+  void do_transform_object() {
+    instance_row_ = image_.registers().instance_row_base + memif::kInstanceRows * instance_;
+    transform_lanes(read_matrix<F>(image_, instance_row_), &Lane::world, &Lane::current);
+    header_ = image_.instance_header(instance_);
+    // Enter the bottom level: save the top level's groups and stack base (the top-level stack
+    // entries stay below; the bottom level pushes above them, D26).
+    top_groups_ = groups_;
+    top_n_groups_ = n_groups_;
+    top_group_ = group_;
+    top_stack_base_ = stack_base_;
+    tri_mailbox_.clear();
+    start_level(Level::kBottom);
+  }
+
+  void do_transform_triangle() {
+    transform_lanes(read_matrix<F>(image_, header_.triangle_row_base +
+                                               memif::kTriangleRows * triangle_),
+                    &Lane::current, &Lane::tri);
+    phase_ = Phase::kIntersect;
+  }
+
+  // ---- intersection unit (paths e, f) --------------------------------------------------------
+  void do_intersect() {
+    const auto& fp = u_.intersection;
+    ++u_.intersection_packets;
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      const Candidate<F> c = intersect_unit_triangle(fp, l.tri);
+      if (!has(entry_mask_, i)) continue;
+      ++l.counters.intersections;
+      if (!accepts(c, instance_, triangle_, l.hit)) continue;
+      l.hit.t = c.t;
+      l.hit.u = c.u;
+      l.hit.v = c.v;
+      l.hit.c = c.c;
+      l.hit.instance = instance_;
+      l.hit.triangle = triangle_;
+      if (kind_ == RayKind::kShadow) l.done = true;
+    }
+    list_continue();
+  }
+
+  // ---- RGS (path g): shading and new packets (docs/shading.md) --------------------------------
+  void record_primary() {
+    for (int i = 0; i < p_; ++i) {
+      const Lane& l = lane(i);
+      if (!l.valid) continue;
+      auto& px = sink_.pixels[l.pixel];
+      px.t = l.hit.hit() ? l.hit.t.bits : F::infinity().bits;
+      px.u = l.hit.u.bits;
+      px.v = l.hit.v.bits;
+      px.cos = l.hit.c.bits;
+      px.instance = l.hit.instance;
+      px.triangle = l.hit.triangle;
+      for (int k = 0; k < 3; ++k) {
+        px.o[static_cast<std::size_t>(k)] = l.world.o[k].bits;
+        px.d[static_cast<std::size_t>(k)] = l.world.d[k].bits;
+      }
+      px.counters = l.counters;
+    }
+  }
+
+  void add_colour(std::uint32_t pixel, std::uint32_t weight, const Rgb8& c) {
+    auto& s = sink_.colour_sum[pixel];
+    for (int k = 0; k < 3; ++k) s[static_cast<std::size_t>(k)] += weight * c[k];
+  }
+
+  void account_counters() {
+    for (int i = 0; i < p_; ++i)
+      if (lane(i).valid) sink_.by_kind[static_cast<int>(kind_)] += lane(i).counters;
+  }
+
+  void do_shade_surface() {
+    account_counters();
+    if (kind_ == RayKind::kPrimary) record_primary();
+    if (!params_.shade) return next_packet();
+    const auto& regs = image_.registers();
+    const Rgb8 ambient = unpack_rgb(regs.ambient_rgb);
+    const Rgb8 background = unpack_rgb(regs.background_rgb);
+    const auto& ft = u_.transformation;
+    const auto& fr = u_.rgs;
+    for (int i = 0; i < p_; ++i) {
+      const Lane& l = lane(i);
+      Surface& s = surf_[static_cast<std::size_t>(i)];
+      s = Surface{};
+      if (!l.valid) continue;
+      s.pixel = l.pixel;
+      s.weight = l.weight;
+      s.depth = depth_;
+      if (!l.hit.hit()) {
+        add_colour(l.pixel, l.weight, background);
+        continue;
+      }
+      s.hit = true;
+      s.ray = l.world;
+      s.rec = l.hit;
+      const std::uint32_t irow = regs.instance_row_base + memif::kInstanceRows * s.rec.instance;
+      const memif::InstanceHeader h = image_.instance_header(s.rec.instance);
+      // World normal (D19): the triangle's unit normal (row 2 of T_delta) through M^T.
+      const auto nrow = read_row<F>(image_, h.triangle_row_base +
+                                                memif::kTriangleRows * s.rec.triangle + 2);
+      const Mat34<F> m = read_matrix<F>(image_, irow);
+      Mat34<F> mt{};
+      for (int r = 0; r < 3; ++r) mt[r] = {m[0][r], m[1][r], m[2][r], F::zero()};
+      s.n = transform_step(ft, mt, Vec3<F>{nrow[0], nrow[1], nrow[2]}, false);
+      if (is_pos_nonzero(s.rec.c))
+        for (auto& x : s.n) x = x.neg();
+      s.nn = dot_step(ft, s.n, s.n);
+      u_.shading_transformation_steps += 1;  // normal step; the dots count below
+      const memif::ShadingRecord rec = read_shading_record(image_, h.shading_base + s.rec.triangle);
+      s.mat = read_material(image_, rec.material);
+      s.base = base_colour(image_, rec, s.mat, fix16(s.rec.u), fix16(s.rec.v));
+      const std::uint32_t shininess = s.mat.specular_rgb_shininess >> 24;
+      s.spec_rgb = unpack_rgb(s.mat.specular_rgb_shininess);
+      s.spec = shininess >= 1 && (s.mat.specular_rgb_shininess & 0xFFFFFFu) != 0;
+      const bool reflect = params_.secondary && depth_ < max_depth_ && s.mat.reflectivity > 0;
+      if (s.spec || reflect) {
+        const F dn = dot_step(ft, s.ray.d, s.n);
+        const F k = fr.div(dn, s.nn);
+        s.kk = fr.add(k, k);
+      }
+      if (s.spec) {
+        const Mat34<F> tr = reflect_matrix(s.ray, s.n);
+        s.r = transform_step(ft, tr, Vec3<F>{F::one(), s.kk.neg(), F::zero()}, false);
+        s.rr = dot_step(ft, s.r, s.r);
+        u_.shading_transformation_steps += 1;
+      }
+      for (int k = 0; k < 3; ++k) s.acc[static_cast<std::size_t>(k)] = mul8(s.base[k], ambient[k]);
+    }
+    light_ = 0;
+    next_light();
+  }
+
+  // T_R = [D, N, D; O] (paper 2.2.2 with the erratum: translation O).
+  static Mat34<F> reflect_matrix(const Ray<F>& ray, const Vec3<F>& n) {
+    Mat34<F> t{};
+    for (int r = 0; r < 3; ++r) t[r] = {ray.d[r], n[r], ray.d[r], ray.o[r]};
+    return t;
+  }
+
+  std::uint64_t surface_hit_mask() const {
+    std::uint64_t m = 0;
+    for (int i = 0; i < p_; ++i)
+      if (surf_[static_cast<std::size_t>(i)].hit) m |= std::uint64_t{1} << i;
+    return m;
+  }
+
+  // Shadow rays of light `light_` through T_shadow = [L, O, D; 0], R' = ((1,0,0), (-1,1,t)).
+  void next_light() {
+    const auto& regs = image_.registers();
+    if (light_ >= regs.light_count || surface_hit_mask() == 0) return finish_surface();
+    const std::uint32_t a = regs.light_base + memif::kLightWords * light_;
+    Vec3<F> pos;
+    for (std::uint32_t k = 0; k < 3; ++k)
+      pos[k] = F::from_bits(image_.word(memif::kShadingBank, a + k));
+    light_rgb_ = unpack_rgb(image_.word(memif::kShadingBank, a + 3));
+    Packet pk;
+    pk.kind = RayKind::kShadow;
+    pk.depth = depth_;
+    pk.shared_origin = params_.shared_origin;
+    pk.lanes.resize(lanes_.size());
+    for (int i = 0; i < p_; ++i) {
+      const Surface& s = surf_[static_cast<std::size_t>(i)];
+      GenLane& g = pk.lanes[static_cast<std::size_t>(i)];
+      for (int r = 0; r < 3; ++r) g.t[r] = {pos[r], s.ray.o[r], s.ray.d[r], F::zero()};
+      g.ro = {F::one(), F::zero(), F::zero()};
+      g.rd = {F::one().neg(), F::one(), s.rec.t};
+      g.valid = s.hit;
+      g.pixel = s.pixel;
+    }
+    begin_packet(pk);
+    if (!params_.shadows) {
+      // Without shadow rays only the directions are needed: n direction steps, no origin step.
+      const auto& fp = u_.transformation;
+      u_.shading_transformation_steps += static_cast<std::uint64_t>(p_);
+      for (int i = 0; i < p_; ++i) {
+        const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
+        lane(i).world.d = transform_step(fp, g.t, g.rd, false);
+      }
+      return do_shade_light();
+    }
+  }
+
+  void do_shade_light() {
+    const auto& ft = u_.transformation;
+    const auto& fr = u_.rgs;
+    std::uint64_t trace = 0;
+    for (int i = 0; i < p_; ++i) {
+      Surface& s = surf_[static_cast<std::size_t>(i)];
+      s.lit = false;
+      s.highlight = false;
+      if (!s.hit) continue;
+      const Vec3<F>& sd = lane(i).world.d;  // hit point - L
+      const F ns = dot_step(ft, s.n, sd);
+      const F ss = dot_step(ft, sd, sd);
+      s.lit = is_neg_nonzero(ns);
+      if (!s.lit) continue;
+      s.cos = fr.div(ns.neg(), fr.sqrt(fr.mul(s.nn, ss)));
+      if (s.spec) {
+        const F rl = dot_step(ft, s.r, sd);
+        s.highlight = is_neg_nonzero(rl);
+        if (s.highlight) s.cos_s = fr.div(rl.neg(), fr.sqrt(fr.mul(s.rr, ss)));
+      }
+      trace |= std::uint64_t{1} << i;
+    }
+    u_.shading_transformation_steps += 1;
+    if (!params_.shadows || trace == 0) {
+      for (int i = 0; i < p_; ++i) lane(i).valid = false;
+      return accumulate_light();
+    }
+    for (int i = 0; i < p_; ++i) lane(i).valid = has(trace, i);
+    issue_rays();
+  }
+
+  void do_shade_shadow() {
+    account_counters();
+    accumulate_light();
+  }
+
+  // Diffuse and specular of light `light_` for the lit, unoccluded hits.
+  void accumulate_light() {
+    for (int i = 0; i < p_; ++i) {
+      Surface& s = surf_[static_cast<std::size_t>(i)];
+      if (!s.hit || !s.lit) continue;
+      if (params_.shadows && lane(i).hit.hit()) continue;  // occluded
+      const std::uint32_t wd = fix8(s.cos);
+      for (int k = 0; k < 3; ++k)
+        s.acc[static_cast<std::size_t>(k)] += (mul8(s.base[k], light_rgb_[k]) * wd) >> 8;
+      if (s.spec && s.highlight) {
+        const std::uint32_t p = specular_power(fix8(s.cos_s), s.mat.specular_rgb_shininess >> 24);
+        for (int k = 0; k < 3; ++k)
+          s.acc[static_cast<std::size_t>(k)] += (mul8(s.spec_rgb[k], light_rgb_[k]) * p) >> 8;
+      }
+    }
+    ++light_;
+    next_light();
+  }
+
+  // Local colour into the pixel, then reflection and transparency children (D37).
+  void finish_surface() {
+    Packet refl, transp;
+    refl.kind = RayKind::kReflection;
+    transp.kind = RayKind::kTransparency;
+    refl.depth = transp.depth = depth_ + 1;
+    refl.lanes.resize(lanes_.size());
+    transp.lanes.resize(lanes_.size());
+    bool any_refl = false, any_transp = false;
+    for (int i = 0; i < p_; ++i) {
+      const Surface& s = surf_[static_cast<std::size_t>(i)];
+      if (!s.hit) continue;
+      Rgb8 local{};
+      for (int k = 0; k < 3; ++k) local[k] = std::min<std::uint32_t>(255u, s.acc[k]);
+      const bool spawn = params_.secondary && depth_ < max_depth_;
+      const std::uint32_t kr = spawn ? s.mat.reflectivity : 0u;
+      const std::uint32_t kt = spawn ? s.mat.transparency : 0u;
+      const std::uint32_t wl =
+          params_.secondary ? mul8(s.weight, 255u - std::min(255u, kr + kt)) : s.weight;
+      add_colour(s.pixel, wl, local);
+      const std::uint32_t wr = mul8(s.weight, kr), wt = mul8(s.weight, kt);
+      const Mat34<F> tr = reflect_matrix(s.ray, s.n);
+      if (wr > 0) {
+        GenLane& g = refl.lanes[static_cast<std::size_t>(i)];
+        g = {true, s.pixel, wr, tr, {epsilon_.neg(), F::zero(), s.rec.t},
+             {F::one(), s.kk.neg(), F::zero()}};
+        any_refl = true;
+      }
+      if (wt > 0) {
+        GenLane& g = transp.lanes[static_cast<std::size_t>(i)];
+        g = {true, s.pixel, wt, tr, {epsilon_, F::zero(), s.rec.t},
+             {F::one(), F::zero(), F::zero()}};
+        any_transp = true;
+      }
+    }
+    if (any_transp) pending_.push_back(transp);
+    if (any_refl) pending_.push_back(refl);
+    next_packet();
+  }
+
+  void next_packet() {
+    if (pending_.empty()) {
+      phase_ = Phase::kDone;
+      return;
+    }
+    const Packet pk = pending_.back();
+    pending_.pop_back();
+    begin_packet(pk);
+  }
+
+  const memif::MemoryImage& image_;
+  const FunctionalParams& params_;
+  PipelineUnits<F>& u_;
+  FrameSink& sink_;
+  int p_;
+  std::uint32_t max_depth_ = 3;
+  Mat34<F> cam_{};
+  std::array<F, 3> scene_lo_{}, scene_hi_{};
+  F epsilon_{}, shadow_t_max_{};
+
+  Phase phase_ = Phase::kDone;
+  RayKind kind_ = RayKind::kPrimary;
+  std::uint32_t depth_ = 0;
+  bool shared_origin_ = false;
+  Packet gen_;
+  std::vector<Packet> pending_;
+  std::vector<Lane> lanes_;
+  std::vector<Surface> surf_;
+  std::uint32_t light_ = 0;
+  Rgb8 light_rgb_{};
+
+  Level level_ = Level::kTop;
+  int clip_face_ = 0;
+  std::uint64_t clip_mask_ = 0;
+  std::array<std::uint64_t, 8> groups_{}, top_groups_{};
+  std::size_t n_groups_ = 0, top_n_groups_ = 0, group_ = 0, top_group_ = 0;
+  std::size_t stack_base_ = 0, top_stack_base_ = 0;
+  std::uint32_t node_ = 0;
+  std::uint64_t mask_ = 0;
+  std::vector<std::uint32_t> stack_node_;
+  std::vector<std::uint64_t> stack_mask_;
+  std::vector<F> stack_t_;
+  ListCursor top_list_, bottom_list_;
+  Mailbox mailbox_, tri_mailbox_;
+  std::uint64_t entry_mask_ = 0;
+  std::uint32_t instance_ = 0, instance_row_ = 0, triangle_ = 0;
+  memif::InstanceHeader header_;
+};
+
+}  // namespace saarcor::units
