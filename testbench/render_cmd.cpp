@@ -15,6 +15,7 @@
 #include "host/primary_rays.h"
 #include "testbench/hit_exr.h"
 #include "testbench/image_io.h"
+#include "units/functional_model.h"
 
 namespace saarcor {
 namespace {
@@ -123,6 +124,149 @@ PixelHit trace_float_pixel(const PreparedScene& prep, PixelCoord px) {
   return to_pixel_hit(h, id, ray);
 }
 
+// ---- functional model --------------------------------------------------------------------------
+
+units::FunctionalParams functional_params(const RenderSettings& s) {
+  units::FunctionalParams p;
+  p.shadows = s.shadows;
+  p.secondary = s.depth > 0;
+  p.max_depth = s.depth > 0 ? s.depth : -1;
+  return p;
+}
+
+// Float<7, m> chosen by an explicit switch: each case is its own template instantiation.
+units::FunctionalFrame run_functional_m(int m, const memif::MemoryImage& image,
+                                        const units::FunctionalParams& params,
+                                        const units::ProgressFn& progress) {
+  switch (m) {
+    case 10:
+      return units::run_functional<ff::Float<7, 10>>(image, params, progress);
+    case 11:
+      return units::run_functional<ff::Float<7, 11>>(image, params, progress);
+    case 12:
+      return units::run_functional<ff::Float<7, 12>>(image, params, progress);
+    case 13:
+      return units::run_functional<ff::Float<7, 13>>(image, params, progress);
+    case 14:
+      return units::run_functional<ff::Float<7, 14>>(image, params, progress);
+    case 15:
+      return units::run_functional<ff::Float<7, 15>>(image, params, progress);
+    case 16:
+      return units::run_functional<ff::Float<7, 16>>(image, params, progress);
+    case 17:
+      return units::run_functional<ff::Float<7, 17>>(image, params, progress);
+    case 18:
+      return units::run_functional<ff::Float<7, 18>>(image, params, progress);
+    case 19:
+      return units::run_functional<ff::Float<7, 19>>(image, params, progress);
+    case 20:
+      return units::run_functional<ff::Float<7, 20>>(image, params, progress);
+    case 21:
+      return units::run_functional<ff::Float<7, 21>>(image, params, progress);
+    case 22:
+      return units::run_functional<ff::Float<7, 22>>(image, params, progress);
+    case 23:
+      return units::run_functional<ff::Float<7, 23>>(image, params, progress);
+    default:
+      break;
+  }
+  throw std::runtime_error("bad mantissa " + std::to_string(m) + ": expected " +
+                           std::to_string(kMinMantissa) + ".." + std::to_string(kMaxMantissa));
+}
+
+// An encoding of the model's format as binary32: exact for Float<7, m <= 23> (the exponent range
+// of binary32 holds it), subnormal encodings read as zero as the model reads them.
+float to_binary32(std::uint32_t bits, ff::Format f) {
+  return static_cast<float>(ff::decode(bits, f, ff::Subnormals::kFlush));
+}
+
+PixelHit functional_pixel_hit(const units::FrameSink::Pixel& p, ff::Format f,
+                              const host::BuiltImage& built) {
+  PixelHit h;
+  h.ox = to_binary32(p.o[0], f);
+  h.oy = to_binary32(p.o[1], f);
+  h.oz = to_binary32(p.o[2], f);
+  h.dx = to_binary32(p.d[0], f);
+  h.dy = to_binary32(p.d[1], f);
+  h.dz = to_binary32(p.d[2], f);
+  if (p.instance == memif::kNone) return h;  // miss: t = inf, ids ~0
+  if (p.instance >= built.instances.size()) {
+    throw std::runtime_error("functional model reported instance " + std::to_string(p.instance) +
+                             " beyond the image's " + std::to_string(built.instances.size()));
+  }
+  h.t = to_binary32(p.t, f);
+  h.u = to_binary32(p.u, f);
+  h.v = to_binary32(p.v, f);
+  h.cos = to_binary32(p.cos, f);
+  h.instance = built.instances[p.instance].id;
+  h.triangle = p.triangle;
+  return h;
+}
+
+nlohmann::json ops_json(const ff::OpCounts& c) {
+  return {{"add", c.add},   {"mul", c.mul}, {"div", c.div},
+          {"sqrt", c.sqrt}, {"cmp", c.cmp}, {"total", c.total()}};
+}
+
+FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene& prep,
+                                    const RenderSettings& settings) {
+  FrameResult r;
+  r.model = model.name;
+  const bool tty = isatty(fileno(stderr));
+  units::ProgressFn report;
+  if (tty) {
+    report = [](int done, int total) {
+      std::fprintf(stderr, "\r  packets %d / %d", done, total);
+      if (done == total) std::fprintf(stderr, "\n");
+    };
+  }
+  const auto t0 = Clock::now();
+  const units::FunctionalFrame frame =
+      run_functional_m(model.mantissa, prep.built.image, functional_params(settings), report);
+  r.seconds = seconds_since(t0);
+  r.hits.width = frame.width;
+  r.hits.height = frame.height;
+  r.hits.pixels.resize(frame.pixels.size());
+  for (std::size_t i = 0; i < frame.pixels.size(); ++i) {
+    r.hits.pixels[i] = functional_pixel_hit(frame.pixels[i], frame.format, prep.built);
+  }
+  r.image.width = frame.width;
+  r.image.height = frame.height;
+  r.image.rgb = frame.rgb;
+  nlohmann::json per_kind;
+  for (int k = 0; k < units::kRayKinds; ++k) {
+    const units::RayCounters& c = frame.by_kind[k];
+    const std::uint64_t n = frame.rays_issued[k];
+    r.rays += n;
+    nlohmann::json j = counter_json({{"traversal_steps", c.traversal_steps},
+                                     {"list_entries", c.list_entries},
+                                     {"mailbox_skips", c.mailbox_skips},
+                                     {"transformations", c.transformations},
+                                     {"intersections", c.intersections}},
+                                    n);
+    j["rays_issued"] = n;
+    j["rays_returned"] = frame.rays_returned[k];
+    per_kind[units::ray_kind_name(static_cast<units::RayKind>(k))] = j;
+  }
+  r.counters["per_ray"] = per_kind;
+  const units::UnitStats& u = frame.units;
+  r.counters["ops"] = {{"traversal", ops_json(u.traversal_ops)},
+                       {"transformation", ops_json(u.transformation_ops)},
+                       {"intersection", ops_json(u.intersection_ops)},
+                       {"rgs", ops_json(u.rgs_ops)}};
+  r.counters["units"] = {{"traversal_steps", u.traversal_steps},
+                         {"inner_steps", u.inner_steps},
+                         {"clip_steps", u.clip_steps},
+                         {"list_steps", u.list_steps},
+                         {"transformation_steps", u.transformation_steps},
+                         {"shading_transformation_steps", u.shading_transformation_steps},
+                         {"intersection_packets", u.intersection_packets},
+                         {"sub_packets", u.sub_packets},
+                         {"packets", u.packets},
+                         {"requests", u.requests}};
+  return r;
+}
+
 void check_functional_format(const ModelSpec& model, const PreparedScene& prep) {
   const ff::Format want{7, model.mantissa};
   if (!(prep.built.params.format == want)) {
@@ -229,7 +373,7 @@ FrameResult render_model(const ModelSpec& model, const PreparedScene& prep,
       return render_float_frame(prep, settings);
     case ModelKind::kFunctional:
       check_functional_format(model, prep);
-      throw std::runtime_error("the functional model is not built into this saarcor yet");
+      return render_functional_frame(model, prep, settings);
     case ModelKind::kCycle:
       break;
   }
@@ -238,13 +382,15 @@ FrameResult render_model(const ModelSpec& model, const PreparedScene& prep,
 
 PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prep,
                      const RenderSettings& settings, PixelCoord pixel) {
-  (void)settings;
   switch (model.kind) {
     case ModelKind::kFloat:
       return trace_float_pixel(prep, pixel);
-    case ModelKind::kFunctional:
+    case ModelKind::kFunctional: {
       check_functional_format(model, prep);
-      throw std::runtime_error("the functional model is not built into this saarcor yet");
+      const units::PixelTrace t =
+          units::trace_pixel(prep.built.image, functional_params(settings), pixel.x, pixel.y);
+      return functional_pixel_hit(t.pixel, prep.built.params.format, prep.built);
+    }
     case ModelKind::kCycle:
       break;
   }
