@@ -17,8 +17,6 @@ namespace {
 using memif::ItemType;
 using memif::MemoryImage;
 
-constexpr std::uint32_t kMaxTextureSize = 1024;
-
 // Sizes in messages: MB (2^20 bytes) with one decimal, KB below one MB.
 std::string mb(std::uint64_t bytes) {
   char buf[32];
@@ -386,9 +384,43 @@ std::uint32_t average2(std::uint32_t a, std::uint32_t b) {
   return out;
 }
 
-// Nearest-neighbour up to the next power of two, then 2:1 box filtering down to at most 1024
-// (docs/memory-image.md). Integer arithmetic only: deterministic.
-StoredTexture resample(const Texture& t, std::size_t index) {
+// Halves a power-of-two texture along x (or y) with a 2:1 box filter.
+void halve_width(std::vector<std::uint32_t>& px, std::uint32_t& pw, std::uint32_t ph) {
+  std::vector<std::uint32_t> half(static_cast<std::size_t>(pw / 2) * ph);
+  for (std::uint32_t y = 0; y < ph; ++y)
+    for (std::uint32_t x = 0; x < pw / 2; ++x)
+      half[static_cast<std::size_t>(y) * (pw / 2) + x] =
+          average2(px[static_cast<std::size_t>(y) * pw + 2 * x],
+                   px[static_cast<std::size_t>(y) * pw + 2 * x + 1]);
+  px.swap(half);
+  pw /= 2;
+}
+void halve_height(std::vector<std::uint32_t>& px, std::uint32_t pw, std::uint32_t& ph) {
+  std::vector<std::uint32_t> half(static_cast<std::size_t>(pw) * (ph / 2));
+  for (std::uint32_t y = 0; y < ph / 2; ++y)
+    for (std::uint32_t x = 0; x < pw; ++x)
+      half[static_cast<std::size_t>(y) * pw + x] =
+          average2(px[static_cast<std::size_t>(2 * y) * pw + x],
+                   px[static_cast<std::size_t>(2 * y + 1) * pw + x]);
+  px.swap(half);
+  ph /= 2;
+}
+
+// Halves the larger side (width on a tie) of a stored texture.
+void halve(StoredTexture& t) {
+  std::uint32_t pw = 1u << t.log2_width, ph = 1u << t.log2_height;
+  if (pw >= ph) {
+    halve_width(t.texels, pw, ph);
+    --t.log2_width;
+  } else {
+    halve_height(t.texels, pw, ph);
+    --t.log2_height;
+  }
+}
+
+// Nearest-neighbour up to the next power of two, then 2:1 box filtering down to at most
+// max_size (docs/memory-image.md). Integer arithmetic only: deterministic.
+StoredTexture resample(const Texture& t, std::size_t index, std::uint32_t max_size) {
   if (t.width <= 0 || t.height <= 0 ||
       t.rgba.size() != static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height))
     throw std::runtime_error("texture " + std::to_string(index) + " (" + t.name + ") has " +
@@ -404,26 +436,10 @@ StoredTexture resample(const Texture& t, std::size_t index) {
       px[static_cast<std::size_t>(y) * pw + x] = t.rgba[sy * w + sx];
     }
   }
-  while (pw > kMaxTextureSize) {
-    std::vector<std::uint32_t> half(static_cast<std::size_t>(pw / 2) * ph);
-    for (std::uint32_t y = 0; y < ph; ++y)
-      for (std::uint32_t x = 0; x < pw / 2; ++x)
-        half[static_cast<std::size_t>(y) * (pw / 2) + x] =
-            average2(px[static_cast<std::size_t>(y) * pw + 2 * x],
-                     px[static_cast<std::size_t>(y) * pw + 2 * x + 1]);
-    px.swap(half);
-    pw /= 2;
-  }
-  while (ph > kMaxTextureSize) {
-    std::vector<std::uint32_t> half(static_cast<std::size_t>(pw) * (ph / 2));
-    for (std::uint32_t y = 0; y < ph / 2; ++y)
-      for (std::uint32_t x = 0; x < pw; ++x)
-        half[static_cast<std::size_t>(y) * pw + x] =
-            average2(px[static_cast<std::size_t>(2 * y) * pw + x],
-                     px[static_cast<std::size_t>(2 * y + 1) * pw + x]);
-    px.swap(half);
-    ph /= 2;
-  }
+  while (pw > max_size)
+    halve_width(px, pw, ph);
+  while (ph > max_size)
+    halve_height(px, pw, ph);
   StoredTexture s;
   while ((1u << s.log2_width) < pw)
     ++s.log2_width;
@@ -461,20 +477,42 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
                                std::to_string(scene.textures.size()));
     if (t >= 0) used[static_cast<std::size_t>(t)] = 1;
   }
+  if (b.params.max_texture_size < 1 || b.params.max_texture_size > 32768 ||
+      (b.params.max_texture_size & (b.params.max_texture_size - 1)) != 0)
+    throw std::runtime_error("maximum texture size " + std::to_string(b.params.max_texture_size) +
+                             " is not a power of two in 1..32768");
   std::vector<StoredTexture> textures(scene.textures.size());
   std::uint64_t texel_words = 0;
   for (std::size_t t = 0; t < scene.textures.size(); ++t) {
     if (!used[t]) continue;
-    textures[t] = resample(scene.textures[t], t);
+    textures[t] = resample(scene.textures[t], t, b.params.max_texture_size);
     texel_words += textures[t].texels.size();
     ++s.textures;
-    if ((1u << textures[t].log2_width) != static_cast<std::uint32_t>(scene.textures[t].width) ||
-        (1u << textures[t].log2_height) != static_cast<std::uint32_t>(scene.textures[t].height))
-      ++s.resampled_textures;
   }
   const std::uint64_t material_words = memif::kMaterialWords * materials;
   const std::uint64_t light_words = memif::kLightWords * scene.lights.size();
   const std::uint64_t record_words = memif::kShadingRecordWords * s.triangle_slots;
+  // Textures give way before the scene is refused: halve the largest (lowest index on a tie)
+  // until the bank fits or every texture is down to 1x1.
+  while (b.params.fit_textures &&
+         material_words + light_words + record_words + texel_words > b.params.bank_words) {
+    std::size_t largest = textures.size();
+    for (std::size_t t = 0; t < textures.size(); ++t)
+      if (used[t] && textures[t].texels.size() > 1 &&
+          (largest == textures.size() ||
+           textures[t].texels.size() > textures[largest].texels.size()))
+        largest = t;
+    if (largest == textures.size()) break;
+    texel_words -= textures[largest].texels.size();
+    halve(textures[largest]);
+    texel_words += textures[largest].texels.size();
+    ++s.texture_halvings;
+  }
+  for (std::size_t t = 0; t < scene.textures.size(); ++t)
+    if (used[t] &&
+        ((1u << textures[t].log2_width) != static_cast<std::uint32_t>(scene.textures[t].width) ||
+         (1u << textures[t].log2_height) != static_cast<std::uint32_t>(scene.textures[t].height)))
+      ++s.resampled_textures;
   const std::uint64_t end = material_words + light_words + record_words + texel_words;
   if (end > b.params.bank_words) {
     const std::uint64_t cap = b.params.bank_words;
@@ -651,7 +689,7 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
                                  std::to_string(obj.positions.size()));
       if (t < obj.degenerate.size() && obj.degenerate[t]) continue;
       auto m = triangle_matrix(obj.positions[tri.x], obj.positions[tri.y], obj.positions[tri.z]);
-      if (!m || !all_finite(encode_affine(*m, f), f)) continue;
+      if (!m || !fits_format(*m, f)) continue;
       info.t_delta[t] = *m;
       skip[t] = 0;
     }

@@ -41,6 +41,11 @@ struct ImageParams {
   // Node and list slots reserved for the top-level tree, as a multiple of its first build, when
   // the scene has dynamic instances: a per-frame rebuild that fits needs no relayout.
   double top_level_headroom = 2.0;
+  // Textures are resampled to power-of-two sizes of at most this many texels per side.
+  std::uint32_t max_texture_size = 1024;
+  // When the shading bank overflows, halve the largest texture until it fits (counted in
+  // ImageStats::texture_halvings) instead of refusing the scene.
+  bool fit_textures = true;
 };
 
 struct InstanceInfo {
@@ -88,6 +93,7 @@ struct ImageStats {
   std::uint64_t clamped_texcoords = 0;   // vertex texcoords beyond 16 periods of the floor
   std::uint64_t textures = 0;            // textures stored (those a material uses)
   std::uint64_t resampled_textures = 0;  // of those, how many changed size
+  std::uint64_t texture_halvings = 0;    // halvings made to fit the shading bank
   double top_build_seconds = 0.0;
   double bottom_build_seconds = 0.0;  // all bottom-level trees
   std::uint64_t scene_bytes() const;  // words of the three scene banks holding data, x4

@@ -430,18 +430,34 @@ TEST(ImageBuilder, SceneThatDoesNotFitNamesBankAndOverflow) {
   p.height = 8;
   EXPECT_NE(error_of(s, p).find("nodes overflow by"), std::string::npos) << error_of(s, p);
 
-  // Shading bank: a 64x64 texture (16 KB) in 8 KB banks whose scene banks still fit.
+  // Shading bank: a 64x64 texture (16 KB) in 8 KB banks whose scene banks still fit. Refused
+  // when textures may not give way...
   Scene t = textured_quad();
   t.textures[0].width = 64;
   t.textures[0].height = 64;
-  t.textures[0].rgba.assign(64 * 64, 0xFFFFFFFFu);
+  t.textures[0].rgba.assign(64 * 64, 0xFF336699u);
   ImageParams q = small_params();
   q.bank_words = 2048;
   q.width = 32;
   q.height = 32;
+  q.fit_textures = false;
   const std::string e2 = error_of(t, q);
-  EXPECT_NE(e2.find("scene does not fit: shading bank 2 needs"), std::string::npos) << e2;
-  EXPECT_NE(e2.find("textures overflow by"), std::string::npos) << e2;
+  EXPECT_NE(e2.find("scene does not fit: shading bank 2 needs 16.1 KB of 8.0 KB"),
+            std::string::npos)
+      << e2;
+  EXPECT_NE(e2.find("textures overflow by 8.1 KB = 8272 bytes"), std::string::npos) << e2;
+  // ... and by default halved until they fit: 2048 words hold 8 material, 4 light and 8 record
+  // words, so 64x64 -> 32x64 (2048 texels, too many) -> 32x32.
+  q.fit_textures = true;
+  const BuiltImage fitted = build_image(t, q);
+  EXPECT_EQ(fitted.stats.texture_halvings, 2u);
+  EXPECT_EQ(fitted.stats.resampled_textures, 1u);
+  const DecodedImage dt = decode_image(fitted.image);
+  ASSERT_EQ(dt.textures.size(), 1u);
+  EXPECT_EQ(dt.textures[0].width, 32u);
+  EXPECT_EQ(dt.textures[0].height, 32u);
+  EXPECT_EQ(dt.textures[0].texels[31 * 32 + 31], 0xFF336699u);
+  EXPECT_EQ(fitted.stats.bytes_per_bank[2], 4u * (20u + 1024u));
 
   // Frame buffer.
   ImageParams fb = small_params();

@@ -65,6 +65,14 @@ bool all_finite(const EncodedAffine& e, const ff::Format& f) {
   return true;
 }
 
+bool fits_format(const Affine64& a, const ff::Format& f) {
+  const double largest = ff::decode(f.max_finite_bits(), f, ff::Subnormals::kKeep);
+  for (const auto& row : a.rows)
+    for (double v : row)
+      if (!(std::abs(v) <= largest)) return false;  // also NaN
+  return true;
+}
+
 std::optional<Affine64> triangle_matrix(const glm::dvec3& a, const glm::dvec3& b,
                                         const glm::dvec3& c) {
   const glm::dvec3 e0 = a - c;
@@ -97,10 +105,8 @@ std::optional<Affine64> triangle_matrix(const glm::vec3& a, const glm::vec3& b,
 std::optional<EncodedAffine> encoded_triangle_matrix(const glm::vec3& a, const glm::vec3& b,
                                                      const glm::vec3& c, const ff::Format& f) {
   const auto t = triangle_matrix(a, b, c);
-  if (!t) return std::nullopt;
-  EncodedAffine e = encode_affine(*t, f);
-  if (!all_finite(e, f)) return std::nullopt;
-  return e;
+  if (!t || !fits_format(*t, f)) return std::nullopt;
+  return encode_affine(*t, f);
 }
 
 Affine64 affine_from_glm(const glm::dmat4& m) {

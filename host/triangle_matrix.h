@@ -40,6 +40,9 @@ Affine32 to_float(const Affine64& a);
 EncodedAffine encode_affine(const Affine64& a, const ff::Format& f);
 // True when every coefficient of `e` is finite (no overflow to inf, no NaN).
 bool all_finite(const EncodedAffine& e, const ff::Format& f);
+// True when every coefficient of `a` is finite with magnitude at most f's largest finite value,
+// so that rounding it into f gives a finite encoding (a cheap test before encode_affine).
+bool fits_format(const Affine64& a, const ff::Format& f);
 
 // A triangle is degenerate when |(A-C) x (B-C)| <= kDegenerateRelArea * L^2, with L the longest
 // edge. The ratio is scale-free (twice the area over the squared longest edge: 0 for a line,
@@ -61,7 +64,7 @@ std::optional<Affine64> triangle_matrix(const glm::dvec3& a, const glm::dvec3& b
 std::optional<Affine64> triangle_matrix(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
 
 // T_delta rounded into format f; std::nullopt when the triangle is degenerate or a coefficient
-// overflows the format (a sliver so thin that 1/height exceeds the format's range).
+// overflows the format (!fits_format: a sliver so thin that 1/height exceeds the format's range).
 std::optional<EncodedAffine> encoded_triangle_matrix(const glm::vec3& a, const glm::vec3& b,
                                                      const glm::vec3& c, const ff::Format& f);
 

@@ -224,6 +224,16 @@ TEST(TriangleMatrix, DegenerateTrianglesGiveNullopt) {
   EXPECT_TRUE(triangle_matrix(p, q, r).has_value());
   EXPECT_FALSE(encoded_triangle_matrix(p, q, r, ff::kFp24).has_value());
   EXPECT_TRUE(encoded_triangle_matrix(p, q, r, ff::kFp32).has_value());
+  // fits_format: the largest finite fp24 value encodes finitely, twice it does not.
+  Affine64 big;
+  big.rows[1][2] = ff::decode(ff::kFp24.max_finite_bits(), ff::kFp24, ff::Subnormals::kKeep);
+  EXPECT_TRUE(fits_format(big, ff::kFp24));
+  EXPECT_TRUE(all_finite(encode_affine(big, ff::kFp24), ff::kFp24));
+  big.rows[1][2] *= -2.0;
+  EXPECT_FALSE(fits_format(big, ff::kFp24));
+  EXPECT_FALSE(all_finite(encode_affine(big, ff::kFp24), ff::kFp24));
+  big.rows[1][2] = std::nan("");
+  EXPECT_FALSE(fits_format(big, ff::kFp24));
 }
 
 TEST(InstanceMatrix, WorldToObjectInvertsObjectToWorld) {
