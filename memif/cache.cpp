@@ -1,0 +1,248 @@
+// Per-type item cache (paper section 3, Table 2; DESIGN.md section 6; DIGEST D20).
+#include "memif/cache.h"
+
+#include <algorithm>
+#include <sstream>
+#include <stdexcept>
+
+namespace saarcor::memif {
+
+namespace {
+// Checked before the module registers with the kernel (a refused configuration leaves nothing
+// behind).
+std::string checked(std::string name, const CacheConfig& config, int words) {
+  auto bad = [&](const std::string& what) {
+    throw std::runtime_error("cache '" + name + "': " + what);
+  };
+  if (config.items < 1) bad("items must be >= 1");
+  if (config.ways < 1 || config.items % config.ways != 0) {
+    bad("ways must divide items (" + std::to_string(config.items) + " items, " +
+        std::to_string(config.ways) + " ways)");
+  }
+  if (config.hit_latency < 2) bad("hit_latency must be >= 2 (one cycle in, one out)");
+  if (config.max_misses < 1) bad("max_misses must be >= 1");
+  if (config.max_targets < 1) bad("max_targets must be >= 1");
+  if (config.request_capacity < 1) bad("request_capacity must be >= 1");
+  if (config.memory_capacity < 1) bad("memory_capacity must be >= 1");
+  if (words > kMaxRequestWords) {
+    bad("items wider than " + std::to_string(kMaxRequestWords) + " words");
+  }
+  return name;
+}
+}  // namespace
+
+Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryImage& image,
+             std::uint16_t client, CacheConfig config)
+    : hw::Module(kernel, checked(std::move(name), config, image.item_words(type))),
+      type_(type),
+      image_(image),
+      client_(client),
+      config_(config),
+      words_(image.item_words(type)),
+      sets_(config.ways > 0 ? config.items / config.ways : 0),
+      requests_(kernel, this->name() + ".req", std::max(1, config.request_capacity), 1),
+      responses_(kernel, this->name() + ".resp", config.hit_latency + 2,
+                 std::max(1, config.hit_latency - 1)),
+      mem_requests_(kernel, this->name() + ".mem_req", std::max(1, config.memory_capacity), 1),
+      fills_(kernel, this->name() + ".fill", std::max(1, config.memory_capacity), 1) {
+  lines_.resize(static_cast<std::size_t>(config.items));
+  mshrs_.resize(static_cast<std::size_t>(config.max_misses));
+  hw::Stats& s = stats();
+  const std::string& n = this->name();
+  requests_stat_ = &s.counter(n + ".requests", "requests", "item requests accepted");
+  hits_ = &s.counter(n + ".hits", "requests", "requests served from a present line");
+  misses_ = &s.counter(n + ".misses", "requests", "requests that allocated a line and fetched it");
+  merges_ = &s.counter(n + ".merges", "requests",
+                       "requests merged into an outstanding miss of the same item");
+  const hw::Counter *req = requests_stat_, *hit = hits_, *merge = merges_;
+  s.formula(n + ".hit_rate", "ratio", "hits / requests", [req, hit] {
+    return req->value ? static_cast<double>(hit->value) / static_cast<double>(req->value) : 0.0;
+  });
+  s.formula(n + ".hit_rate_with_merges", "ratio",
+            "(hits + merges) / requests: the hit rate of a blocking cache", [req, hit, merge] {
+              return req->value ? static_cast<double>(hit->value + merge->value) /
+                                      static_cast<double>(req->value)
+                                : 0.0;
+            });
+}
+
+void Cache::invalidate() {
+  for (Line& l : lines_) {
+    if (l.mshr >= 0) mshrs_[static_cast<std::size_t>(l.mshr)].line = -1;
+    l = Line{};
+  }
+}
+
+bool Cache::idle() const {
+  if (!requests_.empty() || !responses_.empty() || !mem_requests_.empty() || !fills_.empty()) {
+    return false;
+  }
+  for (const Mshr& m : mshrs_) {
+    if (m.busy) return false;
+  }
+  return true;
+}
+
+int Cache::evaluate() {
+  // A fill is written into its line and may answer its first waiting request in the same cycle
+  // (bypass); that delivery takes the response port, so a hit waits a cycle.
+  int progress = accept_fill();
+  const int delivered = deliver();
+  progress += delivered;
+  progress += lookup(delivered == 0);
+  return progress;
+}
+
+int Cache::deliver() {
+  if (filled_.empty()) return 0;
+  if (!responses_.can_push()) {
+    stall();
+    return 0;
+  }
+  const int id = filled_.front();
+  Mshr& m = mshrs_[static_cast<std::size_t>(id)];
+  CacheResponse r;
+  r.index = m.item;
+  r.label = m.targets.front();
+  r.words = m.words;
+  r.count = words_;
+  responses_.push(r);
+  m.targets.pop_front();
+  if (m.targets.empty()) {
+    m.busy = false;
+    filled_.pop_front();
+  }
+  return 1;
+}
+
+int Cache::lookup(bool port_free) {
+  if (!requests_.can_pop()) return 0;
+  const CacheRequest& req = requests_.peek();
+  const std::size_t set = req.index % static_cast<std::uint32_t>(sets_);
+  const std::size_t first = set * static_cast<std::size_t>(config_.ways);
+  int way = -1;
+  for (int w = 0; w < config_.ways; ++w) {
+    const Line& l = lines_[first + static_cast<std::size_t>(w)];
+    if (l.item == req.index && (l.valid || l.mshr >= 0)) {
+      way = w;
+      break;
+    }
+  }
+  if (way >= 0) {
+    Line& l = lines_[first + static_cast<std::size_t>(way)];
+    if (l.valid) {  // hit
+      if (!port_free || !responses_.can_push()) {
+        stall();
+        return 0;
+      }
+      CacheResponse r;
+      r.index = req.index;
+      r.label = req.label;
+      r.words = l.words;
+      r.count = words_;
+      requests_.pop();
+      responses_.push(r);
+      l.lru = ++use_clock_;
+      ++*hits_;
+      ++*requests_stat_;
+      return 1;
+    }
+    Mshr& m = mshrs_[static_cast<std::size_t>(l.mshr)];  // merge into the pending fill
+    if (static_cast<int>(m.targets.size()) >= config_.max_targets) {
+      stall();
+      return 0;
+    }
+    m.targets.push_back(req.label);
+    requests_.pop();
+    l.lru = ++use_clock_;
+    ++*merges_;
+    ++*requests_stat_;
+    return 1;
+  }
+  // Miss: needs a free MSHR and room towards memory.
+  int id = -1;
+  for (std::size_t i = 0; i < mshrs_.size(); ++i) {
+    if (!mshrs_[i].busy) {
+      id = static_cast<int>(i);
+      break;
+    }
+  }
+  if (id < 0 || !mem_requests_.can_push()) {
+    stall();
+    return 0;
+  }
+  int victim = 0;
+  for (int w = 0; w < config_.ways; ++w) {
+    const Line& l = lines_[first + static_cast<std::size_t>(w)];
+    const Line& v = lines_[first + static_cast<std::size_t>(victim)];
+    const bool empty = !l.valid && l.mshr < 0;
+    if (empty) {
+      victim = w;
+      break;
+    }
+    if (l.lru < v.lru) victim = w;
+  }
+  const std::size_t li = first + static_cast<std::size_t>(victim);
+  Line& l = lines_[li];
+  if (l.mshr >= 0) mshrs_[static_cast<std::size_t>(l.mshr)].line = -1;  // fill no longer kept
+  l.item = req.index;
+  l.valid = false;
+  l.mshr = id;
+  l.lru = ++use_clock_;
+  Mshr& m = mshrs_[static_cast<std::size_t>(id)];
+  m.busy = true;
+  m.filled = false;
+  m.item = req.index;
+  m.line = static_cast<int>(li);
+  m.targets.assign(1, req.label);
+  const WordLocation loc = image_.locate(type_, req.index, 0);
+  MemRequest mr;
+  mr.client = client_;
+  mr.tag = static_cast<std::uint32_t>(id);
+  mr.bank = static_cast<std::uint8_t>(loc.bank);
+  mr.offset = loc.offset;
+  mr.words = static_cast<std::uint8_t>(words_);
+  mem_requests_.push(mr);
+  requests_.pop();
+  ++*misses_;
+  ++*requests_stat_;
+  return 1;
+}
+
+int Cache::accept_fill() {
+  if (!fills_.can_pop()) return 0;
+  const MemResponse f = fills_.pop();
+  if (f.tag >= mshrs_.size() || !mshrs_[f.tag].busy || mshrs_[f.tag].filled || f.count != words_) {
+    throw std::logic_error("cache '" + name() + "': fill for MSHR " + std::to_string(f.tag) +
+                           " that is not waiting for one");
+  }
+  Mshr& m = mshrs_[f.tag];
+  m.filled = true;
+  m.words = f.words;
+  if (m.line >= 0) {
+    Line& l = lines_[static_cast<std::size_t>(m.line)];
+    l.valid = true;
+    l.mshr = -1;
+    l.words = f.words;
+  }
+  filled_.push_back(static_cast<int>(f.tag));
+  return 1;
+}
+
+std::string Cache::dump_state() const {
+  std::ostringstream os;
+  int busy = 0;
+  for (const Mshr& m : mshrs_)
+    busy += m.busy;
+  os << item_type_name(type_) << " cache: " << busy << "/" << mshrs_.size()
+     << " misses outstanding, " << filled_.size() << " filled awaiting delivery";
+  for (std::size_t i = 0; i < mshrs_.size(); ++i) {
+    const Mshr& m = mshrs_[i];
+    if (!m.busy) continue;
+    os << "; mshr" << i << " item " << m.item << (m.filled ? " filled" : " waiting for memory")
+       << ", " << m.targets.size() << " requests (first tag " << m.targets.front().tag << ")";
+  }
+  return os.str();
+}
+
+}  // namespace saarcor::memif

@@ -1,0 +1,122 @@
+// Per-type item cache of a DynRTP (paper section 3: "individual caches for each type of data";
+// Table 2: 512 items each; DESIGN.md section 6; DIGEST D20).
+//
+// One cache serves one item type (kd-nodes, list entries or matrix rows of MemoryImage); a line
+// holds one item; the cache is read-only. Sets = items / ways, set = index mod sets, LRU within a
+// set (direct-mapped by default). Non-blocking: up to `max_misses` outstanding misses (MSHRs);
+// a request for an item whose fill is on its way is merged into that miss (a secondary miss:
+// no second memory request).
+//
+// Unit-facing interface (the narrow one; all a unit needs):
+//   requests()  unit pushes CacheRequest{index, label}. Latency 1, capacity `request_capacity`;
+//               can_push() false = back-pressure (the cache is stalled on misses).
+//   responses() unit pops CacheResponse{index, label, words, count}: one response per accepted
+//               request, exactly once, carrying the item's words as in the image.
+//   Timing: a hit pushed in cycle c is poppable at c + hit_latency. A miss takes the memory
+//   round trip (see docs/memif.md for the exact count with the default parameters).
+//   Ordering: hits answer in request order; a miss answers when its fill returns, so responses
+//   may overtake each other: match them by label, never by order.
+//   Throughput: one request looked up and one response delivered per cycle; delivering a
+//   filled miss's waiting requests takes priority over new hits.
+// Classification (what the counters mean): the tag array is updated when a miss is accepted,
+// so the hit/miss decision depends only on the order of accepted requests:
+//   hit    tag present, data present;
+//   merge  tag present, fill pending (a blocking cache, or a simulation with instant fills,
+//          would count it a hit);
+//   miss   tag absent: a victim line is allocated (LRU) and one memory request is sent.
+// Hence hits + merges and misses equal those of a plain cache simulation with instant fills on
+// the same request sequence (the reference the tests use).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "hw/kernel.h"
+#include "memif/image_format.h"
+#include "memif/request.h"
+
+namespace saarcor::memif {
+
+struct CacheConfig {
+  int items = 512;       // lines (DESIGN.md section 6)
+  int ways = 1;          // associativity; items must be a multiple
+  int hit_latency = 2;   // cycles from the unit's push to the response being poppable (>= 2)
+  int max_misses = 8;    // outstanding misses (D20)
+  int max_targets = 16;  // requests waiting on one miss (the first included)
+  int request_capacity = 4;
+  int memory_capacity = 2;  // capacity of the memory request and fill channels
+};
+
+class Cache : public hw::Module {
+ public:
+  // `image` gives the item layout (MemoryImage::locate, item_words); the data come from memory.
+  // `client` is the memory controller client id the cache's traffic is counted under.
+  // Throws std::runtime_error for a bad configuration (one line naming the parameter).
+  Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryImage& image,
+        std::uint16_t client, CacheConfig config = {});
+
+  hw::Channel<CacheRequest>& requests() { return requests_; }
+  hw::Channel<CacheResponse>& responses() { return responses_; }
+  // Memory side, connected to the simple routing.
+  hw::Channel<MemRequest>& memory_requests() { return mem_requests_; }
+  hw::Channel<MemResponse>& fills() { return fills_; }
+
+  // Drops every line (between frames, after a host upload; D20). Outstanding misses still answer
+  // their requests but are not kept.
+  void invalidate();
+
+  int evaluate() override;
+  std::string dump_state() const override;
+  std::uint64_t next_wakeup(std::uint64_t) const override { return hw::kNever; }
+
+  ItemType type() const { return type_; }
+  std::uint16_t client() const { return client_; }
+  const CacheConfig& config() const { return config_; }
+  std::uint64_t requests_count() const { return requests_stat_->value; }
+  std::uint64_t hits() const { return hits_->value; }
+  std::uint64_t misses() const { return misses_->value; }
+  std::uint64_t merges() const { return merges_->value; }
+  bool idle() const;  // no miss outstanding, all four channels empty
+
+ private:
+  struct Line {
+    std::uint32_t item = kNone;
+    bool valid = false;     // data present
+    int mshr = -1;          // fill pending in this MSHR
+    std::uint64_t lru = 0;  // last use, for LRU
+    std::array<std::uint32_t, kMaxRequestWords> words{};
+  };
+  struct Mshr {
+    bool busy = false;
+    bool filled = false;
+    std::uint32_t item = 0;
+    int line = -1;  // the line waiting for this fill; -1 once the line was reallocated
+    std::deque<Label> targets;
+    std::array<std::uint32_t, kMaxRequestWords> words{};
+  };
+
+  // The cycle, as a script.
+  int accept_fill();           // a returning fill is written into its line
+  int deliver();               // one waiting request of a filled miss, if any
+  int lookup(bool port_free);  // the next request: hit, merge or miss
+
+  ItemType type_;
+  const MemoryImage& image_;
+  std::uint16_t client_;
+  CacheConfig config_;
+  int words_;
+  int sets_;
+  hw::Channel<CacheRequest> requests_;
+  hw::Channel<CacheResponse> responses_;
+  hw::Channel<MemRequest> mem_requests_;
+  hw::Channel<MemResponse> fills_;
+  std::vector<Line> lines_;
+  std::vector<Mshr> mshrs_;
+  std::deque<int> filled_;  // MSHRs with data, in fill order
+  std::uint64_t use_clock_ = 0;
+  hw::Counter *requests_stat_, *hits_, *misses_, *merges_;
+};
+
+}  // namespace saarcor::memif

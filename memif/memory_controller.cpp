@@ -1,0 +1,294 @@
+// The memory controller and SRAM banks (paper section 3, DESIGN.md section 6, DIGEST D21/D23).
+#include "memif/memory_controller.h"
+
+#include <algorithm>
+#include <sstream>
+#include <stdexcept>
+
+namespace saarcor::memif {
+
+namespace {
+// Checked before the module registers with the kernel, so a refused configuration leaves no
+// half-built module behind.
+std::string checked(std::string name, const MemoryControllerConfig& c) {
+  auto bad = [&](const std::string& what) {
+    throw std::runtime_error("memory controller '" + name + "': " + what);
+  };
+  if (c.queue_depth < 1) bad("queue_depth must be >= 1");
+  if (c.latency < 1) bad("latency must be >= 1");
+  if (c.switch_penalty < 0) bad("switch_penalty must be >= 0");
+  if (c.max_burst < 1) bad("max_burst must be >= 1");
+  if (c.port_capacity < 2) bad("port_capacity must be >= 2");
+  if (!(c.clock_hz > 0)) bad("clock_hz must be > 0");
+  if (static_cast<int>(c.bank_path.size()) != kNumBanks) {
+    bad("bank_path needs one entry per bank (" + std::to_string(kNumBanks) + ")");
+  }
+  for (int p : c.bank_path) {
+    if (p < 0 || p >= kNumBanks)
+      bad("bank_path entries must be 0.." + std::to_string(kNumBanks - 1));
+  }
+  return name;
+}
+}  // namespace
+
+MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryImage& image,
+                                   MemoryControllerConfig config)
+    : hw::Module(kernel, checked(std::move(name), config)),
+      image_(image),
+      config_(std::move(config)),
+      banks_(kNumBanks),
+      inflight_limit_(config_.latency + 2) {
+  hw::Stats& s = stats();
+  const std::string& n = this->name();
+  for (int b = 0; b < kNumBanks; ++b) {
+    const int p = config_.bank_path[static_cast<std::size_t>(b)];
+    if (static_cast<int>(paths_.size()) <= p) paths_.resize(static_cast<std::size_t>(p) + 1);
+    paths_[static_cast<std::size_t>(p)].banks.push_back(b);
+    const std::string bn = n + ".bank" + std::to_string(b);
+    Bank& bank = banks_[static_cast<std::size_t>(b)];
+    bank.reads = &s.counter(bn + ".reads", "requests", "read requests started");
+    bank.writes = &s.counter(bn + ".writes", "requests", "write requests started");
+    bank.words = &s.counter(bn + ".busy_cycles", "cycles", "cycles transferring a word");
+    bank.max_queue = &s.counter(bn + ".max_queue", "requests", "largest bank queue occupancy");
+  }
+  for (std::size_t p = 0; p < paths_.size(); ++p) {
+    if (paths_[p].banks.empty()) continue;
+    paths_[p].switches = &s.counter(n + ".path" + std::to_string(p) + ".bank_switches", "events",
+                                    "starts on a bank other than the path's open bank");
+  }
+}
+
+MemoryController::Port& MemoryController::add_port(const std::string& name) {
+  ports_.push_back(std::make_unique<Port>(kernel(), name, config_.port_capacity));
+  return *ports_.back();
+}
+
+std::uint16_t MemoryController::add_client(const std::string& name) {
+  if (clients_.size() >= 0xFFFF) throw std::runtime_error("memory controller: too many clients");
+  const auto id = static_cast<std::uint16_t>(clients_.size());
+  Client c;
+  c.name = name;
+  c.bytes = &stats().counter(name + ".mem_bytes", "bytes",
+                             "external memory traffic of this client (reads and writes)");
+  const double clock = config_.clock_hz;
+  const hw::Counter* bytes = c.bytes;
+  hw::Kernel* k = &kernel();
+  stats().formula(name + ".mem_mb_per_s", "MB/s", "external memory bandwidth at the modelled clock",
+                  [bytes, clock, k] {
+                    return k->now() == 0 ? 0.0
+                                         : static_cast<double>(bytes->value) * clock /
+                                               static_cast<double>(k->now()) / 1048576.0;
+                  });
+  clients_.push_back(std::move(c));
+  return id;
+}
+
+std::uint64_t MemoryController::client_bytes(std::uint16_t client) const {
+  return clients_.at(client).bytes->value;
+}
+
+double MemoryController::client_mb_per_s(std::uint16_t client, std::uint64_t cycles) const {
+  if (cycles == 0) return 0.0;
+  return static_cast<double>(client_bytes(client)) * config_.clock_hz /
+         static_cast<double>(cycles) / 1048576.0;
+}
+
+const std::string& MemoryController::client_name(std::uint16_t client) const {
+  return clients_.at(client).name;
+}
+
+std::uint64_t MemoryController::bank_switches() const {
+  std::uint64_t n = 0;
+  for (const Path& p : paths_) {
+    if (p.switches) n += p.switches->value;
+  }
+  return n;
+}
+
+bool MemoryController::idle() const {
+  for (const Bank& b : banks_) {
+    if (!b.queue.empty() || !b.inflight.empty()) return false;
+  }
+  for (const auto& p : ports_) {
+    if (!p->requests.empty() || !p->responses.empty()) return false;
+  }
+  return true;
+}
+
+int MemoryController::evaluate() {
+  // Back to front, like pipeline stages: each stage reads what the later one left last cycle.
+  int progress = retire_responses();
+  progress += issue();
+  progress += accept_requests();
+  return progress;
+}
+
+// Completed reads leave towards their port, oldest due first; one per port and cycle.
+int MemoryController::retire_responses() {
+  int moved = 0;
+  for (;;) {
+    int best = -1;
+    for (int b = 0; b < kNumBanks; ++b) {
+      const Bank& bank = banks_[static_cast<std::size_t>(b)];
+      if (bank.inflight.empty() || bank.inflight.front().due > now()) continue;
+      if (!ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.can_push()) {
+        continue;
+      }
+      if (best < 0 ||
+          bank.inflight.front().due < banks_[static_cast<std::size_t>(best)].inflight.front().due) {
+        best = b;
+      }
+    }
+    if (best < 0) break;
+    Bank& bank = banks_[static_cast<std::size_t>(best)];
+    ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.push(
+        bank.inflight.front().resp);
+    bank.inflight.pop_front();
+    ++moved;
+  }
+  for (const Bank& bank : banks_) {
+    if (!bank.inflight.empty() && bank.inflight.front().due <= now()) stall();  // port full
+  }
+  return moved;
+}
+
+void MemoryController::start(int b, std::uint64_t when) {
+  Bank& bank = banks_[static_cast<std::size_t>(b)];
+  const Queued q = bank.queue.front();
+  bank.queue.pop_front();
+  const MemRequest& r = q.req;
+  bank.free_at = when + r.words;
+  *bank.words += r.words;
+  *clients_.at(r.client).bytes += r.counted_bytes ? r.counted_bytes : 4u * r.words;
+  std::vector<std::uint32_t>& mem = image_.bank(b);
+  if (r.write) {
+    ++*bank.writes;
+    for (int i = 0; i < r.words; ++i)
+      mem[r.offset + static_cast<std::uint32_t>(i)] = r.data[static_cast<std::size_t>(i)];
+    return;
+  }
+  ++*bank.reads;
+  InFlight f;
+  f.due = when + r.words - 1 + static_cast<std::uint64_t>(config_.latency);
+  f.port = q.port;
+  f.resp.client = r.client;
+  f.resp.tag = r.tag;
+  f.resp.count = r.words;
+  for (int i = 0; i < r.words; ++i)
+    f.resp.words[static_cast<std::size_t>(i)] = mem[r.offset + static_cast<std::uint32_t>(i)];
+  bank.inflight.push_back(f);
+}
+
+int MemoryController::issue() {
+  int started = 0;
+  for (Path& path : paths_) {
+    if (path.banks.empty() || path.free_at > now()) continue;
+    auto startable = [&](int b) {
+      const Bank& bank = banks_[static_cast<std::size_t>(b)];
+      return !bank.queue.empty() && bank.free_at <= now() &&
+             static_cast<int>(bank.inflight.size()) < inflight_limit_;
+    };
+    int oldest_any = -1, oldest_startable = -1, others_waiting = 0;
+    for (int b : path.banks) {
+      const Bank& bank = banks_[static_cast<std::size_t>(b)];
+      if (bank.queue.empty()) continue;
+      if (b != path.open) ++others_waiting;
+      auto older = [&](int than) {
+        return than < 0 ||
+               bank.queue.front().seq < banks_[static_cast<std::size_t>(than)].queue.front().seq;
+      };
+      if (older(oldest_any)) oldest_any = b;
+      if (startable(b) && older(oldest_startable)) oldest_startable = b;
+    }
+    int chosen = -1;
+    if (config_.reorder) {
+      // Stay on the open bank while it has work and the burst limit allows, waiting for it when
+      // it becomes free no later than a switch would let another bank start: such a switch
+      // would be needless. Otherwise switch to the free bank with the oldest request.
+      const Bank* open = path.open >= 0 ? &banks_[static_cast<std::size_t>(path.open)] : nullptr;
+      const bool open_wanted = open != nullptr && !open->queue.empty() &&
+                               (path.burst < config_.max_burst || others_waiting == 0);
+      if (open_wanted && startable(path.open)) {
+        chosen = path.open;
+      } else if (open_wanted &&
+                 open->free_at <= now() + static_cast<std::uint64_t>(config_.switch_penalty)) {
+        chosen = -1;  // wait for the open bank
+      } else {
+        chosen = oldest_startable;
+      }
+    } else if (oldest_any >= 0 && startable(oldest_any)) {
+      chosen = oldest_any;
+    }
+    if (chosen < 0) continue;
+    std::uint64_t when = now();
+    if (chosen != path.open) {
+      if (path.open >= 0) {
+        when += static_cast<std::uint64_t>(config_.switch_penalty);
+        ++*path.switches;
+      }
+      path.open = chosen;
+      path.burst = 0;
+    }
+    ++path.burst;
+    path.free_at = when + 1;
+    start(chosen, when);
+    ++started;
+  }
+  return started;
+}
+
+int MemoryController::accept_requests() {
+  int accepted = 0;
+  for (std::size_t p = 0; p < ports_.size(); ++p) {
+    hw::Channel<MemRequest>& in = ports_[p]->requests;
+    if (!in.can_pop()) continue;
+    const MemRequest& r = in.peek();
+    if (r.bank >= kNumBanks || r.words < 1 || r.words > kMaxRequestWords ||
+        static_cast<std::uint64_t>(r.offset) + r.words > image_.bank(r.bank).size() ||
+        r.client >= clients_.size()) {
+      throw std::runtime_error("memory controller '" + name() + "': port " + ports_[p]->name +
+                               " sent a request outside memory (bank " + std::to_string(r.bank) +
+                               ", offset " + std::to_string(r.offset) + ", " +
+                               std::to_string(r.words) + " words, client " +
+                               std::to_string(r.client) + ")");
+    }
+    Bank& bank = banks_[r.bank];
+    if (static_cast<int>(bank.queue.size()) >= config_.queue_depth) {
+      stall();
+      continue;
+    }
+    bank.queue.push_back({in.pop(), static_cast<int>(p), seq_++});
+    bank.max_queue->set_max(bank.queue.size());
+    ++accepted;
+  }
+  return accepted;
+}
+
+std::uint64_t MemoryController::next_wakeup(std::uint64_t now) const {
+  std::uint64_t t = hw::kNever;
+  for (int b = 0; b < kNumBanks; ++b) {
+    const Bank& bank = banks_[static_cast<std::size_t>(b)];
+    if (!bank.inflight.empty() && bank.inflight.front().due > now) {
+      t = std::min(t, bank.inflight.front().due);
+    }
+    if (!bank.queue.empty()) {
+      const Path& path =
+          paths_[static_cast<std::size_t>(config_.bank_path[static_cast<std::size_t>(b)])];
+      const std::uint64_t ready = std::max(bank.free_at, path.free_at);
+      if (ready > now) t = std::min(t, ready);
+    }
+  }
+  return t;
+}
+
+std::string MemoryController::dump_state() const {
+  std::ostringstream os;
+  for (int b = 0; b < kNumBanks; ++b) {
+    const Bank& bank = banks_[static_cast<std::size_t>(b)];
+    os << "bank" << b << " queue " << bank.queue.size() << " in flight " << bank.inflight.size()
+       << " free at " << bank.free_at << (b + 1 < kNumBanks ? "; " : "");
+  }
+  return os.str();
+}
+
+}  // namespace saarcor::memif

@@ -1,0 +1,130 @@
+// The memory controller and the SRAM banks (paper section 3: "Mem-Ctrl ... uses a simple
+// reordering algorithm that ... avoid[s] unnecessary switching of memory-banks"; DESIGN.md
+// section 6; DIGEST D21, D23, D39).
+//
+// Model:
+//   * Ports: each client group (the simple routing of the caches, a shading unit, a frame-buffer
+//     writer, the host bus) talks to the controller through one Port: a request channel and a
+//     response channel (latency 1 each: the routing cycle each way of D21).
+//   * Intake: per port and cycle at most one request moves into the per-bank queue of its bank
+//     (depth `queue_depth`); a full queue holds the port (head-of-line, back-pressure).
+//   * Banks: six 32-bit SRAM banks reading the MemoryImage. A request of w words occupies its
+//     bank for w cycles from its start cycle s; its response (all w words) is handed to the port
+//     in cycle s + w - 1 + latency.
+//   * Issue paths: banks on the same path (default: the three scene banks 3-5, which the DynRTC
+//     shares) are started by one shared issue stage, at most one start per cycle; starting a
+//     bank other than the path's open (last) bank costs `switch_penalty` cycles (D21). With
+//     `reorder` on, a path keeps issuing to its open bank while that bank has work and is free
+//     (at most `max_burst` in a row while other banks wait), else it switches to the free bank
+//     with the oldest request; with `reorder` off it always serves the path's oldest request.
+//   * Writes (frame buffer, host) store into the image at their start cycle; no response.
+//   * Bytes are counted per client at the start cycle (4 per word, or MemRequest::counted_bytes)
+//     and reported as MB/s at the modelled clock (MB = 2^20 bytes, D39).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hw/kernel.h"
+#include "memif/image_format.h"
+#include "memif/request.h"
+
+namespace saarcor::memif {
+
+struct MemoryControllerConfig {
+  int queue_depth = 8;     // per-bank request queue (D23)
+  int latency = 4;         // cycles from a word's read slot to its data (D21: SRAM + pads)
+  int switch_penalty = 1;  // cycles lost when a shared path starts another bank (D21)
+  int max_burst = 8;       // consecutive starts on the open bank while other banks wait
+  bool reorder = true;     // prefer the open bank (D23); false: oldest request first
+  // Issue path of each bank; banks with the same number share one issue stage.
+  std::vector<int> bank_path = {0, 1, 2, 3, 3, 3};
+  int port_capacity = 4;     // request and response channel capacity per port
+  double clock_hz = 90.0e6;  // modelled clock, for MB/s (D39)
+};
+
+class MemoryController : public hw::Module {
+ public:
+  struct Port {
+    std::string name;
+    hw::Channel<MemRequest> requests;    // client pushes, controller pops
+    hw::Channel<MemResponse> responses;  // controller pushes, client pops
+    Port(hw::Kernel& k, const std::string& n, int capacity)
+        : name(n), requests(k, n + ".req", capacity, 1), responses(k, n + ".resp", capacity, 1) {}
+  };
+
+  // Throws std::runtime_error for a bad configuration (one line naming the parameter).
+  MemoryController(hw::Kernel& kernel, std::string name, MemoryImage& image,
+                   MemoryControllerConfig config = {});
+
+  // Set-up (before the first cycle). A port is a pair of channels; a client is a name bandwidth
+  // is counted under (several clients may share one port, e.g. all caches behind the routing).
+  Port& add_port(const std::string& name);
+  std::uint16_t add_client(const std::string& name);
+
+  int evaluate() override;
+  std::string dump_state() const override;
+  std::uint64_t next_wakeup(std::uint64_t now) const override;
+
+  // Bandwidth per client: bytes so far, and MB/s over `cycles` cycles at the modelled clock.
+  std::uint64_t client_bytes(std::uint16_t client) const;
+  double client_mb_per_s(std::uint16_t client, std::uint64_t cycles) const;
+  const std::string& client_name(std::uint16_t client) const;
+  int clients() const { return static_cast<int>(clients_.size()); }
+  std::uint64_t bank_switches() const;
+  bool idle() const;  // nothing queued, in flight, or in a port channel
+  const MemoryControllerConfig& config() const { return config_; }
+  const MemoryImage& image() const { return image_; }
+
+ private:
+  struct Queued {
+    MemRequest req;
+    int port;
+    std::uint64_t seq;  // arrival order, for oldest-first
+  };
+  struct InFlight {
+    std::uint64_t due;
+    int port;
+    MemResponse resp;
+  };
+  struct Bank {
+    std::deque<Queued> queue;
+    std::deque<InFlight> inflight;  // reads, in start order (due cycles increase)
+    std::uint64_t free_at = 0;      // first cycle the bank can start another request
+    hw::Counter* reads = nullptr;
+    hw::Counter* writes = nullptr;
+    hw::Counter* words = nullptr;
+    hw::Counter* max_queue = nullptr;
+  };
+  struct Path {
+    std::vector<int> banks;
+    int open = -1;
+    int burst = 0;
+    std::uint64_t free_at = 0;
+    hw::Counter* switches = nullptr;
+  };
+  struct Client {
+    std::string name;
+    hw::Counter* bytes = nullptr;
+  };
+
+  // The cycle, as a script.
+  int retire_responses();
+  int issue();
+  int accept_requests();
+  void start(int bank, std::uint64_t when);
+
+  MemoryImage& image_;
+  MemoryControllerConfig config_;
+  std::vector<std::unique_ptr<Port>> ports_;
+  std::vector<Bank> banks_;
+  std::vector<Path> paths_;
+  std::vector<Client> clients_;
+  std::uint64_t seq_ = 0;
+  int inflight_limit_;
+};
+
+}  // namespace saarcor::memif

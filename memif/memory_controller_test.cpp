@@ -1,0 +1,258 @@
+// Memory controller and SRAM banks (DESIGN.md section 6; DIGEST D21, D23): exact timing with a
+// mock client, bank parallelism, the switch penalty and the reordering, writes, bandwidth
+// counting, bad requests and bad configurations.
+#include "memif/memory_controller.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <random>
+
+namespace saarcor::memif {
+namespace {
+
+class FnModule : public hw::Module {
+ public:
+  FnModule(hw::Kernel& k, std::string name, std::function<int()> f)
+      : hw::Module(k, std::move(name)), f_(std::move(f)) {}
+  int evaluate() override { return f_(); }
+
+ private:
+  std::function<int()> f_;
+};
+
+MemoryImage numbered_image() {
+  MemoryImage img(ff::kFp24, 4096);
+  for (int b = 0; b < kNumBanks; ++b) {
+    for (std::uint32_t o = 0; o < 4096; ++o)
+      img.set_word(b, o, (static_cast<std::uint32_t>(b) << 24) | o);
+  }
+  return img;
+}
+
+MemRequest read(std::uint16_t client, std::uint32_t tag, int bank, std::uint32_t offset,
+                int words) {
+  MemRequest r;
+  r.client = client;
+  r.tag = tag;
+  r.bank = static_cast<std::uint8_t>(bank);
+  r.offset = offset;
+  r.words = static_cast<std::uint8_t>(words);
+  return r;
+}
+
+// A client that sends a scripted list of (cycle, request) and records (cycle, response).
+struct ScriptedClient {
+  ScriptedClient(hw::Kernel& k, MemoryController::Port& port,
+                 std::vector<std::pair<std::uint64_t, MemRequest>> script)
+      : script_(std::move(script)), mod_(k, "client." + port.name, [this, &k, &port] {
+          int p = 0;
+          if (next_ < script_.size() && script_[next_].first <= k.now() &&
+              port.requests.can_push()) {
+            port.requests.push(script_[next_++].second);
+            ++p;
+          }
+          if (port.responses.can_pop()) {
+            got.emplace_back(k.now(), port.responses.pop());
+            ++p;
+          }
+          return p;
+        }) {}
+  std::vector<std::pair<std::uint64_t, MemRequest>> script_;
+  std::size_t next_ = 0;
+  std::vector<std::pair<std::uint64_t, MemResponse>> got;
+  FnModule mod_;
+};
+
+TEST(MemoryController, OneReadTakesTheDocumentedCyclesAndReturnsTheImageWords) {
+  for (int words : {1, 2, 3}) {
+    MemoryImage img = numbered_image();
+    hw::Kernel k;
+    MemoryController mc(k, "ctrl", img);
+    MemoryController::Port& port = mc.add_port("p");
+    const std::uint16_t c = mc.add_client("c");
+    ScriptedClient client(k, port, {{0, read(c, 77, 4, 100, words)}});
+    k.run_to_completion([&] { return client.got.size() == 1; }, 100);
+    // push 0 -> accepted into the bank queue at 1 -> started at 2 -> last word read at
+    // 2 + words - 1 -> data + latency 4 -> handed to the port -> poppable one cycle later.
+    EXPECT_EQ(client.got[0].first, static_cast<std::uint64_t>(2 + words - 1 + 4 + 1));
+    const MemResponse& r = client.got[0].second;
+    EXPECT_EQ(r.tag, 77u);
+    EXPECT_EQ(r.client, c);
+    ASSERT_EQ(r.count, words);
+    for (int i = 0; i < words; ++i)
+      EXPECT_EQ(r.words[i], (4u << 24) | (100u + i));
+    EXPECT_EQ(mc.client_bytes(c), 4u * words);
+  }
+}
+
+TEST(MemoryController, OneBankDeliversOneWordPerCycle) {
+  MemoryImage img = numbered_image();
+  hw::Kernel k;
+  MemoryController mc(k, "ctrl", img);
+  MemoryController::Port& port = mc.add_port("p");
+  const std::uint16_t c = mc.add_client("c");
+  std::vector<std::pair<std::uint64_t, MemRequest>> script;
+  for (int i = 0; i < 30; ++i)
+    script.push_back({0, read(c, i, 3, 3 * i, 3)});
+  ScriptedClient client(k, port, script);
+  k.run_to_completion([&] { return client.got.size() == 30; }, 1000);
+  // Back-to-back on one bank: starts at 2, 5, 8, ...; the last at 2 + 29*3 = 89.
+  EXPECT_EQ(client.got.back().first, 89u + 2 + 4 + 1);
+  EXPECT_EQ(k.stats().value("ctrl.bank3.busy_cycles"), 90.0);
+  EXPECT_EQ(mc.bank_switches(), 0u);
+}
+
+TEST(MemoryController, SharedPathPaysThePenaltyWhenSwitchingBanksAndBanksOverlap) {
+  MemoryImage img = numbered_image();
+  for (int penalty : {0, 1, 3}) {
+    hw::Kernel k;
+    MemoryControllerConfig cfg;
+    cfg.switch_penalty = penalty;
+    MemoryController mc(k, "ctrl", img, cfg);
+    MemoryController::Port& port = mc.add_port("p");
+    const std::uint16_t c = mc.add_client("c");
+    // Three 3-word reads to banks 3, 4, 5, pushed at 0, 1, 2: accepted at 1, 2, 3.
+    ScriptedClient client(
+        k, port, {{0, read(c, 0, 3, 0, 3)}, {0, read(c, 1, 4, 0, 3)}, {0, read(c, 2, 5, 0, 3)}});
+    k.run_to_completion([&] { return client.got.size() == 3; }, 100);
+    // Starts: bank3 at 2; bank4 accepted at 2, path free at 3, switch: 3 + penalty; bank5
+    // accepted at 3, path free at 4 + penalty, switch: 4 + 2*penalty.
+    const std::uint64_t s[3] = {2, 3u + penalty, 4u + 2u * penalty};
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(client.got[i].first, s[i] + 2 + 4 + 1) << "penalty " << penalty << " read " << i;
+    }
+    EXPECT_EQ(mc.bank_switches(), 2u);
+  }
+}
+
+TEST(MemoryController, ReorderingCutsBankSwitchesOnRandomTraffic) {
+  // Several clients, random scene-bank reads; the same request stream with and without the
+  // open-bank preference. Every response must carry the right words either way.
+  auto run = [](bool reorder, std::uint64_t* cycles) {
+    MemoryImage img = numbered_image();
+    hw::Kernel k;
+    MemoryControllerConfig cfg;
+    cfg.reorder = reorder;
+    MemoryController mc(k, "ctrl", img, cfg);
+    std::vector<std::unique_ptr<ScriptedClient>> clients;
+    std::mt19937 rng(3);
+    std::map<std::pair<int, std::uint32_t>, MemRequest> sent;
+    for (int p = 0; p < 3; ++p) {
+      MemoryController::Port& port = mc.add_port("p" + std::to_string(p));
+      const std::uint16_t c = mc.add_client("c" + std::to_string(p));
+      std::vector<std::pair<std::uint64_t, MemRequest>> script;
+      for (std::uint32_t i = 0; i < 300; ++i) {
+        MemRequest r = read(c, i, 3 + static_cast<int>(rng() % 3), rng() % 4000,
+                            2 + static_cast<int>(rng() % 2));
+        sent[{p, i}] = r;
+        script.push_back({0, r});
+      }
+      clients.push_back(std::make_unique<ScriptedClient>(k, port, script));
+    }
+    *cycles = k.run_to_completion(
+        [&] {
+          for (auto& c : clients) {
+            if (c->got.size() != 300) return false;
+          }
+          return true;
+        },
+        100000);
+    for (int p = 0; p < 3; ++p) {
+      for (const auto& [t, r] : clients[p]->got) {
+        const MemRequest& q = sent.at({p, r.tag});
+        EXPECT_EQ(r.count, q.words);
+        for (int w = 0; w < q.words; ++w) {
+          EXPECT_EQ(r.words[w], img.word(q.bank, q.offset + w));
+        }
+      }
+    }
+    return mc.bank_switches();
+  };
+  std::uint64_t cycles_fifo = 0, cycles_reorder = 0;
+  const std::uint64_t fifo = run(false, &cycles_fifo);
+  const std::uint64_t reorder = run(true, &cycles_reorder);
+  EXPECT_LT(reorder, fifo);
+  EXPECT_LT(cycles_reorder, cycles_fifo);
+  std::printf("bank switches: in order %llu (%llu cycles), reordered %llu (%llu cycles)\n",
+              static_cast<unsigned long long>(fifo), static_cast<unsigned long long>(cycles_fifo),
+              static_cast<unsigned long long>(reorder),
+              static_cast<unsigned long long>(cycles_reorder));
+}
+
+TEST(MemoryController, WritesLandInTheImageAndLaterReadsSeeThem) {
+  MemoryImage img = numbered_image();
+  hw::Kernel k;
+  MemoryController mc(k, "ctrl", img);
+  MemoryController::Port& port = mc.add_port("p");
+  const std::uint16_t c = mc.add_client("frame");
+  MemRequest w = read(c, 0, 0, 10, 2);
+  w.write = true;
+  w.data = {0xAABBCCu, 0x112233u, 0, 0};
+  w.counted_bytes = 6;  // 3 bytes per pixel (D36)
+  ScriptedClient client(k, port, {{0, w}, {0, read(c, 5, 0, 10, 2)}});
+  k.run_to_completion([&] { return client.got.size() == 1; }, 100);
+  EXPECT_EQ(img.word(0, 10), 0xAABBCCu);
+  EXPECT_EQ(img.word(0, 11), 0x112233u);
+  EXPECT_EQ(client.got[0].second.words[0], 0xAABBCCu);
+  EXPECT_EQ(client.got[0].second.tag, 5u);
+  EXPECT_EQ(mc.client_bytes(c), 6u + 8u);
+  EXPECT_EQ(k.stats().value("ctrl.bank0.writes"), 1.0);
+}
+
+TEST(MemoryController, BandwidthIsReportedInMegabytesPerSecondAtTheModelledClock) {
+  MemoryImage img = numbered_image();
+  hw::Kernel k;
+  MemoryController mc(k, "ctrl", img);
+  MemoryController::Port& port = mc.add_port("p");
+  const std::uint16_t c = mc.add_client("dynrtp0.node_cache");
+  std::vector<std::pair<std::uint64_t, MemRequest>> script;
+  for (int i = 0; i < 100; ++i)
+    script.push_back({0, read(c, i, 3, 2 * i, 2)});
+  ScriptedClient client(k, port, script);
+  const std::uint64_t cycles = k.run_to_completion([&] { return client.got.size() == 100; }, 10000);
+  EXPECT_EQ(mc.client_bytes(c), 800u);
+  // 800 bytes in `cycles` cycles at 90 MHz, MB = 2^20 bytes.
+  const double expect = 800.0 * 90e6 / static_cast<double>(cycles) / 1048576.0;
+  EXPECT_DOUBLE_EQ(mc.client_mb_per_s(c, cycles), expect);
+  EXPECT_DOUBLE_EQ(k.stats().value("dynrtp0.node_cache.mem_mb_per_s"), expect);
+  // Sanity on the scale: one bank flat out is 4 B * 90 MHz = 343.3 MB/s.
+  EXPECT_GT(expect, 250.0);
+  EXPECT_LT(expect, 343.33);
+}
+
+TEST(MemoryController, RequestsOutsideMemoryAndBadConfigurationsAreRefused) {
+  MemoryImage img = numbered_image();
+  {
+    hw::Kernel k;
+    MemoryController mc(k, "ctrl", img);
+    MemoryController::Port& port = mc.add_port("p");
+    const std::uint16_t c = mc.add_client("c");
+    ScriptedClient client(k, port, {{0, read(c, 0, 3, 4095, 2)}});
+    EXPECT_THROW(k.run([] { return false; }, 10), std::runtime_error);
+  }
+  {
+    hw::Kernel k;
+    MemoryController mc(k, "ctrl", img);
+    MemoryController::Port& port = mc.add_port("p");
+    const std::uint16_t c = mc.add_client("c");
+    ScriptedClient client(k, port, {{0, read(c, 0, 6, 0, 1)}});
+    EXPECT_THROW(k.run([] { return false; }, 10), std::runtime_error);
+  }
+  hw::Kernel k;
+  auto make = [&](auto edit) {  // the same kernel every time: a refusal leaves nothing behind
+    MemoryControllerConfig cfg;
+    edit(cfg);
+    MemoryController mc(k, "bad", img, cfg);
+  };
+  EXPECT_THROW(make([](auto& c) { c.queue_depth = 0; }), std::runtime_error);
+  EXPECT_THROW(make([](auto& c) { c.latency = 0; }), std::runtime_error);
+  EXPECT_THROW(make([](auto& c) { c.bank_path = {0, 1}; }), std::runtime_error);
+  EXPECT_THROW(make([](auto& c) { c.switch_penalty = -1; }), std::runtime_error);
+  EXPECT_THROW(make([](auto& c) { c.clock_hz = 0; }), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace saarcor::memif

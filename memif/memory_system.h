@@ -1,0 +1,78 @@
+// The memory interface (MI) assembled (paper Fig. 2 and section 3; DESIGN.md section 6;
+// DIGEST D23, D44): per DynRTP three caches (kd-nodes, lists, matrix rows) behind one simple
+// routing shared by all DynRTPs; per DynRTP an uncached shading port and a frame-buffer port;
+// one host bus; one memory controller over the six SRAM banks of a MemoryImage.
+//
+// This is what the DynRTC cycle model instantiates. A unit uses only its cache's two channels:
+//   Cache& c = mi.cache(p, ItemType::kNode);
+//   if (c.requests().can_push()) c.requests().push({index, {unit_id, thread}});
+//   if (c.responses().can_pop()) { CacheResponse r = c.responses().pop(); ... r.label.tag ... }
+// The RGS uses shading_port(p) / frame_port(p) directly with MemRequests labelled by
+// shading_client(p) / frame_client(p) (reads answered on the port's response channel in the
+// order issued per bank; writes unanswered).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hw/kernel.h"
+#include "memif/cache.h"
+#include "memif/host_bus.h"
+#include "memif/memory_controller.h"
+#include "memif/routing.h"
+
+namespace saarcor::memif {
+
+struct MemorySystemConfig {
+  int pipelines = 1;  // DynRTPs sharing the controller (D44)
+  CacheConfig node_cache{};
+  CacheConfig list_cache{};
+  CacheConfig row_cache{};
+  MemoryControllerConfig controller{};
+  int responses_per_cycle = 1;  // labelled broadcast width of the simple routing
+  HostBusConfig host{};
+};
+
+class MemorySystem {
+ public:
+  // Names: "mi.ctrl", "mi.routing", "mi.host", "dynrtp<p>.<type>_cache", "dynrtp<p>.shading",
+  // "dynrtp<p>.frame". Throws std::runtime_error for a bad configuration.
+  MemorySystem(hw::Kernel& kernel, MemoryImage& image, const MemorySystemConfig& config = {});
+
+  Cache& cache(int pipeline, ItemType type);
+  MemoryController::Port& shading_port(int pipeline);
+  MemoryController::Port& frame_port(int pipeline);
+  std::uint16_t shading_client(int pipeline) const;
+  std::uint16_t frame_client(int pipeline) const;
+  MemoryController& controller() { return *controller_; }
+  SimpleRouting& routing() { return *routing_; }
+  HostBus& host() { return *host_; }
+  int pipelines() const { return config_.pipelines; }
+
+  // No miss outstanding, nothing queued in the controller or in any memif channel (responses
+  // included: a response the unit has not popped yet counts as work), nothing left to upload.
+  bool idle() const;
+  // Invalidates every cache (frame start, after an upload; D20).
+  void invalidate_caches();
+  // Bandwidth report: one line per client, "name bytes MB/s", at the modelled clock over
+  // `cycles` cycles.
+  std::string bandwidth_report(std::uint64_t cycles) const;
+
+ private:
+  struct Pipeline {
+    std::unique_ptr<Cache> caches[kItemTypes];
+    MemoryController::Port* shading = nullptr;
+    MemoryController::Port* frame = nullptr;
+    std::uint16_t shading_client = 0, frame_client = 0;
+  };
+  const Pipeline& at(int p) const;
+
+  MemorySystemConfig config_;
+  std::unique_ptr<MemoryController> controller_;
+  std::unique_ptr<SimpleRouting> routing_;
+  std::unique_ptr<HostBus> host_;
+  std::vector<Pipeline> pipes_;
+};
+
+}  // namespace saarcor::memif

@@ -1,0 +1,55 @@
+// Simple routing (paper section 3: "acts like a multiplexer for memory requests and uses a
+// labeled broadcast for memory responses" [SWS02]; DESIGN.md section 6; DIGEST D23).
+//
+// Requests: one per cycle from the clients (every cache of every DynRTP) to the controller port,
+// chosen round-robin among the clients that have one (fair: a client waits at most one turn of
+// the others). Responses: up to `responses_per_cycle` per cycle from the controller port, each
+// delivered to the client named by its label (MemResponse::client); a client whose fill channel
+// is full holds the broadcast (head-of-line), as a shared bus would.
+// Latency: one cycle each way in the routing's channels (the client's request channel and its
+// fill channel, both latency 1), plus one each way in the controller's port channels.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hw/kernel.h"
+#include "memif/memory_controller.h"
+#include "memif/request.h"
+
+namespace saarcor::memif {
+
+class SimpleRouting : public hw::Module {
+ public:
+  SimpleRouting(hw::Kernel& kernel, std::string name, MemoryController::Port& port,
+                int responses_per_cycle = 1);
+
+  // Set-up: a client (named by its controller client id) whose requests the routing takes from
+  // `requests` and whose responses it pushes into `fills`.
+  void add_client(std::uint16_t client, hw::Channel<MemRequest>& requests,
+                  hw::Channel<MemResponse>& fills);
+
+  int evaluate() override;
+  void commit() override { rr_.commit(); }
+  std::uint64_t next_wakeup(std::uint64_t) const override { return hw::kNever; }
+  std::string dump_state() const override;
+
+ private:
+  struct Client {
+    std::uint16_t id;
+    hw::Channel<MemRequest>* requests;
+    hw::Channel<MemResponse>* fills;
+  };
+  int broadcast();
+  int arbitrate();
+
+  MemoryController::Port& port_;
+  int responses_per_cycle_;
+  std::vector<Client> clients_;
+  std::vector<int> by_id_;  // controller client id -> index in clients_, -1 if not ours
+  hw::Reg<int> rr_{0};      // next client to be offered the request bus
+  hw::Counter* forwarded_;
+};
+
+}  // namespace saarcor::memif
