@@ -85,8 +85,8 @@ struct TraversalLane {
 };
 
 template <class F>
-inline TraversalLane<F> traversal_lane(const ff::FpUnit<F>& fp, F split, F o_axis, F d_axis,
-                                       F tn, F tf) {
+inline TraversalLane<F> traversal_lane(const ff::FpUnit<F>& fp, F split, F o_axis, F d_axis, F tn,
+                                       F tf) {
   const F d = fp.div(fp.sub(split, o_axis), d_axis);
   const bool before = fp.lt(d, tn);  // plane before the segment: far side only
   const bool after = fp.lt(tf, d);   // plane beyond the segment: near side only

@@ -10,7 +10,9 @@ namespace {
 
 using F = ff::fp24;
 
-F f(double v) { return F::from_double(v); }
+F f(double v) {
+  return F::from_double(v);
+}
 
 TEST(TransformStep, OpOrderIsM0XPlusM1YThenM2ZPlusT) {
   ff::OpCounts ops;
@@ -25,7 +27,7 @@ TEST(TransformStep, OpOrderIsM0XPlusM1YThenM2ZPlusT) {
   const Vec3<F> v{f(1), f(1), f(1)};
   const Vec3<F> o = transform_step(fp, m, v, true);
   EXPECT_EQ(o[0].bits, f(1).bits);
-  EXPECT_EQ(o[1].bits, f(14).bits);    // (2 + 3) + (4 + 5)
+  EXPECT_EQ(o[1].bits, f(14).bits);     // (2 + 3) + (4 + 5)
   EXPECT_EQ(o[2].bits, f(-8.25).bits);  // (0.5 - 1) + (0.25 - 8)
   EXPECT_EQ(ops.mul, 9u);
   EXPECT_EQ(ops.add, 9u);
@@ -83,7 +85,7 @@ TEST(ClipFace, EntryRaisesStartExitLowersEnd) {
   ff::OpCounts ops;
   ff::FpUnit<F> fp({}, &ops);
   F tn = f(0), tf = F::infinity();
-  clip_face(fp, f(1), f(-1), f(2), true, tn, tf);  // (1 - -1) / 2 = 1
+  clip_face(fp, f(1), f(-1), f(2), true, tn, tf);   // (1 - -1) / 2 = 1
   clip_face(fp, f(5), f(-1), f(2), false, tn, tf);  // (5 + 1) / 2 = 3
   EXPECT_EQ(tn.bits, f(1).bits);
   EXPECT_EQ(tf.bits, f(3).bits);
@@ -125,7 +127,8 @@ TEST(Intersection, HitMissEdge) {
   EXPECT_TRUE(
       intersect_unit_triangle(fp, unit_ray(0.5, 0.5 + std::ldexp(1.0, -17), 1, 0, 0, -1)).inside);
   // u one ulp below zero.
-  EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(-std::ldexp(1.0, -30), 0.5, 1, 0, 0, -1)).inside);
+  EXPECT_FALSE(
+      intersect_unit_triangle(fp, unit_ray(-std::ldexp(1.0, -30), 0.5, 1, 0, 0, -1)).inside);
   // Behind the origin (t = -1), parallel (D'z = 0), and t = 0 are misses.
   EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(0.25, 0.25, -1, 0, 0, -1)).inside);
   EXPECT_FALSE(intersect_unit_triangle(fp, unit_ray(0.25, 0.25, 1, 0, 0, 0)).inside);
@@ -142,9 +145,9 @@ TEST(Intersection, TieRuleSmallerInstanceThenTriangle) {
   best.t = f(1);
   best.instance = 5;
   best.triangle = 9;
-  EXPECT_TRUE(accepts(c, 4, 100, best));   // equal t, smaller instance
-  EXPECT_TRUE(accepts(c, 5, 8, best));     // equal t, same instance, smaller triangle
-  EXPECT_FALSE(accepts(c, 5, 9, best));    // the same triangle again changes nothing
+  EXPECT_TRUE(accepts(c, 4, 100, best));  // equal t, smaller instance
+  EXPECT_TRUE(accepts(c, 5, 8, best));    // equal t, same instance, smaller triangle
+  EXPECT_FALSE(accepts(c, 5, 9, best));   // the same triangle again changes nothing
   EXPECT_FALSE(accepts(c, 5, 10, best));
   EXPECT_FALSE(accepts(c, 6, 0, best));
   best.t = F::from_bits(f(1).bits + 1);  // one ulp further: any instance wins

@@ -18,7 +18,8 @@ PacketTiling packet_tiling(int width, int height, int packet) {
     throw std::runtime_error("functional model: resolution " + std::to_string(width) + "x" +
                              std::to_string(height) + " is empty");
   int log2p = 0;
-  while ((1 << log2p) < packet) ++log2p;
+  while ((1 << log2p) < packet)
+    ++log2p;
   PacketTiling t;
   t.tile_width = 1 << ((log2p + 1) / 2);
   t.tile_height = packet / t.tile_width;
@@ -27,8 +28,7 @@ PacketTiling packet_tiling(int width, int height, int packet) {
   return t;
 }
 
-std::vector<std::uint32_t> packet_pixels(const PacketTiling& t, int width, int height,
-                                         int index) {
+std::vector<std::uint32_t> packet_pixels(const PacketTiling& t, int width, int height, int index) {
   std::vector<std::uint32_t> px(static_cast<std::size_t>(t.tile_width * t.tile_height),
                                 memif::kNone);
   const int x0 = (index % t.tiles_x) * t.tile_width;
@@ -74,8 +74,8 @@ void collect(FunctionalFrame& frame, const PipelineUnits<F>& u, FrameSink& sink)
   frame.rgb.resize(sink.pixels.size() * 3u);
   for (std::size_t i = 0; i < sink.pixels.size(); ++i)
     for (std::size_t k = 0; k < 3; ++k)
-      frame.rgb[3u * i + k] =
-          static_cast<std::uint8_t>(std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
+      frame.rgb[3u * i + k] = static_cast<std::uint8_t>(
+          std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
   frame.pixels = std::move(sink.pixels);
 }
 
@@ -85,21 +85,36 @@ decltype(auto) with_format(const ff::Format& f, Fn&& fn) {
   if (f.exp_bits == 8 && f.man_bits == 23) return fn(ff::Float<8, 23>{});
   if (f.exp_bits == 7) {
     switch (f.man_bits) {
-      case 10: return fn(ff::Float<7, 10>{});
-      case 11: return fn(ff::Float<7, 11>{});
-      case 12: return fn(ff::Float<7, 12>{});
-      case 13: return fn(ff::Float<7, 13>{});
-      case 14: return fn(ff::Float<7, 14>{});
-      case 15: return fn(ff::Float<7, 15>{});
-      case 16: return fn(ff::Float<7, 16>{});
-      case 17: return fn(ff::Float<7, 17>{});
-      case 18: return fn(ff::Float<7, 18>{});
-      case 19: return fn(ff::Float<7, 19>{});
-      case 20: return fn(ff::Float<7, 20>{});
-      case 21: return fn(ff::Float<7, 21>{});
-      case 22: return fn(ff::Float<7, 22>{});
-      case 23: return fn(ff::Float<7, 23>{});
-      default: break;
+      case 10:
+        return fn(ff::Float<7, 10>{});
+      case 11:
+        return fn(ff::Float<7, 11>{});
+      case 12:
+        return fn(ff::Float<7, 12>{});
+      case 13:
+        return fn(ff::Float<7, 13>{});
+      case 14:
+        return fn(ff::Float<7, 14>{});
+      case 15:
+        return fn(ff::Float<7, 15>{});
+      case 16:
+        return fn(ff::Float<7, 16>{});
+      case 17:
+        return fn(ff::Float<7, 17>{});
+      case 18:
+        return fn(ff::Float<7, 18>{});
+      case 19:
+        return fn(ff::Float<7, 19>{});
+      case 20:
+        return fn(ff::Float<7, 20>{});
+      case 21:
+        return fn(ff::Float<7, 21>{});
+      case 22:
+        return fn(ff::Float<7, 22>{});
+      case 23:
+        return fn(ff::Float<7, 23>{});
+      default:
+        break;
     }
   }
   throw std::runtime_error("functional model: float format " + ff::format_name(f) +
@@ -136,16 +151,14 @@ FunctionalFrame run_functional(const memif::MemoryImage& image, const Functional
   collect(frame, units, sink);
   frame.units.requests = requests;
   frame.units.packets = static_cast<std::uint64_t>(total);
-  frame.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  frame.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return frame;
 }
 
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
                                const ProgressFn& progress) {
-  return with_format(image.format(), [&](auto f) {
-    return run_functional<decltype(f)>(image, params, progress);
-  });
+  return with_format(image.format(),
+                     [&](auto f) { return run_functional<decltype(f)>(image, params, progress); });
 }
 
 PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& params, int x,
@@ -176,8 +189,8 @@ PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& 
       trace.log.emplace_back(line);
       thread.execute();
     }
-    const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
-                          static_cast<std::size_t>(x);
+    const std::size_t i =
+        static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
     trace.pixel = sink.pixels[i];
     for (std::size_t k = 0; k < 3; ++k)
       trace.rgb[k] = static_cast<std::uint8_t>(
@@ -186,8 +199,8 @@ PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& 
   });
 }
 
-#define SAARCOR_INSTANTIATE(E, M)                                                           \
-  template FunctionalFrame run_functional<ff::Float<E, M>>(                                 \
+#define SAARCOR_INSTANTIATE(E, M)                           \
+  template FunctionalFrame run_functional<ff::Float<E, M>>( \
       const memif::MemoryImage&, const FunctionalParams&, const ProgressFn&);
 SAARCOR_INSTANTIATE(7, 10)
 SAARCOR_INSTANTIATE(7, 11)

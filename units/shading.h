@@ -17,8 +17,12 @@ namespace saarcor::units {
 
 using Rgb8 = std::array<std::uint32_t, 3>;
 
-inline Rgb8 unpack_rgb(std::uint32_t w) { return {w & 255u, (w >> 8) & 255u, (w >> 16) & 255u}; }
-inline std::uint32_t mul8(std::uint32_t a, std::uint32_t b) { return (a * b + 127u) / 255u; }
+inline Rgb8 unpack_rgb(std::uint32_t w) {
+  return {w & 255u, (w >> 8) & 255u, (w >> 16) & 255u};
+}
+inline std::uint32_t mul8(std::uint32_t a, std::uint32_t b) {
+  return (a * b + 127u) / 255u;
+}
 
 // Float to unsigned fixed point with `frac_bits` fraction bits, clamped to [0, 1]: a shifter on
 // the encoding in hardware, exact here (docs/shading.md: fix8, fix16). NaN gives 0.
@@ -43,14 +47,16 @@ inline memif::ShadingRecord read_shading_record(const memif::MemoryImage& image,
   const auto& regs = image.registers();
   const std::uint32_t a = regs.shading_record_base + memif::kShadingRecordWords * record;
   std::array<std::uint32_t, 4> w{};
-  for (std::uint32_t i = 0; i < 4; ++i) w[i] = image.word(memif::kShadingBank, a + i);
+  for (std::uint32_t i = 0; i < 4; ++i)
+    w[i] = image.word(memif::kShadingBank, a + i);
   return memif::decode_shading(w.data());
 }
 inline memif::MaterialRecord read_material(const memif::MemoryImage& image,
                                            std::uint32_t material) {
   const std::uint32_t a = image.registers().material_base + memif::kMaterialWords * material;
   std::array<std::uint32_t, 4> w{};
-  for (std::uint32_t i = 0; i < 4; ++i) w[i] = image.word(memif::kShadingBank, a + i);
+  for (std::uint32_t i = 0; i < 4; ++i)
+    w[i] = image.word(memif::kShadingBank, a + i);
   return memif::decode_material(w.data());
 }
 
@@ -105,7 +111,8 @@ inline Rgb8 base_colour(const memif::MemoryImage& image, const memif::ShadingRec
 // p = 256, then `shininess` times p = (p*ws + 128) >> 8 (docs/shading.md section 6.6).
 inline std::uint32_t specular_power(std::uint32_t ws, std::uint32_t shininess) {
   std::uint32_t p = 256;
-  for (std::uint32_t i = 0; i < shininess && p != 0; ++i) p = (p * ws + 128u) >> 8;
+  for (std::uint32_t i = 0; i < shininess && p != 0; ++i)
+    p = (p * ws + 128u) >> 8;
   return p;
 }
 

@@ -25,16 +25,16 @@ namespace saarcor::units {
 inline constexpr int kMaxPacket = 64;  // lane masks are 64-bit
 
 struct FunctionalParams {
-  int packet = 4;          // P rays per packet (thread); a power of two, 1..64
-  int stack_depth = 64;    // traversal stack entries per packet (D26)
-  int mailbox = 8;         // object mailbox entries per thread (D28), 0 = off
-  int triangle_mailbox = 0;  // triangle mailbox entries (D28 option), 0 = off
+  int packet = 4;             // P rays per packet (thread); a power of two, 1..64
+  int stack_depth = 64;       // traversal stack entries per packet (D26)
+  int mailbox = 8;            // object mailbox entries per thread (D28), 0 = off
+  int triangle_mailbox = 0;   // triangle mailbox entries (D28 option), 0 = off
   bool shared_origin = true;  // the n+1 rule for packets with one origin (D31)
-  bool shade = true;        // run the RGS; false leaves the image black (hit records only)
-  bool shadows = false;     // shadow rays (docs/shading.md 6.4); Table 3 setting: off
-  bool secondary = false;   // reflection and transparency rays; Table 3 setting: off
-  int max_depth = -1;       // secondary-ray depth bound, -1 = FrameRegisters::max_depth
-  ff::Mode mode{};          // rounding of every FP unit
+  bool shade = true;          // run the RGS; false leaves the image black (hit records only)
+  bool shadows = false;       // shadow rays (docs/shading.md 6.4); Table 3 setting: off
+  bool secondary = false;     // reflection and transparency rays; Table 3 setting: off
+  int max_depth = -1;         // secondary-ray depth bound, -1 = FrameRegisters::max_depth
+  ff::Mode mode{};            // rounding of every FP unit
 };
 
 // Work counted per ray (DESIGN.md section 5; issue 4).
@@ -72,8 +72,8 @@ enum class UnitId : std::uint8_t {
   kNone,
 };
 inline const char* unit_name(UnitId u) {
-  constexpr const char* kNames[] = {"rgs", "transformation", "traversal", "list", "intersection",
-                                    "none"};
+  constexpr const char* kNames[] = {"rgs",  "transformation", "traversal",
+                                    "list", "intersection",   "none"};
   return kNames[static_cast<int>(u)];
 }
 
@@ -94,9 +94,9 @@ enum class Phase : std::uint8_t {
 };
 inline const char* phase_name(Phase p) {
   constexpr const char* kNames[] = {
-      "generate",           "clip_top",  "traverse",      "list",         "transform_object",
-      "clip_bottom",        "transform_triangle", "intersect", "shade_surface", "shade_light",
-      "shade_shadow",       "done"};
+      "generate",         "clip_top",    "traverse",           "list",
+      "transform_object", "clip_bottom", "transform_triangle", "intersect",
+      "shade_surface",    "shade_light", "shade_shadow",       "done"};
   return kNames[static_cast<int>(p)];
 }
 inline UnitId phase_unit(Phase p) {
@@ -130,7 +130,7 @@ struct Request {
   Phase phase = Phase::kDone;
   std::uint32_t item = memif::kNone;  // kTraverse: node; kList: list entry; kTransform*: first
                                       // matrix row; kClip*: face 0..5; otherwise kNone
-  int steps = 0;  // transformation steps (n+1 or 2n), intersection cycles (P), else 1
+  int steps = 0;           // transformation steps (n+1 or 2n), intersection cycles (P), else 1
   std::uint64_t mask = 0;  // the rays concerned
 };
 
@@ -157,8 +157,8 @@ class PipelineUnits {
   std::uint64_t list_steps = 0;            // list entries fetched
   std::uint64_t transformation_steps = 0;  // ray transformation steps (generation, object, tri)
   std::uint64_t shading_transformation_steps = 0;  // normal and dot-product steps of the RGS
-  std::uint64_t intersection_packets = 0;  // packets intersected (P rays each)
-  std::uint64_t sub_packets = 0;           // masked sub-packets from mixed direction signs (D27)
+  std::uint64_t intersection_packets = 0;          // packets intersected (P rays each)
+  std::uint64_t sub_packets = 0;  // masked sub-packets from mixed direction signs (D27)
 };
 
 // Where a thread's results go: the frame the RGC hands pixels from.
@@ -203,8 +203,8 @@ class ThreadProgram {
         tri_mailbox_(params.triangle_mailbox) {
     if (!(F::kFormat == image.format()))
       throw std::runtime_error("functional model: the image's float format " +
-                               ff::format_name(image.format()) +
-                               " does not match the model's " + ff::format_name(F::kFormat));
+                               ff::format_name(image.format()) + " does not match the model's " +
+                               ff::format_name(F::kFormat));
     if (p_ < 1 || p_ > kMaxPacket || (p_ & (p_ - 1)) != 0)
       throw std::runtime_error("functional model: packet width " + std::to_string(p_) +
                                " is not a power of two in 1..64");
@@ -216,8 +216,8 @@ class ThreadProgram {
     stack_mask_.reserve(static_cast<std::size_t>(params.stack_depth));
     stack_t_.reserve(static_cast<std::size_t>(params.stack_depth) * 2u * lanes_.size());
     const auto& regs = image.registers();
-    max_depth_ = params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth)
-                                       : regs.max_depth;
+    max_depth_ =
+        params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth) : regs.max_depth;
     for (int i = 0; i < 3; ++i) {
       cam_[i] = {F::from_bits(regs.cam_r[i]), F::from_bits(regs.cam_u[i]),
                  F::from_bits(regs.cam_d[i]), F::from_bits(regs.cam_p[i])};
@@ -371,9 +371,9 @@ class ThreadProgram {
     std::uint32_t pixel = memif::kNone;
     std::uint32_t weight = 0;
     Ray<F> world, current, tri;
-    F tn{}, tf{};          // segment of the node being visited
+    F tn{}, tf{};            // segment of the node being visited
     F clip_tn{}, clip_tf{};  // the level's clipped segment (restart of a sign group)
-    HitRecord<F> hit;      // hit.t = t_best (starts at the ray's t_max)
+    HitRecord<F> hit;        // hit.t = t_best (starts at the ray's t_max)
     RayCounters counters;
   };
 
@@ -671,7 +671,8 @@ class ThreadProgram {
       n_groups_ = top_n_groups_;
       group_ = top_group_;
       stack_base_ = top_stack_base_;
-      for (int i = 0; i < p_; ++i) lane(i).current = lane(i).world;
+      for (int i = 0; i < p_; ++i)
+        lane(i).current = lane(i).world;
       return list_continue();
     }
     phase_ = kind_ == RayKind::kShadow ? Phase::kShadeShadow : Phase::kShadeSurface;
@@ -745,9 +746,9 @@ class ThreadProgram {
   }
 
   void do_transform_triangle() {
-    transform_lanes(read_matrix<F>(image_, header_.triangle_row_base +
-                                               memif::kTriangleRows * triangle_),
-                    &Lane::current, &Lane::tri);
+    transform_lanes(
+        read_matrix<F>(image_, header_.triangle_row_base + memif::kTriangleRows * triangle_),
+        &Lane::current, &Lane::tri);
     phase_ = Phase::kIntersect;
   }
 
@@ -794,7 +795,8 @@ class ThreadProgram {
 
   void add_colour(std::uint32_t pixel, std::uint32_t weight, const Rgb8& c) {
     auto& s = sink_.colour_sum[pixel];
-    for (int k = 0; k < 3; ++k) s[static_cast<std::size_t>(k)] += weight * c[k];
+    for (int k = 0; k < 3; ++k)
+      s[static_cast<std::size_t>(k)] += weight * c[k];
   }
 
   void account_counters() {
@@ -829,14 +831,16 @@ class ThreadProgram {
       const std::uint32_t irow = regs.instance_row_base + memif::kInstanceRows * s.rec.instance;
       const memif::InstanceHeader h = image_.instance_header(s.rec.instance);
       // World normal (D19): the triangle's unit normal (row 2 of T_delta) through M^T.
-      const auto nrow = read_row<F>(image_, h.triangle_row_base +
-                                                memif::kTriangleRows * s.rec.triangle + 2);
+      const auto nrow =
+          read_row<F>(image_, h.triangle_row_base + memif::kTriangleRows * s.rec.triangle + 2);
       const Mat34<F> m = read_matrix<F>(image_, irow);
       Mat34<F> mt{};
-      for (int r = 0; r < 3; ++r) mt[r] = {m[0][r], m[1][r], m[2][r], F::zero()};
+      for (int r = 0; r < 3; ++r)
+        mt[r] = {m[0][r], m[1][r], m[2][r], F::zero()};
       s.n = transform_step(ft, mt, Vec3<F>{nrow[0], nrow[1], nrow[2]}, false);
       if (is_pos_nonzero(s.rec.c))
-        for (auto& x : s.n) x = x.neg();
+        for (auto& x : s.n)
+          x = x.neg();
       s.nn = dot_step(ft, s.n, s.n);
       u_.shading_transformation_steps += 1;  // normal step; the dots count below
       const memif::ShadingRecord rec = read_shading_record(image_, h.shading_base + s.rec.triangle);
@@ -857,7 +861,8 @@ class ThreadProgram {
         s.rr = dot_step(ft, s.r, s.r);
         u_.shading_transformation_steps += 1;
       }
-      for (int k = 0; k < 3; ++k) s.acc[static_cast<std::size_t>(k)] = mul8(s.base[k], ambient[k]);
+      for (int k = 0; k < 3; ++k)
+        s.acc[static_cast<std::size_t>(k)] = mul8(s.base[k], ambient[k]);
     }
     light_ = 0;
     next_light();
@@ -866,7 +871,8 @@ class ThreadProgram {
   // T_R = [D, N, D; O] (paper 2.2.2 with the erratum: translation O).
   static Mat34<F> reflect_matrix(const Ray<F>& ray, const Vec3<F>& n) {
     Mat34<F> t{};
-    for (int r = 0; r < 3; ++r) t[r] = {ray.d[r], n[r], ray.d[r], ray.o[r]};
+    for (int r = 0; r < 3; ++r)
+      t[r] = {ray.d[r], n[r], ray.d[r], ray.o[r]};
     return t;
   }
 
@@ -894,7 +900,8 @@ class ThreadProgram {
     for (int i = 0; i < p_; ++i) {
       const Surface& s = surf_[static_cast<std::size_t>(i)];
       GenLane& g = pk.lanes[static_cast<std::size_t>(i)];
-      for (int r = 0; r < 3; ++r) g.t[r] = {pos[r], s.ray.o[r], s.ray.d[r], F::zero()};
+      for (int r = 0; r < 3; ++r)
+        g.t[r] = {pos[r], s.ray.o[r], s.ray.d[r], F::zero()};
       g.ro = {F::one(), F::zero(), F::zero()};
       g.rd = {F::one().neg(), F::one(), s.rec.t};
       g.valid = s.hit;
@@ -937,10 +944,12 @@ class ThreadProgram {
     }
     u_.shading_transformation_steps += 1;
     if (!params_.shadows || trace == 0) {
-      for (int i = 0; i < p_; ++i) lane(i).valid = false;
+      for (int i = 0; i < p_; ++i)
+        lane(i).valid = false;
       return accumulate_light();
     }
-    for (int i = 0; i < p_; ++i) lane(i).valid = has(trace, i);
+    for (int i = 0; i < p_; ++i)
+      lane(i).valid = has(trace, i);
     issue_rays();
   }
 
@@ -981,7 +990,8 @@ class ThreadProgram {
       const Surface& s = surf_[static_cast<std::size_t>(i)];
       if (!s.hit) continue;
       Rgb8 local{};
-      for (int k = 0; k < 3; ++k) local[k] = std::min<std::uint32_t>(255u, s.acc[k]);
+      for (int k = 0; k < 3; ++k)
+        local[k] = std::min<std::uint32_t>(255u, s.acc[k]);
       const bool spawn = params_.secondary && depth_ < max_depth_;
       const std::uint32_t kr = spawn ? s.mat.reflectivity : 0u;
       const std::uint32_t kt = spawn ? s.mat.transparency : 0u;
@@ -992,13 +1002,21 @@ class ThreadProgram {
       const Mat34<F> tr = reflect_matrix(s.ray, s.n);
       if (wr > 0) {
         GenLane& g = refl.lanes[static_cast<std::size_t>(i)];
-        g = {true, s.pixel, wr, tr, {epsilon_.neg(), F::zero(), s.rec.t},
+        g = {true,
+             s.pixel,
+             wr,
+             tr,
+             {epsilon_.neg(), F::zero(), s.rec.t},
              {F::one(), s.kk.neg(), F::zero()}};
         any_refl = true;
       }
       if (wt > 0) {
         GenLane& g = transp.lanes[static_cast<std::size_t>(i)];
-        g = {true, s.pixel, wt, tr, {epsilon_, F::zero(), s.rec.t},
+        g = {true,
+             s.pixel,
+             wt,
+             tr,
+             {epsilon_, F::zero(), s.rec.t},
              {F::one(), F::zero(), F::zero()}};
         any_transp = true;
       }
