@@ -160,15 +160,23 @@ constexpr std::uint8_t kBoth = 0;
 constexpr std::uint8_t kLeft = 1;
 constexpr std::uint8_t kRight = 2;
 
+// Neighbours of a finite binary32 value (inline: libm's nextafter is a call).
+inline float float_next_down(float f) {
+  const std::uint32_t u = std::bit_cast<std::uint32_t>(f);
+  if (f == 0.0f) return -std::numeric_limits<float>::denorm_min();
+  return std::bit_cast<float>(f > 0.0f ? u - 1u : u + 1u);
+}
+inline float float_next_up(float f) {
+  return -float_next_down(-f);
+}
+// Rounding a binary64 value outward to binary32.
 inline float float_down(double d) {
-  float f = static_cast<float>(d);
-  if (static_cast<double>(f) > d) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-  return f;
+  const float f = static_cast<float>(d);
+  return static_cast<double>(f) > d ? float_next_down(f) : f;
 }
 inline float float_up(double d) {
-  float f = static_cast<float>(d);
-  if (static_cast<double>(f) < d) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
+  const float f = static_cast<float>(d);
+  return static_cast<double>(f) < d ? float_next_up(f) : f;
 }
 
 struct Split {
@@ -198,8 +206,8 @@ class Builder {
   void make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0);
   Split find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
                    std::uint32_t n) const;
-  bool clip(std::uint32_t id, const Box& box, float lo[3], float hi[3]) const;
-  bool clip_triangle(std::uint32_t id, const Box& box, float lo[3], float hi[3]) const;
+  int clip_split(std::uint32_t id, const Box& box, int axis, float split, float llo[3],
+                 float lhi[3], float rlo[3], float rhi[3]) const;
   void add_clipped(std::uint32_t id, const float lo[3], const float hi[3], std::vector<Key>* out);
 
   const KdBuildParams& p_;
@@ -339,8 +347,8 @@ void Builder::build_boxes(std::span<const Aabb> boxes) {
 void Builder::run() {
   tree_.nodes.clear();
   tree_.items.clear();
-  tree_.nodes.reserve(std::max<std::size_t>(1, item_count_ / 2));
-  tree_.items.reserve(item_count_ * 2);
+  tree_.nodes.reserve(std::size_t{item_count_} * 2 + 1);
+  tree_.items.reserve(std::size_t{item_count_} * 3);
   tree_.nodes.emplace_back();
   if (item_count_ == 0) {
     tree_.nodes[0].leaf = true;
@@ -380,43 +388,54 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
     const double hi = box.hi[k];
     const std::uint32_t lo_o = ordered(box.lo[k]);
     const std::uint32_t hi_o = ordered(box.hi[k]);
+    // Per candidate, without the constant factors: m = aL*nL + aR*nR + nP*min(aL, aR) (the
+    // planars go to the cheaper side), with aL, aR the children's half areas. The full cost
+    // kt + ki * m / area is compared only when m beats the best so far; the empty-space bonus
+    // (possible only where one side is empty) takes the exact path.
+    const double scale = ki * inv_area;
+    double best_m =
+        std::isinf(best.cost) ? std::numeric_limits<double>::infinity() : (best.cost - kt) / scale;
     const Key* ev = ev_[k].data();
     std::uint32_t nl = 0;
     std::uint32_t nr = n;
-    std::size_t i = b[k];
+    std::uint32_t np = 0;       // planars at the current position
+    std::uint32_t pending = 0;  // starts and planars at the current position (left after it)
     const std::size_t end = e[k];
-    while (i < end) {
-      const std::uint32_t pos = key_pos(ev[i]);
-      const Key head = Key{pos} << 2;
-      std::uint32_t c_end = 0;
-      std::uint32_t c_planar = 0;
-      std::uint32_t c_start = 0;
-      while (i < end && (ev[i] >> kIdBits) == (head | kEnd)) {
-        ++c_end;
-        ++i;
-      }
-      while (i < end && (ev[i] >> kIdBits) == (head | kPlanar)) {
-        ++c_planar;
-        ++i;
-      }
-      while (i < end && (ev[i] >> kIdBits) == (head | kStart)) {
-        ++c_start;
-        ++i;
-      }
-      nr -= c_planar + c_end;
+    for (std::size_t i = b[k]; i < end; ++i) {
+      const Key key = ev[i];
+      const std::uint32_t t = key_type(key);
+      nr -= t != kStart;
+      np += t == kPlanar;
+      pending += t != kEnd;
+      const std::uint32_t pos = key_pos(key);
+      // Evaluate at the last event of a position: then nl holds the items entirely before it,
+      // nr those entirely after it, np those in it.
+      if (i + 1 < end && key_pos(ev[i + 1]) == pos) continue;
       if (pos > lo_o && pos < hi_o) {
         const double x = unordered(pos);
-        const double pl = ((x - lo) * sum + prod) * inv_area;
-        const double pr = ((hi - x) * sum + prod) * inv_area;
-        // Planar items go to the left or to the right, whichever is cheaper.
-        const std::uint32_t nl1 = nl + c_planar;
-        const std::uint32_t nr2 = nr + c_planar;
-        const double c1 = (nl1 == 0 || nr == 0 ? bonus : 1.0) * (kt + ki * (pl * nl1 + pr * nr));
-        const double c2 = (nl == 0 || nr2 == 0 ? bonus : 1.0) * (kt + ki * (pl * nl + pr * nr2));
-        if (c1 < best.cost) best = Split{c1, k, pos, true};
-        if (c2 < best.cost) best = Split{c2, k, pos, false};
+        const double al = (x - lo) * sum + prod;
+        const double ar = (hi - x) * sum + prod;
+        const double m = al * nl + ar * nr + np * std::min(al, ar);
+        if (nl == 0 || nr == 0) {
+          // One side may be empty: both planar placements with the bonus, exactly.
+          const std::uint32_t nl1 = nl + np;
+          const std::uint32_t nr2 = nr + np;
+          const double c1 = (nl1 == 0 || nr == 0 ? bonus : 1.0) *
+                            (kt + ki * (al * inv_area * nl1 + ar * inv_area * nr));
+          const double c2 = (nl == 0 || nr2 == 0 ? bonus : 1.0) *
+                            (kt + ki * (al * inv_area * nl + ar * inv_area * nr2));
+          if (c1 < best.cost || c2 < best.cost) {
+            best = c1 <= c2 ? Split{c1, k, pos, true} : Split{c2, k, pos, false};
+            best_m = (best.cost - kt) / scale;
+          }
+        } else if (m < best_m) {
+          best_m = m;
+          best = Split{kt + scale * m, k, pos, al <= ar};
+        }
       }
-      nl += c_start + c_planar;
+      nl += pending;
+      pending = 0;
+      np = 0;
     }
   }
   return best;
@@ -436,25 +455,52 @@ void Builder::make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0) {
   tree_.items.insert(tree_.items.end(), leaf_scratch_.begin(), leaf_scratch_.end());
 }
 
-bool Builder::clip(std::uint32_t id, const Box& box, float lo[3], float hi[3]) const {
-  if (triangles_) return clip_triangle(id, box, lo, hi);
-  const Aabb& a = boxes_[id];
-  for (int k = 0; k < 3; ++k) {
-    lo[k] = std::max(a.lo[k], box.lo[k]);
-    hi[k] = std::min(a.hi[k], box.hi[k]);
-    if (lo[k] > hi[k]) return false;
+// Perfect splits: the straddling item clipped to the node's box and cut by the plane; fills both
+// children's clipped bounds. Returns bit 0 when a left piece exists, bit 1 when a right one does.
+//
+// Triangles are clipped (Sutherland-Hodgman, binary64) once to the node box, then the polygon is
+// cut in two. Bounds are conservative: exact coordinates (input vertices, clip-plane coordinates,
+// interpolations between equal exact values) are taken as they are; interpolated ones are widened
+// by 2^-32 of the triangle's magnitude before rounding outward to binary32, which covers the
+// binary64 rounding. Boxes are intersected exactly.
+int Builder::clip_split(std::uint32_t id, const Box& box, int axis, float split, float llo[3],
+                        float lhi[3], float rlo[3], float rhi[3]) const {
+  Box lbox = box;
+  Box rbox = box;
+  lbox.hi[axis] = split;
+  rbox.lo[axis] = split;
+  if (!triangles_) {
+    const Aabb& a = boxes_[id];
+    int result = 3;
+    for (int k = 0; k < 3; ++k) {
+      llo[k] = std::max(a.lo[k], lbox.lo[k]);
+      lhi[k] = std::min(a.hi[k], lbox.hi[k]);
+      rlo[k] = std::max(a.lo[k], rbox.lo[k]);
+      rhi[k] = std::min(a.hi[k], rbox.hi[k]);
+      if (llo[k] > lhi[k]) result &= ~1;
+      if (rlo[k] > rhi[k]) result &= ~2;
+    }
+    return result;
   }
-  return true;
-}
-
-// The triangle clipped to the box (Sutherland-Hodgman in binary64), bounded conservatively:
-// coordinates that are exact (input vertices, clip-plane coordinates, and interpolations between
-// equal exact values) are taken as they are; interpolated ones are widened by 2^-32 of the
-// magnitude before rounding outward to binary32, which covers the binary64 rounding errors.
-bool Builder::clip_triangle(std::uint32_t id, const Box& box, float lo[3], float hi[3]) const {
   struct V {
     double x[3];
     std::uint8_t exact;  // bit k: coordinate k is exact
+  };
+  // Point on edge PQ where coordinate k equals c.
+  auto cut = [](const V& P, const V& Q, int k, double c, double dp, double dq) {
+    const double u = dp / (dp - dq);
+    V R;
+    R.exact = static_cast<std::uint8_t>(1u << k);
+    for (int j = 0; j < 3; ++j) {
+      if (j == k) {
+        R.x[j] = c;
+      } else {
+        R.x[j] = P.x[j] + u * (Q.x[j] - P.x[j]);
+        if (P.x[j] == Q.x[j] && (P.exact & Q.exact & (1u << j)))
+          R.exact |= static_cast<std::uint8_t>(1u << j);
+      }
+    }
+    return R;
   };
   V poly[2][12];
   int n = 3;
@@ -473,59 +519,65 @@ bool Builder::clip_triangle(std::uint32_t id, const Box& box, float lo[3], float
   }
   int cur = 0;
   for (int k = 0; k < 3 && n > 0; ++k) {
-    for (int s = 0; s < 2 && n > 0; ++s) {
-      const double c = s == 0 ? box.lo[k] : box.hi[k];
-      if (s == 0 ? tlo[k] >= box.lo[k] : thi[k] <= box.hi[k]) continue;  // fully inside
-      const double sign = s == 0 ? 1.0 : -1.0;
+    for (int side = 0; side < 2 && n > 0; ++side) {
+      if (side == 0 ? tlo[k] >= box.lo[k] : thi[k] <= box.hi[k]) continue;  // inside already
+      const double c = side == 0 ? box.lo[k] : box.hi[k];
+      const double sign = side == 0 ? 1.0 : -1.0;
       const V* in = poly[cur];
       V* out = poly[cur ^ 1];
       int m = 0;
       for (int i = 0; i < n; ++i) {
         const V& P = in[i];
-        const V& Q = in[(i + 1) % n];
+        const V& Q = in[i + 1 < n ? i + 1 : 0];
         const double dp = sign * (P.x[k] - c);
         const double dq = sign * (Q.x[k] - c);
         if (dp >= 0.0) out[m++] = P;
-        if ((dp < 0.0) != (dq < 0.0)) {
-          const double u = dp / (dp - dq);
-          V& R = out[m++];
-          R.exact = static_cast<std::uint8_t>(1u << k);
-          for (int j = 0; j < 3; ++j) {
-            if (j == k) {
-              R.x[j] = c;
-            } else {
-              R.x[j] = P.x[j] + u * (Q.x[j] - P.x[j]);
-              if (P.x[j] == Q.x[j] && (P.exact & Q.exact & (1u << j)))
-                R.exact |= static_cast<std::uint8_t>(1u << j);
-            }
-          }
-        }
+        if ((dp < 0.0) != (dq < 0.0)) out[m++] = cut(P, Q, k, c, dp, dq);
       }
       n = m;
       cur ^= 1;
     }
   }
-  if (n == 0) return false;
-  for (int k = 0; k < 3; ++k) {
-    double l = std::numeric_limits<double>::infinity();
-    double h = -std::numeric_limits<double>::infinity();
-    for (int i = 0; i < n; ++i) {
-      const V& v = poly[cur][i];
-      double vl = v.x[k];
-      double vh = v.x[k];
-      if (!(v.exact & (1u << k))) {
-        const double w = std::ldexp(std::max(std::fabs(tlo[k]), std::fabs(thi[k])), -32);
-        vl -= w;
-        vh += w;
-      }
-      l = std::min(l, vl);
-      h = std::max(h, vh);
+  if (n == 0) return 0;
+  // Cut the polygon at the plane; vertices on it belong to both pieces.
+  V left[12];
+  V right[12];
+  int nl = 0;
+  int nr = 0;
+  const V* pg = poly[cur];
+  const double c = split;
+  for (int i = 0; i < n; ++i) {
+    const V& P = pg[i];
+    const V& Q = pg[i + 1 < n ? i + 1 : 0];
+    const double dp = P.x[axis] - c;
+    const double dq = Q.x[axis] - c;
+    if (dp <= 0.0) left[nl++] = P;
+    if (dp >= 0.0) right[nr++] = P;
+    if ((dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0)) {
+      const V R = cut(P, Q, axis, c, dp, dq);
+      left[nl++] = R;
+      right[nr++] = R;
     }
-    lo[k] = std::max({float_down(l), box.lo[k], tlo[k]});
-    hi[k] = std::min({float_up(h), box.hi[k], thi[k]});
-    if (lo[k] > hi[k]) return false;
   }
-  return true;
+  constexpr double kWiden = 0x1p-32;
+  auto bound = [&](const V* pv, int count, const Box& b, float lo[3], float hi[3]) {
+    if (count == 0) return false;
+    for (int k = 0; k < 3; ++k) {
+      const double w = kWiden * std::max(std::fabs(tlo[k]), std::fabs(thi[k]));
+      double l = std::numeric_limits<double>::infinity();
+      double h = -std::numeric_limits<double>::infinity();
+      for (int i = 0; i < count; ++i) {
+        const bool exact = pv[i].exact & (1u << k);
+        l = std::min(l, exact ? pv[i].x[k] : pv[i].x[k] - w);
+        h = std::max(h, exact ? pv[i].x[k] : pv[i].x[k] + w);
+      }
+      lo[k] = std::max({float_down(l), b.lo[k], tlo[k]});
+      hi[k] = std::min({float_up(h), b.hi[k], thi[k]});
+      if (lo[k] > hi[k]) return false;
+    }
+    return true;
+  };
+  return (bound(left, nl, lbox, llo, lhi) ? 1 : 0) | (bound(right, nr, rbox, rlo, rhi) ? 2 : 0);
 }
 
 void Builder::add_clipped(std::uint32_t id, const float lo[3], const float hi[3],
@@ -542,39 +594,44 @@ void Builder::add_clipped(std::uint32_t id, const float lo[3], const float hi[3]
   }
 }
 
-// Writes the events of one side (those whose item has side `want`) in order, merging the sorted
-// new events of the straddling items. Returns the number written.
+// Splits one axis's sorted event list into the children's lists in one pass, merging in the
+// sorted new events of the straddling items. Returns the left count; *right_count the right one.
 std::size_t split_events(const Key* ev, std::size_t n, const std::uint8_t* side,
                          const std::vector<Key>& add_left, const std::vector<Key>& add_right,
                          Key* left, Key* right, std::size_t* right_count) {
-  // Branch-free filter: every event is written to both outputs; the cursors advance only for the
-  // item's side (straddlers advance neither).
+  constexpr Key kNone = ~Key{0};  // sentinel above every real key
+  const Key* al = add_left.data();
+  const Key* al_end = al + add_left.size();
+  const Key* ar = add_right.data();
+  const Key* ar_end = ar + add_right.size();
+  Key next_l = al < al_end ? *al : kNone;
+  Key next_r = ar < ar_end ? *ar : kNone;
   std::size_t l = 0;
   std::size_t r = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Key key = ev[i];
+    // New events that sort before this one (rare: predictable branches).
+    while (next_l < key) {
+      left[l++] = next_l;
+      next_l = ++al < al_end ? *al : kNone;
+    }
+    while (next_r < key) {
+      right[r++] = next_r;
+      next_r = ++ar < ar_end ? *ar : kNone;
+    }
+    // Branch-free filter: written to both outputs, the cursors advance only for the item's
+    // side (straddlers advance neither).
     const std::uint8_t s = side[key_id(key)];
     left[l] = key;
     right[r] = key;
     l += s & 1u;
     r += s >> 1;
   }
-  // Merge the new events from the back (the room after the filtered events is reserved).
-  auto merge_back = [](Key* a, std::size_t na, const std::vector<Key>& add) {
-    std::size_t i = na;
-    std::size_t j = add.size();
-    std::size_t w = na + add.size();
-    while (j > 0) {
-      if (i > 0 && a[i - 1] > add[j - 1]) {
-        a[--w] = a[--i];
-      } else {
-        a[--w] = add[--j];
-      }
-    }
-    return na + add.size();
-  };
-  l = merge_back(left, l, add_left);
-  *right_count = merge_back(right, r, add_right);
+  while (al < al_end)
+    left[l++] = *al++;
+  while (ar < ar_end)
+    right[r++] = *ar++;
+  *right_count = r;
   return l;
 }
 
@@ -596,40 +653,35 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
   // Classify against the stored plane (the grid value itself): ends at or before it are left,
   // starts at or after it right, planars at it go to the SAH's side, the rest straddle.
   std::uint8_t* side = side_.data();
-  both_.clear();
   std::uint32_t n_left = 0;
   std::uint32_t n_right = 0;
   {
+    // Branch-free: a start writes right or straddling, the end then marks left if it ends at or
+    // before the plane; each item is counted at its last event (end or planar).
     const Key* ev = ev_[k].data();
     const std::uint8_t planar_side = best.planar_left ? kLeft : kRight;
+    const std::size_t count = e[k] - b[k];
+    both_.resize(count);
+    std::uint32_t* both = both_.data();
+    std::size_t nb = 0;
     for (std::size_t i = b[k]; i < e[k]; ++i) {
       const Key key = ev[i];
       const std::uint32_t id = key_id(key);
       const std::uint32_t pos = key_pos(key);
-      switch (key_type(key)) {
-        case kStart:
-          if (pos >= s) {
-            side[id] = kRight;
-            ++n_right;
-          } else {
-            side[id] = kBoth;
-          }
-          break;
-        case kEnd:
-          if (pos <= s) {
-            side[id] = kLeft;
-            ++n_left;
-          } else if (side[id] == kBoth) {
-            both_.push_back(id);
-          }
-          break;
-        default: {
-          const std::uint8_t sd = pos < s ? kLeft : pos > s ? kRight : planar_side;
-          side[id] = sd;
-          (sd == kLeft ? n_left : n_right) += 1;
-        }
-      }
+      const std::uint32_t t = key_type(key);
+      const std::uint8_t cur = side[id];
+      const std::uint8_t v_start = pos >= s ? kRight : kBoth;
+      const std::uint8_t v_end = cur | (pos <= s ? kLeft : 0);
+      const std::uint8_t v_planar = pos < s ? kLeft : pos > s ? kRight : planar_side;
+      const std::uint8_t v = t == kStart ? v_start : t == kEnd ? v_end : v_planar;
+      side[id] = v;
+      const bool last = t != kStart;
+      n_left += last & (v == kLeft);
+      n_right += last & (v == kRight);
+      both[nb] = id;
+      nb += last & (v == kBoth);
     }
+    both_.resize(nb);
   }
 
   Box lbox = box;
@@ -648,13 +700,14 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     float lhi[3];
     float rlo[3];
     float rhi[3];
+    const int pieces = clip_split(id, box, k, split, llo, lhi, rlo, rhi);
     // A clipped piece that only touches the plane is left to the other side.
-    bool in_left = clip(id, lbox, llo, lhi) && llo[k] < split;
-    const bool in_right = clip(id, rbox, rlo, rhi) && rhi[k] > split;
+    bool in_left = (pieces & 1) && llo[k] < split;
+    bool in_right = (pieces & 2) && rhi[k] > split;
     if (!in_left && !in_right) {
       // Only possible through rounding on a sliver: keep the item somewhere rather than lose it.
-      in_left = clip(id, lbox, llo, lhi);
-      if (!in_left) continue;
+      in_left = (pieces & 1) != 0;
+      in_right = !in_left && (pieces & 2) != 0;
     }
     if (in_left) {
       add_clipped(id, llo, lhi, new_left_);
