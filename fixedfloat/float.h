@@ -78,27 +78,28 @@ struct OpCounts {
 template <class F>
 class FpUnit {
  public:
-  explicit FpUnit(Mode mode = {}, OpCounts* counts = nullptr) : mode_(mode), counts_(counts) {}
+  explicit FpUnit(Mode mode = {}, OpCounts* counts = nullptr)
+      : mode_(mode), rounder_(mode), counts_(counts) {}
 
   F add(F a, F b) const {
     if (counts_) ++counts_->add;
-    return F{fast::add<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
+    return F{fast::add<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_)};
   }
   F sub(F a, F b) const {
     if (counts_) ++counts_->add;
-    return F{fast::sub<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
+    return F{fast::sub<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_)};
   }
   F mul(F a, F b) const {
     if (counts_) ++counts_->mul;
-    return F{fast::mul<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
+    return F{fast::mul<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_)};
   }
   F div(F a, F b) const {
     if (counts_) ++counts_->div;
-    return F{fast::div<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
+    return F{fast::div<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_)};
   }
   F sqrt(F a) const {
     if (counts_) ++counts_->sqrt;
-    return F{fast::sqrt<F::kExpBits, F::kManBits>(a.bits, mode_)};
+    return F{fast::sqrt<F::kExpBits, F::kManBits>(a.bits, rounder_)};
   }
   bool lt(F a, F b) const {
     if (counts_) ++counts_->cmp;
@@ -131,6 +132,7 @@ class FpUnit {
 
  private:
   Mode mode_;
+  fast::Rounder<F::kExpBits, F::kManBits> rounder_;
   OpCounts* counts_;
 };
 

@@ -2,19 +2,23 @@
 // Float<E,M> and FpUnit call these; the runtime-format functions in format.h remain the general
 // path every special case falls back to.
 //
-// Method (the same as format.cpp, only with bit manipulation instead of frexp/ldexp/floor):
-//   1. decode: a normal encoding becomes its exact binary64 value by moving the exponent/mantissa
-//      fields into binary64 position and re-biasing the exponent (one shift, one add);
-//   2. the op runs once in binary64 (+, -, x, /, sqrt: correctly rounded to 53 bits);
+// Method (the same idea as format.cpp, with bit manipulation instead of frexp/ldexp/floor):
+//   1. decode: a normal encoding becomes its exact binary64 magnitude by moving the exponent and
+//      mantissa fields into binary64 position and re-biasing the exponent (one shift, one add);
+//      signs are handled on the encodings (mul/div: sign xor; add: b's sign relative to a's);
+//   2. the op runs once in binary64 (+, -, x, /, sqrt: correctly rounded to 53 bits; a product of
+//      two significands of at most 24 bits is exact);
 //   3. round: when the binary64 result lies in the target's normal exponent range, its 52-bit
 //      fraction is cut to M bits with integer arithmetic on the bit pattern. A carry out of the
 //      mantissa increments the exponent field, and a carry out of the largest finite value gives
-//      exactly the infinity encoding. Only when the discarded bits are exactly a tie (nearest
-//      even) or exactly zero (truncation) does the sign of the exact error decide, and only then
-//      is it computed (TwoSum for add, a fused remainder for div and sqrt; products of two
-//      significands of at most 24 bits are exact in binary64, so mul never needs it).
-// Zeros, subnormals, inf, NaN and results outside the normal range take the general path. The
-// MPFR tests (fixedfloat/*_test.cpp) check the whole arrangement bit for bit.
+//      exactly the infinity encoding. Nearest-even rounds the binary64 value with ties to even:
+//      double rounding is innocuous because 53 >= 2(M+1)+2 for every supported format (Figueroa
+//      1995; DESIGN.md section 3). Truncation needs the sign of the exact error only when the
+//      binary64 value lies exactly on the target grid; only then is it computed (TwoSum for add,
+//      a fused remainder for div and sqrt).
+// Zeros, subnormals, inf, NaN and results outside the normal range take the general path in
+// format.cpp (binary64 value + exact error sign, round_pack). The MPFR tests
+// (fixedfloat/*_test.cpp) check the whole arrangement bit for bit.
 #pragma once
 
 #include <bit>
@@ -43,20 +47,32 @@ struct Layout {
   static constexpr std::uint64_t kHalf = std::uint64_t{1} << (kShift - 1);
 };
 
-// True for normal encodings (exponent field neither 0 nor all ones).
+// True for normal encodings (exponent field neither 0 nor all ones): adding one to the exponent
+// field wraps the all-ones field to 0, so normal <=> (field + 1) mod 2^E >= 2, i.e. some bit of
+// (field + 1) above the lowest is set.
 template <int E, int M>
 inline bool is_normal(std::uint32_t b) {
   using L = Layout<E, M>;
-  return ((b >> M) & L::kExpMax) - 1u < L::kExpMax - 1u;
+  return ((b + (1u << M)) & ((L::kExpMax - 1u) << M)) != 0;
+}
+template <int E, int M>
+inline bool both_normal(std::uint32_t a, std::uint32_t b) {
+  return is_normal<E, M>(a) & is_normal<E, M>(b);
+}
+
+// Bit pattern of the exact binary64 magnitude of a normal encoding.
+template <int E, int M>
+inline std::uint64_t magnitude_bits(std::uint32_t b) {
+  using L = Layout<E, M>;
+  return (static_cast<std::uint64_t>(b & L::kMag) << L::kShift) + L::kRebias;
 }
 
 // Exact binary64 value of a normal encoding.
 template <int E, int M>
 inline double decode_normal(std::uint32_t b) {
   using L = Layout<E, M>;
-  const std::uint64_t mag = static_cast<std::uint64_t>(b & L::kMag) << L::kShift;
   const std::uint64_t sign = static_cast<std::uint64_t>(b & L::kSign) << (63 - E - M);
-  return std::bit_cast<double>((mag + L::kRebias) | sign);
+  return std::bit_cast<double>(magnitude_bits<E, M>(b) | sign);
 }
 
 // Exact binary64 value of any encoding (subnormals read as +-0 in flush mode).
@@ -67,38 +83,97 @@ inline double decode(std::uint32_t b, Subnormals s) {
   return ff::decode(b, Layout<E, M>::kFormat, s);
 }
 
-// Rounds v into Float<E,M>. dir_fn() returns the sign of (exact result - v); it is called only
-// when the discarded bits leave the rounding undecided, or on the general path.
-template <int E, int M, class DirFn>
-inline std::uint32_t round(double v, const Mode& mode, DirFn dir_fn) {
+// The general paths, called with the mode by value: passing a reference to a member of the
+// caller's FpUnit would let that object escape, and the compiler would then reload the unit's
+// fields on every op instead of keeping them in registers.
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t slow_add(std::uint32_t a, std::uint32_t b, Mode m) {
+  return op_add(a, b, Layout<E, M>::kFormat, m);
+}
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t slow_mul(std::uint32_t a, std::uint32_t b, Mode m) {
+  return op_mul(a, b, Layout<E, M>::kFormat, m);
+}
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t slow_div(std::uint32_t a, std::uint32_t b, Mode m) {
+  return op_div(a, b, Layout<E, M>::kFormat, m);
+}
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t slow_sqrt(std::uint32_t a, Mode m) {
+  return op_sqrt(a, Layout<E, M>::kFormat, m);
+}
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t slow_round(double v, int dir, Mode m) {
+  return round_pack(v, dir, Layout<E, M>::kFormat, m);
+}
+
+// A Mode with the constant of the common rounding case precomputed: for a binary64 magnitude |v|
+// in the target's normal range, nearest-even gives the rounded exponent|mantissa field as
+// (bits(|v|) + add + lsb) >> (52 - M), with add = half - 1 - rebias and lsb the lowest kept bit
+// (a tie then rounds to even). Double rounding (binary64, then M+1 bits) is innocuous for +, -, x,
+// /, sqrt whenever 53 >= 2(M+1)+2 (Figueroa 1995), which holds for every supported format (M <=
+// 23), so nearest-even never needs the exact error. Truncation does: a binary64 value exactly on
+// the target grid may stand for an exact result just below it.
+template <int E, int M>
+struct Rounder {
   using L = Layout<E, M>;
-  const std::uint64_t u = std::bit_cast<std::uint64_t>(v);
-  const std::uint64_t mag = u & 0x7FFF'FFFF'FFFF'FFFFull;
-  if (mag - L::kLow < L::kSpan) [[likely]] {
-    const std::uint32_t sign = static_cast<std::uint32_t>(u >> 63) << (E + M);
-    const std::uint64_t t = mag - L::kRebias;  // target exponent field | 52-bit fraction
-    const std::uint64_t low = t & L::kLowBits;
-    if (mode.rounding == Rounding::kNearestEven) {
-      if (low != L::kHalf) [[likely]]
-        return sign | static_cast<std::uint32_t>((t + L::kHalf) >> L::kShift);
-      // v is exactly halfway: the exact result's side decides, ties go to even.
-      const int d = (u >> 63) ? -dir_fn() : dir_fn();
-      const auto q = static_cast<std::uint32_t>(t >> L::kShift);
-      return sign | (q + ((d > 0 || (d == 0 && (q & 1u))) ? 1u : 0u));
-    }
-    auto q = static_cast<std::uint32_t>(t >> L::kShift);
-    if (low != 0) [[likely]]
-      return sign | q;
-    // v sits on the grid: truncation steps one down if the exact magnitude is just below it. The
-    // borrow may leave the normal range, into the largest subnormal.
-    const int d = (u >> 63) ? -dir_fn() : dir_fn();
-    if (d < 0) {
-      --q;
-      if ((q >> M) == 0 && mode.subnormals == Subnormals::kFlush) return sign;
-    }
-    return sign | q;
+  Mode mode;
+  std::uint64_t add;
+  constexpr explicit Rounder(const Mode& m) : mode(m), add(L::kHalf - 1u - L::kRebias) {}
+};
+
+// Truncation of a magnitude exactly on the grid; d is the sign of (exact magnitude - |v|). The
+// step down may leave the normal range, into the largest subnormal (flushed in flush mode).
+template <int E, int M>
+inline std::uint32_t truncate_on_grid(std::uint64_t mag, const Mode& mode, int d) {
+  using L = Layout<E, M>;
+  auto q = static_cast<std::uint32_t>((mag - L::kRebias) >> L::kShift);
+  if (d < 0) {
+    --q;
+    if ((q >> M) == 0 && mode.subnormals == Subnormals::kFlush) return 0u;
   }
-  return round_pack(v, dir_fn(), L::kFormat, mode);
+  return q;
+}
+
+// Rounds the binary64 magnitude with bit pattern `mag` into Float<E,M> and attaches `sign` (the
+// result's sign bit in encoding position). dir_fn() returns the sign of (exact magnitude - |v|);
+// it is called only for truncation of a value on the grid, or on the general path.
+template <int E, int M, class DirFn, class SlowFn>
+inline std::uint32_t round_mag(std::uint64_t mag, std::uint32_t sign, const Rounder<E, M>& r,
+                               DirFn dir_fn, SlowFn slow_fn) {
+  using L = Layout<E, M>;
+  // The kept bits (exponent and the top M fraction bits) decide the range; their constants fit in
+  // 32 bits, which keeps the common path free of 64-bit immediates.
+  const std::uint64_t kept = mag >> L::kShift;
+  if (kept - (L::kLow >> L::kShift) < (L::kSpan >> L::kShift)) [[likely]] {
+    if (r.mode.rounding == Rounding::kNearestEven) [[likely]] {
+      // A carry out of the mantissa increments the exponent field; a carry out of the largest
+      // finite value gives exactly the infinity encoding.
+      return sign | static_cast<std::uint32_t>((mag + r.add + (kept & 1u)) >> L::kShift);
+    }
+    if ((mag & L::kLowBits) != 0)
+      return sign | static_cast<std::uint32_t>((mag - L::kRebias) >> L::kShift);
+    return sign | truncate_on_grid<E, M>(mag, r.mode, dir_fn());
+  }
+  return slow_fn();
+}
+
+// round_mag with the general round_pack as the way out of the normal range.
+template <int E, int M, class DirFn>
+inline std::uint32_t round_mag(std::uint64_t mag, std::uint32_t sign, const Rounder<E, M>& r,
+                               DirFn dir_fn) {
+  return round_mag<E, M>(mag, sign, r, dir_fn, [&] {
+    const double v = std::bit_cast<double>(mag | (sign ? (std::uint64_t{1} << 63) : 0u));
+    return slow_round<E, M>(v, sign ? -dir_fn() : dir_fn(), r.mode);
+  });
+}
+
+// Splits a signed binary64 result into its magnitude bits and the encoding's sign bit.
+template <int E, int M>
+inline std::uint64_t split_sign(double v, std::uint32_t* sign) {
+  const std::uint64_t u = std::bit_cast<std::uint64_t>(v);
+  *sign = static_cast<std::uint32_t>(u >> (63 - E - M)) & Layout<E, M>::kSign;
+  return u & 0x7FFF'FFFF'FFFF'FFFFull;
 }
 
 inline int sign_of(double x) {
@@ -106,55 +181,72 @@ inline int sign_of(double x) {
 }
 
 template <int E, int M>
-inline std::uint32_t add(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  if (is_normal<E, M>(a) && is_normal<E, M>(b)) [[likely]] {
-    const double x = decode_normal<E, M>(a);
-    const double y = decode_normal<E, M>(b);
-    const double s = x + y;
-    return round<E, M>(s, m, [&] {
-      // TwoSum (Knuth): the exact error of the binary64 addition.
-      const double bb = s - x;
-      return sign_of((x - (s - bb)) + (y - bb));
-    });
+inline std::uint32_t add(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  using L = Layout<E, M>;
+  if (both_normal<E, M>(a, b)) [[likely]] {
+    // |a| + (+-|b|) with b's sign relative to a's: the sum's sign flips a's sign when negative.
+    const std::uint64_t rel = static_cast<std::uint64_t>((a ^ b) & L::kSign) << (63 - E - M);
+    const double s = std::bit_cast<double>(magnitude_bits<E, M>(a)) +
+                     std::bit_cast<double>(magnitude_bits<E, M>(b) | rel);
+    const std::uint64_t u = std::bit_cast<std::uint64_t>(s);
+    const std::uint32_t sign = (static_cast<std::uint32_t>(u >> (63 - E - M)) ^ a) & L::kSign;
+    return round_mag<E, M>(
+        u & 0x7FFF'FFFF'FFFF'FFFFull, sign, r,
+        [&] {
+          // TwoSum (Knuth): the exact error of the binary64 addition, as seen by the magnitude. The
+          // operands are decoded again here so the common path need not keep them live.
+          const double x = std::bit_cast<double>(magnitude_bits<E, M>(a));
+          const double y = std::bit_cast<double>(magnitude_bits<E, M>(b) | rel);
+          const double bb = s - x;
+          const int d = sign_of((x - (s - bb)) + (y - bb));
+          return (u >> 63) ? -d : d;
+        },
+        // Out of the normal range (overflow, cancellation to zero or below the smallest normal):
+        // the general path, which also gives exact cancellation its +0.
+        [&] { return slow_add<E, M>(a, b, r.mode); });
   }
-  return op_add(a, b, Layout<E, M>::kFormat, m);
+  return slow_add<E, M>(a, b, r.mode);
 }
 
 template <int E, int M>
-inline std::uint32_t sub(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  return add<E, M>(a, b ^ Layout<E, M>::kSign, m);
+inline std::uint32_t sub(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  return add<E, M>(a, b ^ Layout<E, M>::kSign, r);
 }
 
 template <int E, int M>
-inline std::uint32_t mul(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  if (is_normal<E, M>(a) && is_normal<E, M>(b)) [[likely]] {
-    // Two significands of at most 24 bits: the binary64 product is exact.
-    const double p = decode_normal<E, M>(a) * decode_normal<E, M>(b);
-    return round<E, M>(p, m, [] { return 0; });
+inline std::uint32_t mul(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  if (both_normal<E, M>(a, b)) [[likely]] {
+    // Two significands of at most 24 bits: the binary64 product of the magnitudes is exact.
+    const double p = std::bit_cast<double>(magnitude_bits<E, M>(a)) *
+                     std::bit_cast<double>(magnitude_bits<E, M>(b));
+    return round_mag<E, M>(std::bit_cast<std::uint64_t>(p), (a ^ b) & Layout<E, M>::kSign, r,
+                           [] { return 0; });
   }
-  return op_mul(a, b, Layout<E, M>::kFormat, m);
+  return slow_mul<E, M>(a, b, r.mode);
 }
 
 template <int E, int M>
-inline std::uint32_t div(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  if (is_normal<E, M>(a) && is_normal<E, M>(b)) [[likely]] {
-    const double x = decode_normal<E, M>(a);
-    const double y = decode_normal<E, M>(b);
+inline std::uint32_t div(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  if (both_normal<E, M>(a, b)) [[likely]] {
+    const double x = std::bit_cast<double>(magnitude_bits<E, M>(a));
+    const double y = std::bit_cast<double>(magnitude_bits<E, M>(b));
     const double q = x / y;
-    // x - q*y is exact in one fused operation; x/y - q has its sign times sign(y).
-    return round<E, M>(q, m, [&] { return sign_of(std::fma(-q, y, x)) * sign_of(y); });
+    // x - q*y is exact in one fused operation and has the sign of x/y - q (y > 0).
+    return round_mag<E, M>(std::bit_cast<std::uint64_t>(q), (a ^ b) & Layout<E, M>::kSign, r,
+                           [&] { return sign_of(std::fma(-q, y, x)); });
   }
-  return op_div(a, b, Layout<E, M>::kFormat, m);
+  return slow_div<E, M>(a, b, r.mode);
 }
 
 template <int E, int M>
-inline std::uint32_t sqrt(std::uint32_t a, const Mode& m) {
+inline std::uint32_t sqrt(std::uint32_t a, const Rounder<E, M>& r) {
   if (is_normal<E, M>(a) && !(a & Layout<E, M>::kSign)) [[likely]] {
-    const double x = decode_normal<E, M>(a);
-    const double r = std::sqrt(x);
-    return round<E, M>(r, m, [&] { return sign_of(std::fma(-r, r, x)); });
+    const double x = std::bit_cast<double>(magnitude_bits<E, M>(a));
+    const double s = std::sqrt(x);
+    return round_mag<E, M>(std::bit_cast<std::uint64_t>(s), 0u, r,
+                           [&] { return sign_of(std::fma(-s, s, x)); });
   }
-  return op_sqrt(a, Layout<E, M>::kFormat, m);
+  return slow_sqrt<E, M>(a, r.mode);
 }
 
 template <int E, int M>
@@ -188,7 +280,9 @@ inline std::uint32_t max(std::uint32_t a, std::uint32_t b, const Mode& m) {
 
 template <int E, int M>
 inline std::uint32_t from_double(double v, const Mode& m) {
-  return round<E, M>(v, m, [] { return 0; });
+  std::uint32_t sign;
+  const std::uint64_t mag = split_sign<E, M>(v, &sign);
+  return round_mag<E, M>(mag, sign, Rounder<E, M>(m), [] { return 0; });
 }
 
 }  // namespace saarcor::ff::fast
