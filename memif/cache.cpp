@@ -24,6 +24,7 @@ std::string checked(std::string name, const CacheConfig& config, int words) {
   if (config.max_targets < 1) bad("max_targets must be >= 1");
   if (config.request_capacity < 1) bad("request_capacity must be >= 1");
   if (config.memory_capacity < 1) bad("memory_capacity must be >= 1");
+  if (config.ports < 1) bad("ports must be >= 1");
   if (words > kMaxRequestWords) {
     bad("items wider than " + std::to_string(kMaxRequestWords) + " words");
   }
@@ -40,11 +41,15 @@ Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryIm
       config_(config),
       words_(image.item_words(type)),
       sets_(config.ways > 0 ? config.items / config.ways : 0),
-      requests_(kernel, this->name() + ".req", std::max(1, config.request_capacity), 1),
-      responses_(kernel, this->name() + ".resp", config.hit_latency + 2,
-                 std::max(1, config.hit_latency - 1)),
       mem_requests_(kernel, this->name() + ".mem_req", std::max(1, config.memory_capacity), 1),
       fills_(kernel, this->name() + ".fill", std::max(1, config.memory_capacity), 1) {
+  for (int p = 0; p < config.ports; ++p) {
+    const std::string suffix = config.ports == 1 ? "" : std::to_string(p);
+    requests_.push_back(std::make_unique<hw::Channel<CacheRequest>>(
+        kernel, this->name() + ".req" + suffix, config.request_capacity, 1));
+    responses_.push_back(std::make_unique<hw::Channel<CacheResponse>>(
+        kernel, this->name() + ".resp" + suffix, config.hit_latency + 2, config.hit_latency - 1));
+  }
   lines_.resize(static_cast<std::size_t>(config.items));
   mshrs_.resize(static_cast<std::size_t>(config.max_misses));
   hw::Stats& s = stats();
@@ -74,8 +79,9 @@ void Cache::invalidate() {
 }
 
 bool Cache::idle() const {
-  if (!requests_.empty() || !responses_.empty() || !mem_requests_.empty() || !fills_.empty()) {
-    return false;
+  if (!mem_requests_.empty() || !fills_.empty()) return false;
+  for (std::size_t p = 0; p < requests_.size(); ++p) {
+    if (!requests_[p]->empty() || !responses_[p]->empty()) return false;
   }
   for (const Mshr& m : mshrs_) {
     if (m.busy) return false;
@@ -95,18 +101,19 @@ int Cache::evaluate() {
 
 int Cache::deliver() {
   if (filled_.empty()) return 0;
-  if (!responses_.can_push()) {
+  const int id = filled_.front();
+  Mshr& m = mshrs_[static_cast<std::size_t>(id)];
+  hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(m.targets.front().port)];
+  if (!out.can_push()) {
     stall();
     return 0;
   }
-  const int id = filled_.front();
-  Mshr& m = mshrs_[static_cast<std::size_t>(id)];
   CacheResponse r;
   r.index = m.item;
-  r.label = m.targets.front();
+  r.label = m.targets.front().label;
   r.words = m.words;
   r.count = words_;
-  responses_.push(r);
+  out.push(r);
   m.targets.pop_front();
   if (m.targets.empty()) {
     m.busy = false;
@@ -116,8 +123,25 @@ int Cache::deliver() {
 }
 
 int Cache::lookup(bool port_free) {
-  if (!requests_.can_pop()) return 0;
-  const CacheRequest& req = requests_.peek();
+  const int ports = static_cast<int>(requests_.size());
+  int port = -1;
+  for (int k = 0; k < ports; ++k) {
+    const int p = (next_port_ + k) % ports;
+    if (requests_[static_cast<std::size_t>(p)]->can_pop()) {
+      port = p;
+      break;
+    }
+  }
+  if (port < 0) return 0;
+  hw::Channel<CacheRequest>& in = *requests_[static_cast<std::size_t>(port)];
+  hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(port)];
+  const CacheRequest& req = in.peek();
+  auto accepted = [&] {
+    if (accept_log_) accept_log_->push_back(req.index);
+    ++*requests_stat_;
+    next_port_ = (port + 1) % ports;
+    in.pop();  // last: `req` refers to the channel's slot
+  };
   const std::size_t set = req.index % static_cast<std::uint32_t>(sets_);
   const std::size_t first = set * static_cast<std::size_t>(config_.ways);
   int way = -1;
@@ -131,7 +155,7 @@ int Cache::lookup(bool port_free) {
   if (way >= 0) {
     Line& l = lines_[first + static_cast<std::size_t>(way)];
     if (l.valid) {  // hit
-      if (!port_free || !responses_.can_push()) {
+      if (!port_free || !out.can_push()) {
         stall();
         return 0;
       }
@@ -140,11 +164,10 @@ int Cache::lookup(bool port_free) {
       r.label = req.label;
       r.words = l.words;
       r.count = words_;
-      requests_.pop();
-      responses_.push(r);
+      out.push(r);
       l.lru = ++use_clock_;
       ++*hits_;
-      ++*requests_stat_;
+      accepted();
       return 1;
     }
     Mshr& m = mshrs_[static_cast<std::size_t>(l.mshr)];  // merge into the pending fill
@@ -152,11 +175,10 @@ int Cache::lookup(bool port_free) {
       stall();
       return 0;
     }
-    m.targets.push_back(req.label);
-    requests_.pop();
+    m.targets.push_back({req.label, port});
     l.lru = ++use_clock_;
     ++*merges_;
-    ++*requests_stat_;
+    accepted();
     return 1;
   }
   // Miss: needs a free MSHR and room towards memory.
@@ -194,7 +216,7 @@ int Cache::lookup(bool port_free) {
   m.filled = false;
   m.item = req.index;
   m.line = static_cast<int>(li);
-  m.targets.assign(1, req.label);
+  m.targets.assign(1, {req.label, port});
   const WordLocation loc = image_.locate(type_, req.index, 0);
   MemRequest mr;
   mr.client = client_;
@@ -203,9 +225,8 @@ int Cache::lookup(bool port_free) {
   mr.offset = loc.offset;
   mr.words = static_cast<std::uint8_t>(words_);
   mem_requests_.push(mr);
-  requests_.pop();
   ++*misses_;
-  ++*requests_stat_;
+  accepted();
   return 1;
 }
 
@@ -240,7 +261,7 @@ std::string Cache::dump_state() const {
     const Mshr& m = mshrs_[i];
     if (!m.busy) continue;
     os << "; mshr" << i << " item " << m.item << (m.filled ? " filled" : " waiting for memory")
-       << ", " << m.targets.size() << " requests (first tag " << m.targets.front().tag << ")";
+       << ", " << m.targets.size() << " requests (first tag " << m.targets.front().label.tag << ")";
   }
   return os.str();
 }

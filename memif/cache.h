@@ -8,10 +8,11 @@
 // no second memory request).
 //
 // Unit-facing interface (the narrow one; all a unit needs):
-//   requests()  unit pushes CacheRequest{index, label}. Latency 1, capacity `request_capacity`;
-//               can_push() false = back-pressure (the cache is stalled on misses).
-//   responses() unit pops CacheResponse{index, label, words, count}: one response per accepted
-//               request, exactly once, carrying the item's words as in the image.
+//   requests(p)  unit pushes CacheRequest{index, label}. Latency 1, capacity `request_capacity`;
+//                can_push() false = back-pressure (the cache is stalled on misses).
+//   responses(p) unit pops CacheResponse{index, label, words, count}: one response per accepted
+//                request of port p, exactly once, carrying the item's words as in the image.
+//   p = 0 unless the cache was built with several ports (several units sharing one cache).
 //   Timing: a hit pushed in cycle c is poppable at c + hit_latency. A miss takes the memory
 //   round trip (see docs/memif.md for the exact count with the default parameters).
 //   Ordering: hits answer in request order; a miss answers when its fill returns, so responses
@@ -30,6 +31,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,7 @@ struct CacheConfig {
   int hit_latency = 2;   // cycles from the unit's push to the response being poppable (>= 2)
   int max_misses = 8;    // outstanding misses (D20)
   int max_targets = 16;  // requests waiting on one miss (the first included)
+  int ports = 1;         // request/response channel pairs (one per requesting unit)
   int request_capacity = 4;
   int memory_capacity = 2;  // capacity of the memory request and fill channels
 };
@@ -57,8 +60,15 @@ class Cache : public hw::Module {
   Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryImage& image,
         std::uint16_t client, CacheConfig config = {});
 
-  hw::Channel<CacheRequest>& requests() { return requests_; }
-  hw::Channel<CacheResponse>& responses() { return responses_; }
+  // Port p's channels (0 <= p < ports): a unit pushes requests into requests(p) and gets the
+  // answers to exactly those requests from responses(p). Several ports share the cache's one
+  // lookup and one response per cycle; among ports with a request the lookup goes round-robin.
+  hw::Channel<CacheRequest>& requests(int port = 0) {
+    return *requests_.at(static_cast<std::size_t>(port));
+  }
+  hw::Channel<CacheResponse>& responses(int port = 0) {
+    return *responses_.at(static_cast<std::size_t>(port));
+  }
   // Memory side, connected to the simple routing.
   hw::Channel<MemRequest>& memory_requests() { return mem_requests_; }
   hw::Channel<MemResponse>& fills() { return fills_; }
@@ -66,6 +76,9 @@ class Cache : public hw::Module {
   // Drops every line (between frames, after a host upload; D20). Outstanding misses still answer
   // their requests but are not kept.
   void invalidate();
+  // Test hook: appends the index of every accepted request, in acceptance order (the sequence a
+  // reference cache simulation must see). nullptr switches it off.
+  void set_accept_log(std::vector<std::uint32_t>* log) { accept_log_ = log; }
 
   int evaluate() override;
   std::string dump_state() const override;
@@ -93,7 +106,11 @@ class Cache : public hw::Module {
     bool filled = false;
     std::uint32_t item = 0;
     int line = -1;  // the line waiting for this fill; -1 once the line was reallocated
-    std::deque<Label> targets;
+    struct Target {
+      Label label;
+      int port;
+    };
+    std::deque<Target> targets;
     std::array<std::uint32_t, kMaxRequestWords> words{};
   };
 
@@ -108,14 +125,16 @@ class Cache : public hw::Module {
   CacheConfig config_;
   int words_;
   int sets_;
-  hw::Channel<CacheRequest> requests_;
-  hw::Channel<CacheResponse> responses_;
+  std::vector<std::unique_ptr<hw::Channel<CacheRequest>>> requests_;
+  std::vector<std::unique_ptr<hw::Channel<CacheResponse>>> responses_;
   hw::Channel<MemRequest> mem_requests_;
   hw::Channel<MemResponse> fills_;
   std::vector<Line> lines_;
   std::vector<Mshr> mshrs_;
   std::deque<int> filled_;  // MSHRs with data, in fill order
   std::uint64_t use_clock_ = 0;
+  int next_port_ = 0;  // round-robin among request ports
+  std::vector<std::uint32_t>* accept_log_ = nullptr;
   hw::Counter *requests_stat_, *hits_, *misses_, *merges_;
 };
 

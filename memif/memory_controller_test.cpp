@@ -128,6 +128,28 @@ TEST(MemoryController, SharedPathPaysThePenaltyWhenSwitchingBanksAndBanksOverlap
   }
 }
 
+TEST(MemoryController, ThreeSceneBanksWithoutSwitchPenaltyDeliverThreeWordsPerCycle) {
+  MemoryImage img = numbered_image();
+  hw::Kernel k;
+  MemoryControllerConfig cfg;
+  cfg.switch_penalty = 0;
+  MemoryController mc(k, "ctrl", img, cfg);
+  MemoryController::Port& port = mc.add_port("p");
+  const std::uint16_t c = mc.add_client("c");
+  std::vector<std::pair<std::uint64_t, MemRequest>> script;
+  for (int i = 0; i < 90; ++i)
+    script.push_back({0, read(c, i, 3 + i % 3, 3 * (i / 3), 3)});
+  ScriptedClient client(k, port, script);
+  const std::uint64_t cycles = k.run_to_completion([&] { return client.got.size() == 90; }, 1000);
+  // One request enters per cycle (pushed 0..89, queued 1..90, started 2..91); the last is
+  // answered at 91 + 2 + 4 and popped a cycle later: 270 words in 99 cycles.
+  EXPECT_EQ(client.got.back().first, 98u);
+  EXPECT_EQ(cycles, 99u);
+  for (int b = 3; b < 6; ++b) {
+    EXPECT_EQ(k.stats().value("ctrl.bank" + std::to_string(b) + ".busy_cycles"), 90.0);
+  }
+}
+
 TEST(MemoryController, ReorderingCutsBankSwitchesOnRandomTraffic) {
   // Several clients, random scene-bank reads; the same request stream with and without the
   // open-bank preference. Every response must carry the right words either way.

@@ -106,11 +106,8 @@ class FrameWriter : public hw::Module {
 
 struct Scenario {
   ff::Format format = ff::kFp24;
-  MemorySystemConfig mi;
+  MemorySystemConfig mi;  // a cache with n ports gets n requesters, one per port
   RequesterConfig req;
-  int requesters_per_cache = 1;  // > 1: a second requester per cache is not possible (one
-                                 // producer per channel), so this stays 1; several requesters
-                                 // come from several caches and pipelines.
 };
 
 struct Result {
@@ -124,15 +121,21 @@ Result run_scenario(const Scenario& sc, hw::KernelConfig kc, unsigned seed) {
   hw::Kernel k(kc);
   MemorySystem mi(k, img, sc.mi);
   std::vector<std::unique_ptr<Requester>> reqs;
+  std::vector<std::vector<std::uint32_t>> accepted(
+      static_cast<std::size_t>(mi.pipelines() * kItemTypes));
   for (int p = 0; p < mi.pipelines(); ++p) {
     for (int t = 0; t < kItemTypes; ++t) {
       const auto type = static_cast<ItemType>(t);
+      Cache& cache = mi.cache(p, type);
+      cache.set_accept_log(&accepted[static_cast<std::size_t>(p * kItemTypes + t)]);
       RequesterConfig rc = sc.req;
       rc.items = ref.regions().count[static_cast<std::size_t>(t)];
-      reqs.push_back(std::make_unique<Requester>(
-          k, "test.req" + std::to_string(p) + "." + item_type_name(type), mi.cache(p, type), ref,
-          static_cast<std::uint16_t>(10 * p + t), rc,
-          seed * 100 + static_cast<unsigned>(reqs.size())));
+      for (int port = 0; port < cache.config().ports; ++port) {
+        reqs.push_back(std::make_unique<Requester>(
+            k, "test.req" + std::to_string(p) + "." + item_type_name(type) + std::to_string(port),
+            cache, ref, static_cast<std::uint16_t>(100 * p + 10 * t + port), rc,
+            seed * 100 + static_cast<unsigned>(reqs.size()), port));
+      }
     }
   }
   ShadingReader shading(k, mi, ref, 300);
@@ -158,9 +161,11 @@ Result run_scenario(const Scenario& sc, hw::KernelConfig kc, unsigned seed) {
       const auto type = static_cast<ItemType>(t);
       const Cache& c = mi.cache(p, type);
       testing::ReferenceCache model(c.config().items, c.config().ways);
-      for (std::uint32_t index : reqs[static_cast<std::size_t>(p * kItemTypes + t)]->trace) {
+      const auto& seq = accepted[static_cast<std::size_t>(p * kItemTypes + t)];
+      EXPECT_EQ(seq.size(), c.requests_count());
+      EXPECT_EQ(seq.size(), static_cast<std::size_t>(sc.req.requests * c.config().ports));
+      for (std::uint32_t index : seq)
         model.access(index);
-      }
       std::printf(
           "%s: %llu requests, %llu hits, %llu merges, %llu misses (reference: %llu hits)\n",
           c.name().c_str(), static_cast<unsigned long long>(c.requests_count()),
@@ -228,6 +233,15 @@ TEST(MemorySystem, ScoreboardWithTinyDirectMappedCachesWideRowsAndNoReordering) 
   sc.req.requests = 400;
   sc.req.conflict_stride = 8;
   run_scenario(sc, {}, 3);
+}
+
+TEST(MemorySystem, ScoreboardWithSeveralUnitsSharingOneCacheThroughPorts) {
+  Scenario sc;
+  sc.mi.pipelines = 1;
+  sc.mi.row_cache.ports = 3;  // e.g. transformation, traversal (bounds) and shading helpers
+  sc.mi.node_cache.ports = 2;
+  sc.req.requests = 300;
+  run_scenario(sc, {}, 5);
 }
 
 TEST(MemorySystem, IdleSkipAndEvaluationOrderChangeNoFigure) {

@@ -42,25 +42,26 @@ struct RequesterConfig {
 class Requester : public hw::Module {
  public:
   Requester(hw::Kernel& k, std::string name, Cache& cache, const MemoryImage& reference,
-            std::uint16_t id, RequesterConfig cfg, unsigned seed)
+            std::uint16_t id, RequesterConfig cfg, unsigned seed, int port = 0)
       : hw::Module(k, std::move(name)),
         cache_(cache),
         ref_(reference),
         id_(id),
         cfg_(cfg),
-        rng_(seed) {}
+        rng_(seed),
+        port_(port) {}
 
   int evaluate() override {
     int p = 0;
-    hw::Channel<CacheResponse>& resp = cache_.responses();
+    hw::Channel<CacheResponse>& resp = cache_.responses(port_);
     if (resp.can_pop()) {
       ++p;  // the draw below changes the generator: progress, so idle skip stays exact
       if (static_cast<int>(rng_() % 4) >= cfg_.pop_stall_per_4) check(resp.pop());
     }
-    if (sent_ < cfg_.requests && now() >= next_issue_ && cache_.requests().can_push()) {
+    if (sent_ < cfg_.requests && now() >= next_issue_ && cache_.requests(port_).can_push()) {
       const std::uint32_t index = pick();
       const std::uint32_t tag = static_cast<std::uint32_t>(sent_++);
-      cache_.requests().push({index, {id_, tag}});
+      cache_.requests(port_).push({index, {id_, tag}});
       outstanding_[tag] = index;
       trace.push_back(index);
       next_issue_ = now() + 1 + rng_() % static_cast<unsigned>(cfg_.max_gap + 1);
@@ -76,7 +77,7 @@ class Requester : public hw::Module {
   }
   bool done() const { return sent_ == cfg_.requests && outstanding_.empty(); }
 
-  std::vector<std::uint32_t> trace;  // indices in the order the cache accepted them
+  std::vector<std::uint32_t> trace;  // indices in the order this requester sent them
   int answered = 0;
 
  private:
@@ -112,6 +113,7 @@ class Requester : public hw::Module {
   std::uint16_t id_;
   RequesterConfig cfg_;
   std::mt19937 rng_;
+  int port_;
   int sent_ = 0;
   std::uint64_t next_issue_ = 0;
   std::uint32_t hot_ = 0;
