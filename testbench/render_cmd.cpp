@@ -354,16 +354,20 @@ PreparedScene prepare_scene(const std::string& spec, const RenderSettings& setti
   p.scene = host::load_scene(spec);
   if (settings.time != 0.0) p.scene.set_time(settings.time);
   p.load_seconds = seconds_since(t0);
+  build_prepared_image(p, settings, format);
+  return p;
+}
+
+void build_prepared_image(PreparedScene& p, const RenderSettings& settings, ff::Format format) {
   host::ImageParams ip;
   ip.format = format;
   ip.width = settings.res.width;
   ip.height = settings.res.height;
   ip.max_depth = static_cast<std::uint32_t>(settings.depth);
-  t0 = Clock::now();
+  const auto t0 = Clock::now();
   progress("building the memory image (" + describe_format(format) + ")");
   p.built = host::build_image(p.scene, ip);
   p.build_seconds = seconds_since(t0);
-  return p;
 }
 
 FrameResult render_model(const ModelSpec& model, const PreparedScene& prep,

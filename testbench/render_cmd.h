@@ -58,6 +58,10 @@ struct PreparedScene {
 };
 PreparedScene prepare_scene(const std::string& spec, const RenderSettings& settings,
                             ff::Format format = ff::kFp24);
+// (Re)builds prepared.built from prepared.scene in `format` (the precision study builds one image
+// per format from one loaded scene).
+void build_prepared_image(PreparedScene& prepared, const RenderSettings& settings,
+                          ff::Format format);
 
 // One frame of one model: hit records (hit.instance = glTF node index, values converted exactly
 // to binary32), the shaded RGB8 image, and what it cost.

@@ -8,7 +8,9 @@
 
 #include "testbench/version.h"
 // [subcommand headers]
+#include "testbench/float_tools.h"
 #include "testbench/compare.h"
+#include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
 
 int main(int argc, char** argv) {
@@ -20,6 +22,37 @@ int main(int argc, char** argv) {
   int status = 0;
 
   // [subcommands]
+  saarcor::FloatInfoOptions float_info_opts;
+  {
+    auto* sub = app.add_subcommand("float-info", "parameters of a float format; --value rounds X");
+    sub->add_option("--format", float_info_opts.format, "eEmM, fp24, fp32, fp16")
+        ->capture_default_str();
+    sub->add_option("--value", float_info_opts.value, "a number to round into the format");
+    sub->callback([&] { status = saarcor::run_float_info(float_info_opts); });
+  }
+  saarcor::FloatCalcOptions float_calc_opts;
+  {
+    auto* sub = app.add_subcommand("float-calc", "evaluate 'OP A [B]' lines (hex) from stdin");
+    sub->add_option("--format", float_calc_opts.format, "eEmM, fp24, fp32, fp16")
+        ->capture_default_str();
+    sub->add_option("--round", float_calc_opts.round, "rne | rtz")->capture_default_str();
+    sub->add_option("--subnormals", float_calc_opts.subnormals, "flush | keep")
+        ->capture_default_str();
+    sub->callback([&] { status = saarcor::run_float_calc(float_calc_opts); });
+  }
+  saarcor::FloatGenOptions float_gen_opts;
+  {
+    auto* sub = app.add_subcommand("float-gen", "write TestFloat-style vectors 'A B RESULT'");
+    sub->add_option("op", float_gen_opts.op, "add sub mul div sqrt lt le eq min max")->required();
+    sub->add_option("--count", float_gen_opts.count, "number of vectors")->capture_default_str();
+    sub->add_option("--seed", float_gen_opts.seed, "random seed")->capture_default_str();
+    sub->add_option("--format", float_gen_opts.format, "eEmM, fp24, fp32, fp16")
+        ->capture_default_str();
+    sub->add_option("--round", float_gen_opts.round, "rne | rtz")->capture_default_str();
+    sub->add_option("--subnormals", float_gen_opts.subnormals, "flush | keep")
+        ->capture_default_str();
+    sub->callback([&] { status = saarcor::run_float_gen(float_gen_opts); });
+  }
   saarcor::RenderOptions render_opts;
   {
     auto* sub = app.add_subcommand(
@@ -38,6 +71,18 @@ int main(int argc, char** argv) {
     sub->add_flag("--shadows", render_opts.shadows, "shadow rays");
     sub->add_option("--depth", render_opts.depth, "secondary-ray depth (0 = primary only)");
     sub->callback([&] { status = saarcor::run_render(render_opts); });
+  }
+  saarcor::PrecisionOptions precision_opts;
+  {
+    auto* sub = app.add_subcommand(
+        "precision", "same-triangle share and PSNR of Float<7,m> against the float reference");
+    sub->add_option("scene", precision_opts.scene, "glTF file or builtin:NAME")->required();
+    sub->add_option("--mantissa", precision_opts.mantissa, "mantissa bits: M or A..B (10..23)")
+        ->capture_default_str();
+    sub->add_option("--res", precision_opts.res, "resolution WxH")->capture_default_str();
+    sub->add_option("--out", precision_opts.out, "output prefix (PREFIX.png plot, PREFIX.json)")
+        ->capture_default_str();
+    sub->callback([&] { status = saarcor::run_precision(precision_opts); });
   }
   saarcor::CompareOptions compare_opts;
   {
