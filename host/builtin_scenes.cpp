@@ -680,10 +680,11 @@ Scene make_dynamic() {
                          std::cos(a) * r * dir);  // velocity direction
       const double yaw = std::atan2(v.x, v.z);    // objects face +Z
       const glm::dquat q = glm::angleAxis(yaw, glm::dvec3(0.0, 1.0, 0.0));
+      // Keys are binary32 values, as a glTF file stores them: export and re-load are exact.
       tr.times.push_back(t);
-      tr.values.emplace_back(p, 0.0);
+      tr.values.emplace_back(glm::dvec4(glm::vec4(glm::dvec4(p, 0.0))));
       rot.times.push_back(t);
-      rot.values.emplace_back(q.x, q.y, q.z, q.w);
+      rot.values.emplace_back(glm::dvec4(glm::vec4(glm::dvec4(q.x, q.y, q.z, q.w))));
     }
     node.translation = glm::dvec3(tr.values[0]);
     node.rotation = glm::dquat(rot.values[0].w, rot.values[0].x, rot.values[0].y, rot.values[0].z);
@@ -733,6 +734,7 @@ Scene make_builtin_scene(const std::string& name) {
                              ")");
   }
   s.source = "builtin:" + name;
+  s.set_time(0.0);
   return s;
 }
 
