@@ -1,9 +1,10 @@
 // The DynRTC datapaths as pure functions (paper sections 2.1-2.3 and 3.1; DESIGN.md sections 5
 // and 7): the transformation step, the traversal step of one kd-node for a packet, the
 // unit-triangle intersection and its acceptance rules (DIGEST D13 plus the tie rule of
-// docs/shading.md section 3), and the slab clip of D29. Each takes the FpUnit of the hardware unit
-// that owns the operators, so ops are counted per unit. The functional model and the cycle model
-// call these same functions; nothing here keeps state, so results cannot depend on timing.
+// docs/shading.md section 3), and the slab clip of D29. Each takes the float unit (UnitFp) of the
+// hardware unit that owns the operators, so ops are counted per unit. The functional model and the
+// cycle model call these same functions; nothing here keeps state, so results cannot depend on
+// timing.
 #pragma once
 
 #include <array>
@@ -11,6 +12,7 @@
 
 #include "fixedfloat/float.h"
 #include "memif/image_format.h"
+#include "units/unit_fp.h"
 
 namespace saarcor::units {
 
@@ -51,7 +53,7 @@ inline std::uint32_t magnitude_key(F x) {
 // One step: per output component r, (m_r0*x + m_r1*y) + (m_r2*z + t_r). A direction step feeds
 // zero as the translation (the adder still runs: -0 + +0 = +0, a real datapath effect).
 template <class F>
-inline Vec3<F> transform_step(const ff::FpUnit<F>& fp, const Mat34<F>& m, const Vec3<F>& v,
+inline Vec3<F> transform_step(const UnitFp<F>& fp, const Mat34<F>& m, const Vec3<F>& v,
                               bool translate) {
   Vec3<F> out;
   for (int r = 0; r < 3; ++r) {
@@ -64,7 +66,7 @@ inline Vec3<F> transform_step(const ff::FpUnit<F>& fp, const Mat34<F>& m, const 
 
 // The dot product as one row of a zero-translation step: (a.x*b.x + a.y*b.y) + (a.z*b.z + 0).
 template <class F>
-inline F dot_step(const ff::FpUnit<F>& fp, const Vec3<F>& a, const Vec3<F>& b) {
+inline F dot_step(const UnitFp<F>& fp, const Vec3<F>& a, const Vec3<F>& b) {
   return fp.add(fp.add(fp.mul(a[0], b[0]), fp.mul(a[1], b[1])),
                 fp.add(fp.mul(a[2], b[2]), F::zero()));
 }
@@ -85,7 +87,7 @@ struct TraversalLane {
 };
 
 template <class F>
-inline TraversalLane<F> traversal_lane(const ff::FpUnit<F>& fp, F split, F o_axis, F d_axis, F tn,
+inline TraversalLane<F> traversal_lane(const UnitFp<F>& fp, F split, F o_axis, F d_axis, F tn,
                                        F tf) {
   const F d = fp.div(fp.sub(split, o_axis), d_axis);
   const bool before = fp.lt(d, tn);  // plane before the segment: far side only
@@ -102,7 +104,7 @@ inline TraversalLane<F> traversal_lane(const ff::FpUnit<F>& fp, F split, F o_axi
 // Early termination at node entry (1 cmp): a ray leaves a node whose segment starts beyond its
 // closest hit. Equal values stay (a later triangle may tie in t, docs/shading.md section 3).
 template <class F>
-inline bool terminated(const ff::FpUnit<F>& fp, F t_best, F tn) {
+inline bool terminated(const UnitFp<F>& fp, F t_best, F tn) {
   return fp.lt(t_best, tn);
 }
 
@@ -112,8 +114,7 @@ inline bool terminated(const ff::FpUnit<F>& fp, F t_best, F tn) {
 // comparator-multiplexer max/min keep the old bound on NaN (origin on a parallel face).
 // 1 add, 1 div, 1 cmp.
 template <class F>
-inline void clip_face(const ff::FpUnit<F>& fp, F plane, F o_axis, F d_axis, bool entry, F& tn,
-                      F& tf) {
+inline void clip_face(const UnitFp<F>& fp, F plane, F o_axis, F d_axis, bool entry, F& tn, F& tf) {
   const F t = fp.div(fp.sub(plane, o_axis), d_axis);
   if (entry)
     tn = fp.max(tn, t);
@@ -130,7 +131,7 @@ struct Candidate {
 
 // t = -O'z / D'z, u = O'x + t*D'x, v = O'y + t*D'y; u + v is the third adder.
 template <class F>
-inline Candidate<F> intersect_unit_triangle(const ff::FpUnit<F>& fp, const Ray<F>& r) {
+inline Candidate<F> intersect_unit_triangle(const UnitFp<F>& fp, const Ray<F>& r) {
   Candidate<F> c;
   c.c = r.d[2];
   c.t = fp.div(r.o[2].neg(), r.d[2]);

@@ -16,7 +16,7 @@ F f(double v) {
 
 TEST(TransformStep, OpOrderIsM0XPlusM1YThenM2ZPlusT) {
   ff::OpCounts ops;
-  ff::FpUnit<F> fp({}, &ops);
+  UnitFp<F> fp({}, &ops);
   const double e = std::ldexp(1.0, -17);  // half an ulp of 1.0 in fp24
   // Row 0: (1*1 + e*1) + (e*1 + 0): 1 + e ties to even (1), e + 0 = e, 1 + e -> 1 again. Any
   // other association (1 + (e + e) = 1 + 2^-16) would give the next float above 1.
@@ -41,7 +41,7 @@ TEST(TransformStep, OpOrderIsM0XPlusM1YThenM2ZPlusT) {
 
 TEST(TraversalLane, BothChildrenSplitTheSegmentAtD) {
   ff::OpCounts ops;
-  ff::FpUnit<F> fp({}, &ops);
+  UnitFp<F> fp({}, &ops);
   const TraversalLane<F> r = traversal_lane(fp, f(2), f(0), f(1), f(0), f(10));
   EXPECT_TRUE(r.go_near);
   EXPECT_TRUE(r.go_far);
@@ -53,7 +53,7 @@ TEST(TraversalLane, BothChildrenSplitTheSegmentAtD) {
 }
 
 TEST(TraversalLane, OneSideAndRounding) {
-  ff::FpUnit<F> fp;
+  UnitFp<F> fp;
   // Plane behind the segment start (d = -3 < tn): far child only.
   TraversalLane<F> r = traversal_lane(fp, f(2), f(5), f(1), f(0), f(10));
   EXPECT_FALSE(r.go_near);
@@ -83,7 +83,7 @@ TEST(TraversalLane, OneSideAndRounding) {
 
 TEST(ClipFace, EntryRaisesStartExitLowersEnd) {
   ff::OpCounts ops;
-  ff::FpUnit<F> fp({}, &ops);
+  UnitFp<F> fp({}, &ops);
   F tn = f(0), tf = F::infinity();
   clip_face(fp, f(1), f(-1), f(2), true, tn, tf);   // (1 - -1) / 2 = 1
   clip_face(fp, f(5), f(-1), f(2), false, tn, tf);  // (5 + 1) / 2 = 3
@@ -103,7 +103,7 @@ Ray<F> unit_ray(double ox, double oy, double oz, double dx, double dy, double dz
 
 TEST(Intersection, HitMissEdge) {
   ff::OpCounts ops;
-  ff::FpUnit<F> fp({}, &ops);
+  UnitFp<F> fp({}, &ops);
   Candidate<F> c = intersect_unit_triangle(fp, unit_ray(0.25, 0.125, 2, 0.5, 0.25, -4));
   // t = 2/4 = 0.5, u = 0.25 + 0.25 = 0.5, v = 0.125 + 0.125 = 0.25.
   EXPECT_TRUE(c.inside);
@@ -138,7 +138,7 @@ TEST(Intersection, HitMissEdge) {
 }
 
 TEST(Intersection, TieRuleSmallerInstanceThenTriangle) {
-  ff::FpUnit<F> fp;
+  UnitFp<F> fp;
   const Candidate<F> c = intersect_unit_triangle(fp, unit_ray(0.25, 0.25, 1, 0, 0, -1));
   HitRecord<F> best;
   EXPECT_TRUE(accepts(c, 5, 9, best));  // anything beats no hit

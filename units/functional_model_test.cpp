@@ -52,7 +52,7 @@ void expect_same_frames(const FunctionalFrame& a, const FunctionalFrame& b, bool
 
 // Every instance's every triangle, with the model's own datapath functions and no kd-tree.
 HitRecord<F> brute_force(const host::BuiltImage& b, const Ray<F>& world) {
-  ff::FpUnit<F> fp;
+  UnitFp<F> fp;
   HitRecord<F> best;
   const auto& img = b.image;
   for (std::uint32_t i = 0; i < img.registers().instance_count; ++i) {

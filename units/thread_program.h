@@ -148,7 +148,7 @@ class PipelineUnits {
   PipelineUnits& operator=(const PipelineUnits&) = delete;
 
   ff::OpCounts traversal_ops, transformation_ops, intersection_ops, rgs_ops;
-  ff::FpUnit<F> traversal, transformation, intersection, rgs;
+  UnitFp<F> traversal, transformation, intersection, rgs;
 
   // Work counted per unit, in the unit's own steps.
   std::uint64_t traversal_steps = 0;       // kd-node steps (inner + leaf + empty)
