@@ -20,6 +20,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hw/channel.h"
@@ -82,6 +83,23 @@ class Kernel {
   std::uint64_t evaluated_cycles() const { return evaluated_; }
   std::uint64_t module_evaluations() const { return evaluations_; }
 
+  // Kernel-owned construction: the object lives as long as the kernel (modules and channels may
+  // also be owned elsewhere; they register themselves either way).
+  template <class M, class... Args>
+  M& make(Args&&... args) {
+    auto m = std::make_unique<M>(*this, std::forward<Args>(args)...);
+    M& ref = *m;
+    owned_modules_.push_back(std::move(m));
+    return ref;
+  }
+  template <class T>
+  Channel<T>& make_channel(std::string name, int capacity, int latency = 1, int width = 1) {
+    auto c = std::make_unique<Channel<T>>(*this, std::move(name), capacity, latency, width);
+    Channel<T>& ref = *c;
+    owned_channels_.push_back(std::move(c));
+    return ref;
+  }
+
   const std::vector<Module*>& modules() const { return modules_; }
   const std::vector<ChannelBase*>& channels() const { return channels_; }
 
@@ -105,6 +123,9 @@ class Kernel {
   std::vector<ChannelBase*> dirty_;
   std::mt19937_64 rng_;
   std::unique_ptr<VcdTracer> tracer_;
+  // Declared last: destroyed first, while the registry they registered with still exists.
+  std::vector<std::unique_ptr<ChannelBase>> owned_channels_;
+  std::vector<std::unique_ptr<Module>> owned_modules_;
 };
 
 }  // namespace saarcor::hw

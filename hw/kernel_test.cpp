@@ -189,6 +189,33 @@ TEST(Kernel, BusyAndStallCyclesAreCountedPerModule) {
             static_cast<double>(cycles) + 1);
 }
 
+TEST(Kernel, OwnsModulesAndChannelsMadeThroughIt) {
+  Kernel k;
+  auto& a = k.make_channel<std::uint32_t>("a.ch_a", 3, 2);
+  auto& b = k.make_channel<std::uint32_t>("a.ch_b", 2, 1);
+  auto& src = k.make<testing::Source>(a, 10u);
+  auto& dbl = k.make<testing::Doubler>(a, b, src);
+  std::vector<std::uint32_t> got;
+  class Collect : public Module {
+   public:
+    Collect(Kernel& k, Channel<std::uint32_t>& in, std::vector<std::uint32_t>& out)
+        : Module(k, "collect"), in_(in), out_(out) {}
+    int evaluate() override {
+      if (!in_.can_pop()) return 0;
+      out_.push_back(in_.pop());
+      return 1;
+    }
+    Channel<std::uint32_t>& in_;
+    std::vector<std::uint32_t>& out_;
+  };
+  k.make<Collect>(b, got);
+  k.run_to_completion([&] { return got.size() == 10; }, 1000);
+  EXPECT_EQ(k.modules().size(), 3u);
+  EXPECT_EQ(k.channels().size(), 2u);
+  EXPECT_EQ(dbl.name(), "a.doubler");
+  EXPECT_EQ(got.front(), 1u * 2u + 2u);  // value 1, plus the source's committed count then
+}
+
 TEST(Kernel, ModulesWithTheDefaultWakeupAreNeverSkipped) {
   Kernel k;
   int calls = 0;

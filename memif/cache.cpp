@@ -7,10 +7,9 @@
 
 namespace saarcor::memif {
 
-namespace {
 // Checked before the module registers with the kernel (a refused configuration leaves nothing
 // behind).
-std::string checked(std::string name, const CacheConfig& config, int words) {
+std::string Cache::check(std::string name, const CacheConfig& config, int words) {
   auto bad = [&](const std::string& what) {
     throw std::runtime_error("cache '" + name + "': " + what);
   };
@@ -30,11 +29,10 @@ std::string checked(std::string name, const CacheConfig& config, int words) {
   }
   return name;
 }
-}  // namespace
 
 Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryImage& image,
              std::uint16_t client, CacheConfig config)
-    : hw::Module(kernel, checked(std::move(name), config, image.item_words(type))),
+    : hw::Module(kernel, check(std::move(name), config, image.item_words(type))),
       type_(type),
       image_(image),
       client_(client),

@@ -63,6 +63,10 @@ class Cache : public hw::Module {
   // Port p's channels (0 <= p < ports): a unit pushes requests into requests(p) and gets the
   // answers to exactly those requests from responses(p). Several ports share the cache's one
   // lookup and one response per cycle; among ports with a request the lookup goes round-robin.
+  // Throws std::runtime_error (one line naming the parameter) if the configuration is refused;
+  // returns the name. `words` = MemoryImage::item_words of the type.
+  static std::string check(std::string name, const CacheConfig& config, int words);
+
   hw::Channel<CacheRequest>& requests(int port = 0) {
     return *requests_.at(static_cast<std::size_t>(port));
   }

@@ -6,8 +6,7 @@
 
 namespace saarcor::memif {
 
-namespace {
-std::string checked(std::string name, const HostBusConfig& config) {
+std::string HostBus::check(std::string name, const HostBusConfig& config) {
   if (!(config.mb_per_s > 0) || !std::isfinite(config.mb_per_s)) {
     throw std::runtime_error("host bus '" + name + "': mb_per_s must be > 0");
   }
@@ -20,11 +19,10 @@ std::string checked(std::string name, const HostBusConfig& config) {
   }
   return name;
 }
-}  // namespace
 
 HostBus::HostBus(hw::Kernel& kernel, std::string name, MemoryController& controller,
                  HostBusConfig config)
-    : hw::Module(kernel, checked(std::move(name), config)),
+    : hw::Module(kernel, check(std::move(name), config)),
       controller_(controller),
       port_(controller.add_port(this->name())),
       client_(controller.add_client(this->name())),

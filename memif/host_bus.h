@@ -30,6 +30,9 @@ class HostBus : public hw::Module {
   HostBus(hw::Kernel& kernel, std::string name, MemoryController& controller,
           HostBusConfig config = {});
 
+  // Throws std::runtime_error (one line) if the configuration is refused; returns the name.
+  static std::string check(std::string name, const HostBusConfig& config);
+
   // Queues words for bank `bank` from word `offset` on. Throws std::runtime_error (one line) if
   // the range lies outside the bank.
   void upload(int bank, std::uint32_t offset, const std::vector<std::uint32_t>& words);

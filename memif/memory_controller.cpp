@@ -7,10 +7,9 @@
 
 namespace saarcor::memif {
 
-namespace {
 // Checked before the module registers with the kernel, so a refused configuration leaves no
 // half-built module behind.
-std::string checked(std::string name, const MemoryControllerConfig& c) {
+std::string MemoryController::check(std::string name, const MemoryControllerConfig& c) {
   auto bad = [&](const std::string& what) {
     throw std::runtime_error("memory controller '" + name + "': " + what);
   };
@@ -29,11 +28,10 @@ std::string checked(std::string name, const MemoryControllerConfig& c) {
   }
   return name;
 }
-}  // namespace
 
 MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryImage& image,
                                    MemoryControllerConfig config)
-    : hw::Module(kernel, checked(std::move(name), config)),
+    : hw::Module(kernel, check(std::move(name), config)),
       image_(image),
       config_(std::move(config)),
       banks_(kNumBanks),

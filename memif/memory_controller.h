@@ -60,6 +60,9 @@ class MemoryController : public hw::Module {
   MemoryController(hw::Kernel& kernel, std::string name, MemoryImage& image,
                    MemoryControllerConfig config = {});
 
+  // Throws std::runtime_error (one line) if the configuration is refused; returns the name.
+  static std::string check(std::string name, const MemoryControllerConfig& config);
+
   // Set-up (before the first cycle). A port is a pair of channels; a client is a name bandwidth
   // is counted under (several clients may share one port, e.g. all caches behind the routing).
   Port& add_port(const std::string& name);

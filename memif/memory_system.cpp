@@ -8,7 +8,22 @@ namespace saarcor::memif {
 
 MemorySystem::MemorySystem(hw::Kernel& kernel, MemoryImage& image, const MemorySystemConfig& config)
     : config_(config) {
+  // Everything is checked before anything registers with the kernel: a refused configuration
+  // leaves the kernel untouched.
   if (config.pipelines < 1) throw std::runtime_error("memory system: pipelines must be >= 1");
+  MemoryController::check("mi.ctrl", config.controller);
+  SimpleRouting::check("mi.routing", config.responses_per_cycle);
+  HostBus::check("mi.host", config.host);
+  for (int p = 0; p < config.pipelines; ++p) {
+    for (int t = 0; t < kItemTypes; ++t) {
+      const auto type = static_cast<ItemType>(t);
+      const CacheConfig& c = t == 0   ? config.node_cache
+                             : t == 1 ? config.list_cache
+                                      : config.row_cache;
+      Cache::check("dynrtp" + std::to_string(p) + "." + item_type_name(type) + "_cache", c,
+                   image.item_words(type));
+    }
+  }
   controller_ = std::make_unique<MemoryController>(kernel, "mi.ctrl", image, config.controller);
   MemoryController::Port& cache_port = controller_->add_port("mi.ctrl.caches");
   routing_ =

@@ -306,5 +306,32 @@ TEST(MemorySystem, BandwidthReportNamesEveryClient) {
   EXPECT_THROW(mi.cache(1, ItemType::kNode), std::out_of_range);
 }
 
+TEST(MemorySystem, BadConfigurationsAreRefused) {
+  MemoryImage img = testing::random_scene_image(ff::kFp24, 10);
+  hw::Kernel k;  // one kernel throughout: a refused configuration must leave it untouched
+  auto refused = [&](auto edit) {
+    MemorySystemConfig cfg;
+    edit(cfg);
+    try {
+      MemorySystem mi(k, img, cfg);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(refused([](MemorySystemConfig& c) { c.pipelines = 0; }),
+            "memory system: pipelines must be >= 1");
+  EXPECT_EQ(refused([](MemorySystemConfig& c) { c.responses_per_cycle = 0; }),
+            "routing 'mi.routing': responses_per_cycle must be >= 1");
+  EXPECT_EQ(refused([](MemorySystemConfig& c) { c.row_cache.ports = 0; }),
+            "cache 'dynrtp0.row_cache': ports must be >= 1");
+  EXPECT_EQ(refused([](MemorySystemConfig& c) { c.controller.queue_depth = 0; }),
+            "memory controller 'mi.ctrl': queue_depth must be >= 1");
+  EXPECT_EQ(refused([](MemorySystemConfig& c) { c.host.burst_words = 5; }),
+            "host bus 'mi.host': burst_words must be 1..4");
+  EXPECT_TRUE(k.modules().empty());
+  EXPECT_TRUE(k.channels().empty());
+}
+
 }  // namespace
 }  // namespace saarcor::memif

@@ -6,18 +6,16 @@
 
 namespace saarcor::memif {
 
-namespace {
-std::string checked(std::string name, int responses_per_cycle) {
+std::string SimpleRouting::check(std::string name, int responses_per_cycle) {
   if (responses_per_cycle < 1) {
     throw std::runtime_error("routing '" + name + "': responses_per_cycle must be >= 1");
   }
   return name;
 }
-}  // namespace
 
 SimpleRouting::SimpleRouting(hw::Kernel& kernel, std::string name, MemoryController::Port& port,
                              int responses_per_cycle)
-    : hw::Module(kernel, checked(std::move(name), responses_per_cycle)),
+    : hw::Module(kernel, check(std::move(name), responses_per_cycle)),
       port_(port),
       responses_per_cycle_(responses_per_cycle) {
   forwarded_ = &stats().counter(this->name() + ".requests", "requests",

@@ -25,6 +25,9 @@ class SimpleRouting : public hw::Module {
   SimpleRouting(hw::Kernel& kernel, std::string name, MemoryController::Port& port,
                 int responses_per_cycle = 1);
 
+  // Throws std::runtime_error (one line) if responses_per_cycle < 1; returns the name.
+  static std::string check(std::string name, int responses_per_cycle);
+
   // Set-up: a client (named by its controller client id) whose requests the routing takes from
   // `requests` and whose responses it pushes into `fills`.
   void add_client(std::uint16_t client, hw::Channel<MemRequest>& requests,
