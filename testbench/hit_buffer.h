@@ -13,10 +13,10 @@ struct PixelHit {
   float t = std::numeric_limits<float>::infinity();  // miss: +inf
   float u = 0.0f;
   float v = 0.0f;
-  float cos = 0.0f;                   // D'_z: the cosine with the geometric normal (unnormalised D)
+  float cos = 0.0f;  // D'_z: the cosine with the geometric normal (unnormalised D)
   std::uint32_t instance = 0xFFFFFFFFu;  // glTF node index (built-ins: instance index); miss: ~0
   std::uint32_t triangle = 0xFFFFFFFFu;  // index within its mesh; miss: ~0
-  float ox = 0, oy = 0, oz = 0;  // world-space primary ray
+  float ox = 0, oy = 0, oz = 0;          // world-space primary ray
   float dx = 0, dy = 0, dz = 0;
   bool hit() const { return instance != 0xFFFFFFFFu; }
   friend bool operator==(const PixelHit&, const PixelHit&) = default;
@@ -27,9 +27,7 @@ struct HitBuffer {
   int height = 0;
   std::vector<PixelHit> pixels;  // row-major, row 0 at the top
   PixelHit& at(int x, int y) { return pixels[static_cast<std::size_t>(y) * width + x]; }
-  const PixelHit& at(int x, int y) const {
-    return pixels[static_cast<std::size_t>(y) * width + x];
-  }
+  const PixelHit& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
 };
 
 // An 8-bit RGB frame (what the frame buffer holds), row 0 at the top.

@@ -337,6 +337,7 @@ PrecisionPlot plot_precision(const std::vector<PrecisionRow>& rows, const std::s
 int run_precision(const PrecisionOptions& opts) {
   RenderSettings settings;
   settings.res = parse_resolution(opts.res);
+  settings.bank_mb = opts.bank_mb;
   const auto [lo, hi] = parse_mantissa_range(opts.mantissa);
   if (opts.out.empty()) throw std::runtime_error("bad --out '': expected a file prefix");
   const std::vector<PrecisionRow> rows = run_precision_study(opts.scene, settings, lo, hi);

@@ -49,6 +49,7 @@ struct PrecisionOptions {
   std::string mantissa = "10..23";
   std::string res = "512x384";
   std::string out = "out/precision";  // PREFIX.png (plot), PREFIX.json (table)
+  double bank_mb = 4.0;
 };
 
 int run_precision(const PrecisionOptions& opts);

@@ -343,6 +343,10 @@ PreparedScene prepare_scene(const std::string& spec, const RenderSettings& setti
   if (settings.depth < 0 || settings.depth > 16) {
     throw std::runtime_error("bad --depth " + std::to_string(settings.depth) + ": expected 0..16");
   }
+  if (!(settings.bank_mb > 0.0) || settings.bank_mb > 16384.0) {
+    throw std::runtime_error("bad --bank-mb " + std::to_string(settings.bank_mb) +
+                             ": expected a size in (0, 16384] MB");
+  }
   if (!std::isfinite(settings.time) || settings.time < 0.0) {
     throw std::runtime_error("bad --time " + std::to_string(settings.time) +
                              ": expected a time >= 0 in seconds");
@@ -364,6 +368,7 @@ void build_prepared_image(PreparedScene& p, const RenderSettings& settings, ff::
   ip.width = settings.res.width;
   ip.height = settings.res.height;
   ip.max_depth = static_cast<std::uint32_t>(settings.depth);
+  ip.bank_words = static_cast<std::uint32_t>(std::llround(settings.bank_mb * 262144.0));
   const auto t0 = Clock::now();
   progress("building the memory image (" + describe_format(format) + ")");
   p.built = host::build_image(p.scene, ip);
@@ -432,6 +437,7 @@ int run_render(const RenderOptions& opts) {
   settings.time = opts.time;
   settings.shadows = opts.shadows;
   settings.depth = opts.depth;
+  settings.bank_mb = opts.bank_mb;
   std::optional<PixelCoord> pixel;
   if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
   if (opts.out.empty()) throw std::runtime_error("bad --out '': expected a file prefix");
@@ -480,6 +486,7 @@ int run_render(const RenderOptions& opts) {
                           {"depth", settings.depth},
                           {"image_format", describe_format(prep.built.params.format)},
                           {"bank_words", prep.built.params.bank_words},
+                          {"bank_mb", settings.bank_mb},
                           {"instances", prep.scene.instances.size()},
                           {"objects", prep.scene.objects.size()},
                           {"triangles_unique", prep.scene.unique_triangles()},

@@ -46,6 +46,7 @@ struct RenderSettings {
   double time = 0.0;     // seconds into the scene's animation
   bool shadows = false;  // shadow rays (docs/shading.md section 6)
   int depth = 0;         // secondary rays (reflection, transparency) up to this depth; 0 = none
+  double bank_mb = 4.0;  // SRAM bank size of the memory image (the prototype: 4 MB)
 };
 
 // The scene loaded, set to the time, with its memory image built in `format`.
@@ -96,6 +97,7 @@ struct RenderOptions {
   std::string pixel;   // "x,y": trace one pixel and print its record instead of a frame
   bool shadows = false;
   int depth = 0;
+  double bank_mb = 4.0;
 };
 
 // Returns 0; throws std::runtime_error with one line on bad input.

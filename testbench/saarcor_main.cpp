@@ -8,6 +8,7 @@
 
 #include "testbench/version.h"
 // [subcommand headers]
+#include "testbench/scene_cmd.h"
 #include "testbench/float_tools.h"
 #include "testbench/compare.h"
 #include "testbench/precision_cmd.h"
@@ -22,6 +23,17 @@ int main(int argc, char** argv) {
   int status = 0;
 
   // [subcommands]
+  saarcor::SceneOptions scene_opts;
+  {
+    auto* sub = app.add_subcommand(
+        "scene", "scene statistics: triangles, objects, instances, kd-trees, bytes per bank");
+    sub->add_option("scene", scene_opts.scene, "glTF file or builtin:NAME")->required();
+    sub->add_option("--time", scene_opts.time, "animation time in seconds")->capture_default_str();
+    sub->add_flag("--json", scene_opts.json, "print one JSON object");
+    sub->add_option("--export", scene_opts.export_path, "write the scene as glTF (.glb or .gltf)");
+    sub->add_option("--bank-mb", scene_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
+    sub->callback([&] { status = saarcor::run_scene(scene_opts); });
+  }
   saarcor::FloatInfoOptions float_info_opts;
   {
     auto* sub = app.add_subcommand("float-info", "parameters of a float format; --value rounds X");
@@ -70,6 +82,8 @@ int main(int argc, char** argv) {
     sub->add_option("--pixel", render_opts.pixel, "trace one pixel x,y and print its hit record");
     sub->add_flag("--shadows", render_opts.shadows, "shadow rays");
     sub->add_option("--depth", render_opts.depth, "secondary-ray depth (0 = primary only)");
+    sub->add_option("--bank-mb", render_opts.bank_mb, "SRAM bank size in MB")
+        ->capture_default_str();
     sub->callback([&] { status = saarcor::run_render(render_opts); });
   }
   saarcor::PrecisionOptions precision_opts;
@@ -81,6 +95,8 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     sub->add_option("--res", precision_opts.res, "resolution WxH")->capture_default_str();
     sub->add_option("--out", precision_opts.out, "output prefix (PREFIX.png plot, PREFIX.json)")
+        ->capture_default_str();
+    sub->add_option("--bank-mb", precision_opts.bank_mb, "SRAM bank size in MB")
         ->capture_default_str();
     sub->callback([&] { status = saarcor::run_precision(precision_opts); });
   }
