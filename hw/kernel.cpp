@@ -170,6 +170,10 @@ RunResult Kernel::run(const std::function<bool()>& done, std::uint64_t max_cycle
     const std::uint64_t period = config_.time_series_period;
     if (period != 0) target = std::min(target, (cycle_ / period + 1) * period);
     if (tracer_ && cycle_ < trace_from_) target = std::min(target, trace_from_);
+    if (target == kNever) {  // no watchdog, no limit, and nothing can ever happen again
+      return {RunResult::Status::kWatchdog, cycle_,
+              "nothing can change any more (no pending event)\n" + state_report()};
+    }
     if (target > cycle_) skip_to(target);
   }
 }

@@ -164,6 +164,15 @@ TEST(Kernel, WatchdogStopsADeadlockAtTheSameCycleWithAndWithoutSkipAndReportsEve
   }
 }
 
+TEST(Kernel, ADeadlockWithoutWatchdogOrLimitStopsInsteadOfHanging) {
+  Kernel k({.idle_skip = true, .watchdog_cycles = 0});
+  DesignB d(k, 0);  // no bursts: nothing will ever happen
+  const RunResult r = k.run([] { return false; });
+  EXPECT_EQ(r.status, RunResult::Status::kWatchdog);
+  EXPECT_EQ(r.cycles, 1u);
+  EXPECT_NE(r.report.find("nothing can change"), std::string::npos);
+}
+
 TEST(Kernel, CycleLimitStopsARunThatStillProgresses) {
   Kernel k;
   DesignA d(k, 100000);
