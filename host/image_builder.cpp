@@ -760,12 +760,21 @@ UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
         " objects and " + std::to_string(scene.instances.size()) +
         " instances, the image was built for " + std::to_string(b.objects.size()) + " and " +
         std::to_string(b.instances.size()));
-  UploadDelta d;
-  std::vector<std::uint8_t> moved(b.instances.size(), 0);
+  // Bad input is refused before anything changes.
   for (std::size_t i = 0; i < b.instances.size(); ++i) {
     if (scene.instances[i].object != b.instances[i].object)
       throw std::runtime_error("rebuild_top_level: instance " + std::to_string(i) +
                                " now references another object");
+    const auto w = world_to_object(scene.instances[i].object_to_world);
+    if (!w || !fits_format(*w, b.params.format))
+      throw std::runtime_error("instance " + std::to_string(i) + " (node " +
+                               std::to_string(scene.instances[i].id) +
+                               ") has a singular, non-affine or out-of-range transform");
+  }
+  primary_basis(choose_camera(scene, b.params), b.params.width, b.params.height);
+  UploadDelta d;
+  std::vector<std::uint8_t> moved(b.instances.size(), 0);
+  for (std::size_t i = 0; i < b.instances.size(); ++i) {
     const EncodedAffine before = b.instances[i].world_to_object_encoded;
     update_instance(b, i, scene.instances[i]);
     if (b.instances[i].world_to_object_encoded != before) {

@@ -141,8 +141,10 @@ struct UploadDelta {
 // world -> object matrices, world bounds, a new top-level tree written into its reserved slots,
 // new scene bounds and camera registers. Bottom-level trees, triangle matrices and shading data
 // stay. When the new top-level tree outgrows the reserved slots the scene banks are laid out
-// again (relayout = true) and everything in them counts as uploaded. Throws when `scene` does not
-// have the same objects and instances as the one the image was built from.
+// again (relayout = true) and everything in them counts as uploaded. Throws, leaving `built`
+// unchanged, when `scene` does not have the same objects and instances as the one the image was
+// built from, or has a bad instance transform or camera; throws when a relayout does not fit the
+// banks (then `built` must be built again).
 UploadDelta rebuild_top_level(BuiltImage& built, const Scene& scene);
 
 // ---- reading an image back (tests, the functional model's tests) ------------------------------

@@ -535,6 +535,20 @@ TEST(ImageBuilder, EmptyAndUnusedObjects) {
   }
 }
 
+TEST(ImageBuilder, SceneWithoutInstancesIsAnEmptyTopLevel) {
+  Scene s = few_triangles();
+  s.instances.clear();
+  const BuiltImage b = build_image(s, small_params());
+  EXPECT_EQ(b.stats.stored_objects, 0u);
+  const DecodedImage d = decode_image(b.image);
+  ASSERT_EQ(d.top.nodes.size(), 1u);
+  EXPECT_TRUE(d.top.nodes[0].leaf);
+  EXPECT_EQ(d.top.nodes[0].count, 0u);
+  EXPECT_EQ(d.registers.instance_count, 0u);
+  EXPECT_EQ(d.registers.epsilon, ff::from_double(1e-4, ff::kFp24, {}));
+  EXPECT_EQ(b.stats.scene_bytes(), 8u);
+}
+
 TEST(ImageBuilder, UploadDeltaWhenOneInstanceMoves) {
   Scene s = grid_two_instances(16, /*dynamic=*/true);
   BuiltImage b = build_image(s, small_params());
@@ -571,6 +585,12 @@ TEST(ImageBuilder, UploadDeltaWhenOneInstanceMoves) {
         w >= r.base[2] && w < r.base[2] + 4 * 3;  // rows 0..11 -> bank words 0..11
     EXPECT_TRUE(top_nodes || top_lists || inst_rows) << "word " << w;
   }
+  // A singular transform is refused and leaves the image as it was.
+  Scene bad = s;
+  bad.instances[0].object_to_world[0] = glm::dvec4(0.0);
+  const std::vector<std::uint32_t> bank_ok = b.image.bank(3);
+  EXPECT_THROW(rebuild_top_level(b, bad), std::runtime_error);
+  EXPECT_EQ(b.image.bank(3), bank_ok);
   // Nothing moves: only the top level and the registers.
   const UploadDelta still = rebuild_top_level(b, s);
   EXPECT_EQ(still.moved_instances, 0u);
@@ -610,6 +630,38 @@ TEST(ImageBuilder, TopLevelOutgrowingItsSlotsIsLaidOutAgain) {
                    b.objects[0].list_base);
   for (std::size_t k = 0; k < s.instances.size(); ++k)
     EXPECT_EQ(dec_img.instances[k].world_to_object, b.instances[k].world_to_object_encoded);
+}
+
+TEST(ImageBuilder, DuckRoundTrip) {
+  // A real textured glTF model: 4,212 triangles, one 512x512 texture.
+  const Scene s = load_scene(std::string(SAARCOR_SHARED_SCENES) + "/Duck/Duck.gltf");
+  const BuiltImage b = build_image(s);
+  const DecodedImage d = decode_image(b.image);
+  ASSERT_EQ(b.objects.size(), 1u);
+  const ObjectInfo& o = b.objects[0];
+  EXPECT_EQ(o.triangles, 4212u);
+  expect_same_tree(b.top, d.top, d, 0);
+  expect_same_tree(o.tree, d.bottom.at(o.node_root), d, o.list_base);
+  ASSERT_EQ(d.instances.size(), 1u);
+  for (std::uint32_t t = 0; t < o.triangles; ++t)
+    ASSERT_EQ(d.triangle_matrix(d.instances[0], t), encode_affine(*o.t_delta[t], ff::kFp24));
+  ASSERT_EQ(d.shading.size(), 4212u);
+  ASSERT_EQ(d.textures.size(), 1u);
+  EXPECT_EQ(d.textures[0].width, 512u);
+  EXPECT_EQ(d.textures[0].height, 512u);
+  EXPECT_EQ(d.textures[0].texels, s.textures[0].rgba);  // already a power of two: unchanged
+  EXPECT_EQ(b.stats.resampled_textures, 0u);
+  // Texture coordinates of one triangle, recomputed here.
+  const Object& obj = s.objects[0];
+  for (std::uint32_t t : {0u, 1000u, 4211u}) {
+    const glm::uvec3 tri = obj.triangles[t];
+    const glm::vec2 uv[3] = {obj.texcoords[tri.x], obj.texcoords[tri.y], obj.texcoords[tri.z]};
+    const double fu = std::floor(std::min({uv[0].x, uv[1].x, uv[2].x}));
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(d.shading[t].tex_u[k], std::lround((double(uv[k].x) - fu) * 4096.0)) << t;
+  }
+  EXPECT_EQ(b.stats.bytes_per_bank[2],
+            4u * (4u * d.materials.size() + 4u * d.lights.size() + 4u * 4212u + 512u * 512u));
 }
 
 TEST(DecodeImage, CorruptImagesAreRefused) {
