@@ -27,7 +27,7 @@ class UnitFp : public ff::FpUnit<F> {
  public:
   using Base::Base;
 
-  F add(F a, F b) const {
+  [[gnu::always_inline]] F add(F a, F b) const {
     const std::uint32_t ma = a.bits & kMag, mb = b.bits & kMag;
     if (mb == 0 && normal(a.bits)) return count_add(a);
     if (ma == 0 && normal(b.bits)) return count_add(b);
@@ -36,8 +36,8 @@ class UnitFp : public ff::FpUnit<F> {
       return count_add(F::zero());  // exact cancellation is +0 (no round-down mode)
     return Base::add(a, b);
   }
-  F sub(F a, F b) const { return add(a, b.neg()); }
-  F mul(F a, F b) const {
+  [[gnu::always_inline]] F sub(F a, F b) const { return add(a, b.neg()); }
+  [[gnu::always_inline]] F mul(F a, F b) const {
     const std::uint32_t ma = a.bits & kMag, mb = b.bits & kMag;
     if ((ma == 0 && (mb == 0 || normal(b.bits))) || (mb == 0 && normal(a.bits))) {
       if (auto* c = this->counts()) ++c->mul;
@@ -45,7 +45,7 @@ class UnitFp : public ff::FpUnit<F> {
     }
     return Base::mul(a, b);
   }
-  F div(F a, F b) const {
+  [[gnu::always_inline]] F div(F a, F b) const {
     const std::uint32_t ma = a.bits & kMag, mb = b.bits & kMag;
     if (ma == 0 && normal(b.bits)) {
       if (auto* c = this->counts()) ++c->div;
