@@ -9,6 +9,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/image_builder.h"
+#include "host/scene.h"
+#include "memif/image_format.h"
+
 namespace saarcor::host {
 
 FloatTraceStats& FloatTraceStats::operator+=(const FloatTraceStats& o) {
@@ -72,13 +76,15 @@ inline bool node_is_leaf(const FloatNode& n) {
 
 }  // namespace
 
-bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float t_min,
-                             float t_best, float& t, float& u, float& v, float& cos) {
+// The unit-triangle test without the upper bound: t, u, v and D'z of a valid candidate.
+static inline bool unit_triangle_candidate(const Affine32& t_delta, const FloatRay& ray,
+                                           float t_min, float t_best, float& t, float& u, float& v,
+                                           float& cos) {
   const glm::vec3 o = transform_point(t_delta, ray.origin);
   const glm::vec3 d = transform_vector(t_delta, ray.direction);
   const float tt = -o.z / d.z;
-  // D'z = 0 gives +-inf or NaN: both fail t < t_best below (t_best is finite or +inf).
-  if (!(tt > t_min && tt < t_best)) return false;
+  // t <= t_best keeps exact ties for the caller's tie rule; NaN fails every compare.
+  if (!(tt > t_min && tt <= t_best) || d.z == 0.0f) return false;
   const float uu = o.x + tt * d.x;
   const float vv = o.y + tt * d.y;
   if (!(uu >= 0.0f && vv >= 0.0f && uu + vv <= 1.0f)) return false;
@@ -87,6 +93,27 @@ bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float
   v = vv;
   cos = d.z;
   return true;
+}
+
+bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float t_min,
+                             float t_best, float& t, float& u, float& v, float& cos) {
+  float tt, uu, vv, cc;
+  if (!unit_triangle_candidate(t_delta, ray, t_min, t_best, tt, uu, vv, cc) || !(tt < t_best))
+    return false;
+  t = tt;
+  u = uu;
+  v = vv;
+  cos = cc;
+  return true;
+}
+
+// docs/shading.md section 3: nearer wins; at equal t the smaller (instance, triangle) wins. The
+// initial bound t_max (no hit yet) is strict.
+static inline bool replaces(const FloatHit& best, float t, std::uint32_t instance,
+                            std::uint32_t triangle) {
+  if (t < best.t) return true;
+  return t == best.t && best.hit() &&
+         (instance < best.instance || (instance == best.instance && triangle < best.triangle));
 }
 
 // ---- building ---------------------------------------------------------------------------------
@@ -184,9 +211,11 @@ static void traverse(const FloatNode* nodes, std::uint32_t root, const FloatRay&
       const std::uint32_t flip = std::signbit(dir) ? 1u : 0u;
       const std::uint32_t near_child = child + flip;
       const std::uint32_t far_child = child + (1u - flip);
-      if (!(d < t_far)) {  // d >= t_far, or NaN: the ray lies in the plane (either side will do)
+      // Equality visits both children: a child can be a slab thinner than the rounding of d
+      // (a flat triangle's box), whose interval [d, d] is empty in float but holds the hit.
+      if (!(d <= t_far)) {  // d > t_far, or NaN: the ray lies in the plane (either side will do)
         node = near_child;
-      } else if (d <= t_near) {
+      } else if (d < t_near) {
         node = far_child;
       } else {
         stack[top++] = StackEntry{far_child, d, t_far};
@@ -229,12 +258,14 @@ void FloatScene::trace_object(std::uint32_t instance, const FloatRay& world, flo
                ++stats.intersections;
                const std::uint32_t tri = list[i];
                float t, u, v, c;
-               if (intersect_unit_triangle(matrices[tri], ray, t_min, hit.t, t, u, v, c)) {
+               if (unit_triangle_candidate(matrices[tri], ray, t_min, hit.t, t, u, v, c) &&
+                   replaces(hit, t, instance, tri)) {
                  hit = FloatHit{t, u, v, c, instance, tri};
                  if constexpr (kAnyHit) return true;
                }
              }
-             return hit.t <= leaf_far;
+             // Strict: a hit exactly at the leaf's end may still lose a tie to a later leaf.
+             return hit.t < leaf_far;
            });
 }
 
@@ -280,7 +311,7 @@ FloatHit FloatScene::trace(const FloatRay& ray, float t_min, float t_max, bool a
                    trace_object<false>(inst, ray, t_min, hit, stats);
                  }
                }
-               return hit.t <= leaf_far;
+               return hit.t < leaf_far;
              });
   }
   if (!hit.hit()) hit.t = std::numeric_limits<float>::infinity();
@@ -301,6 +332,317 @@ FloatRay primary_ray(const PrimaryBasis32& c, int x, int y) {
   for (int i = 0; i < 3; ++i)
     r.direction[i] = (c.cr[i] * px + c.cu[i] * py) + (c.cd[i] + 0.0f);
   return r;
+}
+
+// ---- the image's view ---------------------------------------------------------------------------
+
+FloatScene::FloatScene(const BuiltImage& image) {
+  for (const ObjectInfo& o : image.objects) {
+    if (o.stored && !o.tree.nodes.empty()) {
+      add_object(o.tree, o.t_delta);
+    } else {
+      // Not in the image (no instance uses it, or nothing of it survived): an empty leaf.
+      KdTree empty;
+      empty.nodes.push_back(KdTreeNode{true, 0, 0.0f, 0, 0, 0});
+      add_object(empty, o.t_delta);
+    }
+    objects_.back().shading_base = o.shading_base;
+  }
+  for (const InstanceInfo& i : image.instances) {
+    if (i.object >= objects_.size())
+      throw std::runtime_error("float reference: instance of unknown object " +
+                               std::to_string(i.object));
+    instances_.push_back(FloatInstance{i.world_to_object32, i.object, i.id});
+  }
+  set_top(image.top);
+}
+
+// ---- shading (docs/shading.md, in binary32) -----------------------------------------------------
+
+namespace {
+
+using memif::MaterialRecord;
+
+// dot(a, b) := (a.x*b.x + a.y*b.y) + (a.z*b.z + 0): a transformation-unit row.
+inline float dot_t(const glm::vec3& a, const glm::vec3& b) {
+  return (a.x * b.x + a.y * b.y) + (a.z * b.z + 0.0f);
+}
+
+inline std::uint32_t channel(std::uint32_t rgb, int c) {
+  return (rgb >> (8 * c)) & 255u;
+}
+inline std::uint32_t mul8(std::uint32_t a, std::uint32_t b) {
+  return (a * b + 127u) / 255u;
+}
+
+// fix16(x) = clamp(floor(x*65536 + 0.5), 0, 65536), exact on the float value; NaN -> 0.
+inline std::uint32_t fix16(float x) {
+  const double v = std::floor(static_cast<double>(x) * 65536.0 + 0.5);
+  if (!(v > 0.0)) return 0;
+  return v >= 65536.0 ? 65536u : static_cast<std::uint32_t>(v);
+}
+// fix8(x) = clamp(floor(x*256 + 0.5), 0, 256); NaN -> 0.
+inline std::uint32_t fix8(float x) {
+  const double v = std::floor(static_cast<double>(x) * 256.0 + 0.5);
+  if (!(v > 0.0)) return 0;
+  return v >= 256.0 ? 256u : static_cast<std::uint32_t>(v);
+}
+
+struct ShadeLight {
+  glm::vec3 position;
+  std::uint32_t rgb;
+};
+
+// A pending ray of one pixel (docs/shading.md section 7): weight 0..255 and depth.
+struct PendingRay {
+  FloatRay ray;
+  std::uint32_t weight;
+  std::uint32_t depth;
+};
+
+class Shader {
+ public:
+  Shader(const FloatScene& scene, const BuiltImage& image, const Scene& host_scene,
+         const FloatParams& params)
+      : scene_(scene),
+        bank_(image.image.bank(memif::kShadingBank)),
+        regs_(image.image.registers()),
+        params_(params) {
+    const auto& f = image.image.format();
+    epsilon_ = static_cast<float>(ff::decode(regs_.epsilon, f, ff::Subnormals::kFlush));
+    if (host_scene.lights.size() != regs_.light_count)
+      throw std::runtime_error("float reference: the scene has " +
+                               std::to_string(host_scene.lights.size()) + " lights but the image " +
+                               std::to_string(regs_.light_count) +
+                               " (build the image from the same scene)");
+    for (std::uint32_t l = 0; l < regs_.light_count; ++l)
+      lights_.push_back(
+          ShadeLight{host_scene.lights[l].position,
+                     word(regs_.light_base + memif::kLightWords * l + 3) & 0xFFFFFFu});
+  }
+
+  // The pixel colour of a primary ray whose closest hit is `hit` (RGB8 word).
+  std::uint32_t pixel(const FloatRay& primary, const FloatHit& hit) {
+    std::uint32_t sum[3] = {0, 0, 0};
+    pending_.clear();
+    shade_ray(PendingRay{primary, 255u, 0u}, hit, sum);
+    while (!pending_.empty()) {
+      const PendingRay p = pending_.back();
+      pending_.pop_back();
+      const FloatHit h = scene_.trace(p.ray, 0.0f, std::numeric_limits<float>::infinity());
+      shade_ray(p, h, sum);
+    }
+    std::uint32_t rgb = 0;
+    for (int c = 0; c < 3; ++c)
+      rgb |= std::min(255u, (sum[c] + 127u) / 255u) << (8 * c);
+    return rgb;
+  }
+
+ private:
+  std::uint32_t word(std::uint32_t address) const {
+    if (address >= bank_.size())
+      throw std::runtime_error("float reference: shading-bank address " + std::to_string(address) +
+                               " is outside the bank");
+    return bank_[address];
+  }
+
+  void shade_ray(const PendingRay& p, const FloatHit& hit, std::uint32_t sum[3]) {
+    if (!hit.hit()) {
+      for (int c = 0; c < 3; ++c)
+        sum[c] += p.weight * channel(regs_.background_rgb, c);
+      return;
+    }
+    const FloatInstance& inst = scene_.instances()[hit.instance];
+    const FloatObject& obj = scene_.objects()[inst.object];
+    const glm::vec3& O = p.ray.origin;
+    const glm::vec3& D = p.ray.direction;
+    const float t = hit.t;
+
+    // Section 4: the world normal M^T * n_o, facing the ray.
+    const Affine32& td = scene_.t_delta(inst.object, hit.triangle);
+    const glm::vec3 n_o(td.rows[2][0], td.rows[2][1], td.rows[2][2]);
+    const auto& m = inst.world_to_object.rows;
+    glm::vec3 n;
+    for (int r = 0; r < 3; ++r) {
+      const auto rr = static_cast<std::size_t>(r);
+      n[r] = (m[0][rr] * n_o.x + m[1][rr] * n_o.y) + (m[2][rr] * n_o.z + 0.0f);
+    }
+    if (hit.cos > 0.0f) n = -n;
+    const float nn = dot_t(n, n);
+
+    // Section 5: material and base colour.
+    const std::uint32_t record =
+        regs_.shading_record_base + memif::kShadingRecordWords * (obj.shading_base + hit.triangle);
+    const std::uint32_t rec_words[4] = {word(record), word(record + 1), word(record + 2),
+                                        word(record + 3)};
+    const memif::ShadingRecord sr = memif::decode_shading(rec_words);
+    const std::uint32_t maddr = regs_.material_base + memif::kMaterialWords * sr.material;
+    const std::uint32_t mat_words[4] = {word(maddr), word(maddr + 1), word(maddr + 2),
+                                        word(maddr + 3)};
+    const MaterialRecord mat = memif::decode_material(mat_words);
+    std::uint32_t base[3];
+    for (int c = 0; c < 3; ++c)
+      base[c] = channel(mat.diffuse_rgba, c);
+    if (mat.texture != memif::kNone) {
+      const std::uint32_t texel = sample(mat, sr, hit.u, hit.v);
+      for (int c = 0; c < 3; ++c)
+        base[c] = mul8(base[c], channel(texel, c));
+    }
+
+    // Section 6: ambient + diffuse (+ specular) per light.
+    std::uint32_t acc[3];
+    for (int c = 0; c < 3; ++c)
+      acc[c] = mul8(base[c], channel(regs_.ambient_rgb, c));
+    const float k = dot_t(D, n) / nn;
+    const float kk = k + k;
+    const std::uint32_t spec_rgb = mat.specular_rgb_shininess & 0xFFFFFFu;
+    const std::uint32_t shininess = mat.specular_rgb_shininess >> 24;
+    const bool specular = spec_rgb != 0 && shininess >= 1;
+    glm::vec3 refl;
+    for (int r = 0; r < 3; ++r)
+      refl[r] = (D[r] * 1.0f + n[r] * (-kk)) + (D[r] * 0.0f + 0.0f);
+    for (const ShadeLight& light : lights_) {
+      glm::vec3 S;
+      for (int r = 0; r < 3; ++r)
+        S[r] = (light.position[r] * (-1.0f) + O[r] * 1.0f) + (D[r] * t + 0.0f);
+      const float nS = dot_t(n, S);
+      if (!(nS < 0.0f)) continue;
+      const float SS = dot_t(S, S);
+      const float cos_d = (-nS) / std::sqrt(nn * SS);
+      if (params_.shadows) {
+        constexpr float kShadowEnd = 1.0f - 1.0f / 512.0f;
+        if (scene_.trace(FloatRay{light.position, S}, 0.0f, kShadowEnd, true).hit()) continue;
+      }
+      const std::uint32_t wd = fix8(cos_d);
+      for (int c = 0; c < 3; ++c)
+        acc[c] += (mul8(base[c], channel(light.rgb, c)) * wd) >> 8;
+      if (specular) {
+        const float rL = dot_t(refl, S);
+        if (rL < 0.0f) {
+          const float rr = dot_t(refl, refl);
+          const float cos_s = (-rL) / std::sqrt(rr * SS);
+          const std::uint32_t ws = fix8(cos_s);
+          std::uint32_t pw = 256;
+          for (std::uint32_t i = 0; i < shininess; ++i)
+            pw = (pw * ws + 128u) >> 8;
+          for (int c = 0; c < 3; ++c)
+            acc[c] += (mul8(channel(spec_rgb, c), channel(light.rgb, c)) * pw) >> 8;
+        }
+      }
+    }
+
+    // Section 7: weights and children.
+    const std::uint32_t kr = mat.reflectivity;
+    const std::uint32_t kt = mat.transparency;
+    const std::uint32_t wl =
+        params_.secondary ? mul8(p.weight, 255u - std::min(255u, kr + kt)) : p.weight;
+    for (int c = 0; c < 3; ++c)
+      sum[c] += wl * std::min(255u, acc[c]);
+    if (!params_.secondary || p.depth >= regs_.max_depth) return;
+    const std::uint32_t wr = mul8(p.weight, kr);
+    const std::uint32_t wt = mul8(p.weight, kt);
+    const float e = epsilon_;
+    if (wr > 0) {
+      FloatRay child;
+      for (int r = 0; r < 3; ++r) {
+        child.origin[r] = (D[r] * (-e) + n[r] * 0.0f) + (D[r] * t + O[r]);
+        child.direction[r] = refl[r];
+      }
+      pending_.push_back(PendingRay{child, wr, p.depth + 1});
+    }
+    if (wt > 0) {
+      FloatRay child;
+      for (int r = 0; r < 3; ++r) {
+        child.origin[r] = (D[r] * e + n[r] * 0.0f) + (D[r] * t + O[r]);
+        child.direction[r] = (D[r] * 1.0f + n[r] * 0.0f) + (D[r] * 0.0f + 0.0f);
+      }
+      pending_.push_back(PendingRay{child, wt, p.depth + 1});
+    }
+  }
+
+  // Section 5: the texel colour (RGB8) at barycentrics (u, v), nearest or bilinear.
+  std::uint32_t sample(const MaterialRecord& mat, const memif::ShadingRecord& sr, float u,
+                       float v) const {
+    const std::uint64_t bu = fix16(u);
+    const std::uint64_t bv = fix16(v);
+    const std::uint64_t bw = bu + bv >= 65536u ? 0u : 65536u - bu - bv;
+    const std::uint64_t s = sr.tex_u[0] * bu + sr.tex_u[1] * bv + sr.tex_u[2] * bw;
+    const std::uint64_t tt = sr.tex_v[0] * bu + sr.tex_v[1] * bv + sr.tex_v[2] * bw;
+    const std::uint64_t W = std::uint64_t{1} << mat.log2_width;
+    const std::uint64_t H = std::uint64_t{1} << mat.log2_height;
+    const auto texel = [&](std::uint64_t x, std::uint64_t y) {
+      return word(mat.texture + static_cast<std::uint32_t>(y * W + x));
+    };
+    if (!mat.bilinear) {
+      const std::uint64_t x = ((s * W) >> 28) & (W - 1);
+      const std::uint64_t y = ((tt * H) >> 28) & (H - 1);
+      return texel(x, y) & 0xFFFFFFu;
+    }
+    const std::int64_t X = static_cast<std::int64_t>(s * W) - (std::int64_t{1} << 27);
+    const std::int64_t Y = static_cast<std::int64_t>(tt * H) - (std::int64_t{1} << 27);
+    const std::uint64_t x0 = static_cast<std::uint64_t>(X >> 28) & (W - 1);
+    const std::uint64_t y0 = static_cast<std::uint64_t>(Y >> 28) & (H - 1);
+    const std::uint64_t x1 = (x0 + 1) & (W - 1);
+    const std::uint64_t y1 = (y0 + 1) & (H - 1);
+    const std::uint32_t fx = static_cast<std::uint32_t>((X >> 20) & 255);
+    const std::uint32_t fy = static_cast<std::uint32_t>((Y >> 20) & 255);
+    const std::uint32_t c00 = texel(x0, y0), c10 = texel(x1, y0);
+    const std::uint32_t c01 = texel(x0, y1), c11 = texel(x1, y1);
+    std::uint32_t out = 0;
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t top = channel(c00, c) * (256 - fx) + channel(c10, c) * fx;
+      const std::uint32_t bot = channel(c01, c) * (256 - fx) + channel(c11, c) * fx;
+      out |= ((top * (256 - fy) + bot * fy + 32768u) >> 16) << (8 * c);
+    }
+    return out;
+  }
+
+  const FloatScene& scene_;
+  const std::vector<std::uint32_t>& bank_;
+  const memif::FrameRegisters& regs_;
+  FloatParams params_;
+  float epsilon_ = 0.0f;
+  std::vector<ShadeLight> lights_;
+  std::vector<PendingRay> pending_;
+};
+
+}  // namespace
+
+FloatFrame render_float(const FloatScene& float_scene, const BuiltImage& image, const Scene& scene,
+                        const FloatParams& params) {
+  const int w = image.params.width;
+  const int h = image.params.height;
+  const PrimaryBasis32 basis = to_float(image.basis);
+  FloatFrame frame;
+  frame.width = w;
+  frame.height = h;
+  frame.pixels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  frame.rgb.assign(frame.pixels.size() * 3, 0);
+  std::optional<Shader> shader;
+  if (params.shade) shader.emplace(float_scene, image, scene, params);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i =
+          static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      FloatPixel& px = frame.pixels[i];
+      px.ray = primary_ray(basis, x, y);
+      px.hit = float_scene.trace(px.ray, 0.0f, inf, false, &frame.stats);
+      if (px.hit.hit()) px.instance_id = float_scene.instances()[px.hit.instance].id;
+      if (shader) {
+        const std::uint32_t rgb = shader->pixel(px.ray, px.hit);
+        for (int c = 0; c < 3; ++c)
+          frame.rgb[3 * i + static_cast<std::size_t>(c)] =
+              static_cast<std::uint8_t>(channel(rgb, c));
+      }
+    }
+  }
+  return frame;
+}
+
+FloatFrame render_float(const BuiltImage& image, const Scene& scene, const FloatParams& params) {
+  const FloatScene float_scene(image);
+  return render_float(float_scene, image, scene, params);
 }
 
 }  // namespace saarcor::host

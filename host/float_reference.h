@@ -75,7 +75,8 @@ struct FloatObject {
   std::uint32_t item_base = 0;    // its list items start here in FloatScene::items
   std::uint32_t matrix_base = 0;  // T_delta of its triangle 0 in FloatScene::triangles
   std::uint32_t triangle_count = 0;
-  Aabb bounds;  // object space: the root box of its tree
+  std::uint32_t shading_base = 0;  // shading record index of its triangle 0 (image objects)
+  Aabb bounds;                     // object space: the root box of its tree
 };
 
 // Everything trace_float() reads. Built once per frame from the BuiltImage (or, in tests, from
@@ -98,9 +99,15 @@ class FloatScene {
   std::span<const FloatInstance> instances() const { return instances_; }
   std::span<const FloatObject> objects() const { return objects_; }
   const Aabb& bounds() const { return top_bounds_; }
+  // T_delta of triangle `triangle` of object `object` in binary32 (all zero for a dropped slot).
+  const Affine32& t_delta(std::uint32_t object, std::uint32_t triangle) const {
+    return triangles_[objects_[object].matrix_base + triangle];
+  }
 
-  // Closest hit with t_min < t < t_max; on equal t the hit found first in traversal order wins.
-  // any_hit: stop at the first accepted hit (shadow rays).
+  // Closest hit with t_min < t < t_max. Ties (docs/shading.md section 3): a candidate with
+  // t == t_best replaces the best hit when its (instance, triangle) is lexicographically smaller,
+  // so the result does not depend on traversal order. any_hit: stop at the first accepted hit
+  // (shadow rays).
   FloatHit trace(const FloatRay& ray, float t_min, float t_max, bool any_hit = false,
                  FloatTraceStats* stats = nullptr) const;
 
@@ -127,7 +134,8 @@ FloatHit trace_float(const FloatScene& scene, const FloatRay& ray, float t_min =
 // The unit-triangle test of paper section 2.1.2 on one triangle, in binary32 with the datapath's
 // op order: O' = T.O and D' = T.D as (m0*x + m1*y) + (m2*z + t), t = -O'z / D'z,
 // u = O'x + t*D'x, v = O'y + t*D'y; accepted when u >= 0, v >= 0, u + v <= 1 and
-// t_min < t < t_best (DIGEST D13). Returns true and fills t, u, v, cos when accepted.
+// t_min < t < t_best and D'z != 0 (DIGEST D13). Returns true and fills t, u, v, cos when
+// accepted. (FloatScene::trace adds the tie rule for t == t_best.)
 bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float t_min,
                              float t_best, float& t, float& u, float& v, float& cos);
 
@@ -136,11 +144,13 @@ bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float
 // (Cr*x + Cu*y) + (Cd*1 + 0), in binary32.
 FloatRay primary_ray(const PrimaryBasis32& camera, int x, int y);
 
+// Render options (docs/shading.md section 1). The defaults are the paper's Table 3 setting:
+// primary rays and textured shading, no shadow or secondary rays. Resolution, camera, ambient,
+// background, epsilon and max depth come from the image (ImageParams, FrameRegisters).
 struct FloatParams {
-  int width = 512;
-  int height = 384;
-  float t_min = 0.0f;  // primary rays accept t > t_min
-  bool shade = true;   // false: hit records only, the image stays black
+  bool shade = true;       // false: hit records only, the image stays black
+  bool shadows = false;    // shadow rays towards every light
+  bool secondary = false;  // reflection and transparency rays up to FrameRegisters::max_depth
 };
 
 // Per pixel: the closest hit and the world-space primary ray (what a hit EXR stores).
@@ -162,6 +172,11 @@ struct FloatFrame {
   }
 };
 
+// Renders the image's camera at the image's resolution. `scene` supplies the lights' binary32
+// positions (the image holds them in its own format); everything else is read from `image`.
 FloatFrame render_float(const BuiltImage& image, const Scene& scene, const FloatParams& params);
+// The same with a FloatScene built beforehand from `image` (benchmarks, repeated frames).
+FloatFrame render_float(const FloatScene& float_scene, const BuiltImage& image, const Scene& scene,
+                        const FloatParams& params);
 
 }  // namespace saarcor::host
