@@ -188,15 +188,16 @@ struct Split {
 
 class Builder {
  public:
+  // Parameters are checked before anything is derived from them (the grid needs a valid format).
   Builder(const KdBuildParams& params, KdTree& tree)
-      : p_(params), grid_(params.split_format), tree_(tree) {}
+      : p_(checked(params)), grid_(params.split_format), tree_(tree) {}
 
   void build_triangles(std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
                        std::span<const std::uint8_t> skip);
   void build_boxes(std::span<const Aabb> boxes);
 
  private:
-  void check_params() const;
+  static const KdBuildParams& checked(const KdBuildParams& p);
   void check_coordinate(float v, const char* what, std::size_t index) const;
   void start(std::size_t items);
   void add_item_events(std::uint32_t id, const float lo[3], const float hi[3]);
@@ -229,18 +230,19 @@ class Builder {
   Box root_{};
 };
 
-void Builder::check_params() const {
-  const ff::Format& f = p_.split_format;
+const KdBuildParams& Builder::checked(const KdBuildParams& p) {
+  const ff::Format& f = p.split_format;
   if (!f.valid()) throw std::runtime_error("kd-tree: invalid split format " + ff::format_name(f));
-  if (!(p_.traversal_cost >= 0.0f) || !(p_.intersection_cost > 0.0f) ||
-      !(p_.empty_bonus > 0.0f && p_.empty_bonus <= 1.0f))
+  if (!(p.traversal_cost >= 0.0f) || !(p.intersection_cost > 0.0f) ||
+      !(p.empty_bonus > 0.0f && p.empty_bonus <= 1.0f))
     throw std::runtime_error(
         "kd-tree: cost parameters need traversal >= 0, intersection > 0, 0 < empty bonus <= 1");
-  if (p_.max_depth < 0 || p_.max_depth > 1000)
-    throw std::runtime_error("kd-tree: max depth " + std::to_string(p_.max_depth) +
+  if (p.max_depth < 0 || p.max_depth > 1000)
+    throw std::runtime_error("kd-tree: max depth " + std::to_string(p.max_depth) +
                              " outside 0..1000");
-  if (p_.leaf_size < 0)
-    throw std::runtime_error("kd-tree: negative leaf size " + std::to_string(p_.leaf_size));
+  if (p.leaf_size < 0)
+    throw std::runtime_error("kd-tree: negative leaf size " + std::to_string(p.leaf_size));
+  return p;
 }
 
 void Builder::check_coordinate(float v, const char* what, std::size_t index) const {
@@ -293,7 +295,6 @@ void Builder::add_item_events(std::uint32_t id, const float lo[3], const float h
 void Builder::build_triangles(std::span<const glm::vec3> positions,
                               std::span<const glm::uvec3> tris,
                               std::span<const std::uint8_t> skip) {
-  check_params();
   if (!skip.empty() && skip.size() != tris.size())
     throw std::runtime_error("kd-tree: skip list has " + std::to_string(skip.size()) +
                              " entries for " + std::to_string(tris.size()) + " triangles");
@@ -321,7 +322,6 @@ void Builder::build_triangles(std::span<const glm::vec3> positions,
 }
 
 void Builder::build_boxes(std::span<const Aabb> boxes) {
-  check_params();
   boxes_ = boxes;
   triangles_ = false;
   start(boxes.size());
