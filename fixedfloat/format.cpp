@@ -202,8 +202,9 @@ std::uint32_t from_double(double v, const Format& f, const Mode& m) {
 
 std::uint32_t from_int(std::int64_t v, const Format& f, const Mode& m) {
   // Split so that each half is exact in binary64; their sum carries the exact error's sign.
-  const auto hi = static_cast<double>(v >> 21 << 21);
-  const auto lo = static_cast<double>(v - (v >> 21 << 21));
+  const std::int64_t hi_bits = v & ~std::int64_t{0x1FFFFF};  // two's complement: floor to 2^21
+  const auto hi = static_cast<double>(hi_bits);
+  const auto lo = static_cast<double>(v - hi_bits);
   const double s = hi + lo;
   const double bb = s - hi;
   const double err = (hi - (s - bb)) + (lo - bb);
