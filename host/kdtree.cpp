@@ -694,7 +694,6 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     new_left_[j].clear();
     new_right_[j].clear();
   }
-  std::sort(both_.begin(), both_.end());  // deterministic order of the new events' ties
   for (const std::uint32_t id : both_) {
     float llo[3];
     float lhi[3];
