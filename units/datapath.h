@@ -31,22 +31,38 @@ struct Ray {
 
 // ---- bit tests (no comparator: wires on the encoding) ---------------------------------------
 template <class F>
+inline std::uint32_t magnitude_bits(F x) {
+  return x.bits & (F::kFormat.sign_mask() - 1u);
+}
+template <class F>
+inline bool bits_zero(F x) {
+  return magnitude_bits(x) == 0;
+}
+template <class F>
+inline bool bits_nan(F x) {
+  return magnitude_bits(x) > F::kFormat.inf_bits();
+}
+template <class F>
+inline bool bits_inf(F x) {
+  return magnitude_bits(x) == F::kFormat.inf_bits();
+}
+template <class F>
 inline bool is_neg_nonzero(F x) {  // x < 0, NaN excluded
-  return x.sign() && !x.is_zero() && !x.is_nan();
+  return x.sign() && !bits_zero(x) && !bits_nan(x);
 }
 template <class F>
 inline bool is_pos_nonzero(F x) {  // x > 0, NaN excluded
-  return !x.sign() && !x.is_zero() && !x.is_nan();
+  return !x.sign() && !bits_zero(x) && !bits_nan(x);
 }
 template <class F>
 inline bool is_nonneg(F x) {  // x >= 0 (-0 included), NaN excluded
-  return (!x.sign() || x.is_zero()) && !x.is_nan();
+  return (!x.sign() || bits_zero(x)) && !bits_nan(x);
 }
 // For operands known to be >= 0 and not NaN the encoding orders like the value (with -0 read as
 // +0): D13's "bit-pattern compare", used where the intersection unit has no comparator.
 template <class F>
 inline std::uint32_t magnitude_key(F x) {
-  return x.is_zero() ? 0u : x.abs().bits;
+  return magnitude_bits(x);
 }
 
 // ---- transformation unit (paper 2.3, DESIGN.md 5: 9 mul, 9 add per step) -----------------------
@@ -95,7 +111,7 @@ inline TraversalLane<F> traversal_lane(const UnitFp<F>& fp, F split, F o_axis, F
   TraversalLane<F> r;
   r.go_near = !before;
   r.go_far = !after;
-  const bool nan = d.is_nan();
+  const bool nan = bits_nan(d);
   r.near_tf = (r.go_far && !nan) ? d : tf;
   r.far_tn = (r.go_near && !nan) ? d : tn;
   return r;
@@ -138,7 +154,7 @@ inline Candidate<F> intersect_unit_triangle(const UnitFp<F>& fp, const Ray<F>& r
   c.u = fp.add(r.o[0], fp.mul(c.t, r.d[0]));
   c.v = fp.add(r.o[1], fp.mul(c.t, r.d[1]));
   const F sum = fp.add(c.u, c.v);
-  c.inside = !c.c.is_zero() && !c.c.is_nan() && is_pos_nonzero(c.t) && !c.t.is_inf() &&
+  c.inside = !bits_zero(c.c) && !bits_nan(c.c) && is_pos_nonzero(c.t) && !bits_inf(c.t) &&
              is_nonneg(c.u) && is_nonneg(c.v) && is_nonneg(sum) &&
              magnitude_key(sum) <= F::one().bits;
   return c;

@@ -65,6 +65,16 @@ void BM_FunctionalFp24Room(benchmark::State& state) {
         static_cast<double>(f.units.transformation_steps) / static_cast<double>(f.units.packets),
         static_cast<double>(f.units.intersection_packets) / static_cast<double>(f.units.packets),
         static_cast<double>(f.units.sub_packets) / static_cast<double>(f.units.packets));
+    const double ops =
+        static_cast<double>(f.units.traversal_ops.total() + f.units.transformation_ops.total() +
+                            f.units.intersection_ops.total() + f.units.rgs_ops.total());
+    std::printf(
+        "float ops per primary ray: %.1f (traversal %.1f, transformation %.1f, "
+        "intersection %.1f, rgs %.1f)\n",
+        ops / n, static_cast<double>(f.units.traversal_ops.total()) / n,
+        static_cast<double>(f.units.transformation_ops.total()) / n,
+        static_cast<double>(f.units.intersection_ops.total()) / n,
+        static_cast<double>(f.units.rgs_ops.total()) / n);
   }
 }
 BENCHMARK(BM_FunctionalFp24Room)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->Iterations(2);

@@ -150,6 +150,16 @@ class PipelineUnits {
   ff::OpCounts traversal_ops, transformation_ops, intersection_ops, rgs_ops;
   UnitFp<F> traversal, transformation, intersection, rgs;
 
+  // The ops of a masked lane: the hardware lane fires and its result is discarded (D30), so it
+  // is counted without being computed.
+  static void count_idle(ff::OpCounts& c, std::uint64_t add, std::uint64_t mul, std::uint64_t div,
+                         std::uint64_t cmp) {
+    c.add += add;
+    c.mul += mul;
+    c.div += div;
+    c.cmp += cmp;
+  }
+
   // Work counted per unit, in the unit's own steps.
   std::uint64_t traversal_steps = 0;       // kd-node steps (inner + leaf + empty)
   std::uint64_t inner_steps = 0;           // steps on inner nodes (P add, P div, 3P cmp)
@@ -438,8 +448,14 @@ class ThreadProgram {
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
-      l.world.o = shared_origin_ ? shared : transform_step(fp, g.t, g.ro, true);
-      l.world.d = transform_step(fp, g.t, g.rd, false);
+      if (!l.valid) {
+        l.world.o = shared;
+        PipelineUnits<F>::count_idle(u_.transformation_ops, shared_origin_ ? 9 : 18,
+                                     shared_origin_ ? 9 : 18, 0, 0);
+      } else {
+        l.world.o = shared_origin_ ? shared : transform_step(fp, g.t, g.ro, true);
+        l.world.d = transform_step(fp, g.t, g.rd, false);
+      }
       l.current = l.world;
       l.hit = HitRecord<F>{};
       if (kind_ == RayKind::kShadow) l.hit.t = shadow_t_max_;
@@ -499,6 +515,10 @@ class ThreadProgram {
     }
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
+      if (!has(clip_mask_, i)) {
+        PipelineUnits<F>::count_idle(u_.traversal_ops, 1, 0, 1, 1);
+        continue;
+      }
       const bool neg = l.current.d[axis].sign();
       const bool entry = !exit_face;
       // Entry face: lo for a positive direction, hi for a negative one; exit face the other.
@@ -513,7 +533,11 @@ class ThreadProgram {
     std::uint64_t inside = 0;
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
-      if (!fp.lt(l.clip_tf, l.clip_tn) && has(clip_mask_, i)) inside |= std::uint64_t{1} << i;
+      if (!has(clip_mask_, i)) {
+        PipelineUnits<F>::count_idle(u_.traversal_ops, 0, 0, 0, 1);
+        continue;
+      }
+      if (!fp.lt(l.clip_tf, l.clip_tn)) inside |= std::uint64_t{1} << i;
     }
     // Sign groups: rays with equal direction signs share one front-to-back order (D27). Groups
     // in increasing sign-pattern order; each is a masked sub-packet traversed to the end.
@@ -560,8 +584,11 @@ class ThreadProgram {
     std::uint64_t active = 0;
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
-      const bool term = terminated(fp, l.hit.t, l.tn);
-      if (has(mask_, i) && !l.done && !term) active |= std::uint64_t{1} << i;
+      if (!has(mask_, i) || l.done) {
+        PipelineUnits<F>::count_idle(u_.traversal_ops, 0, 0, 0, 1);
+        continue;
+      }
+      if (!terminated(fp, l.hit.t, l.tn)) active |= std::uint64_t{1} << i;
     }
     for (int i = 0; i < p_; ++i)
       if (has(active, i)) ++lane(i).counters.traversal_steps;
@@ -589,9 +616,12 @@ class ThreadProgram {
     std::array<F, kMaxPacket> near_tf{}, far_tn{};
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
+      if (!has(active, i)) {
+        PipelineUnits<F>::count_idle(u_.traversal_ops, 1, 0, 1, 2);
+        continue;
+      }
       const TraversalLane<F> r =
           traversal_lane(fp, split, l.current.o[axis], l.current.d[axis], l.tn, l.tf);
-      if (!has(active, i)) continue;
       if (r.go_near) near_mask |= std::uint64_t{1} << i;
       if (r.go_far) far_mask |= std::uint64_t{1} << i;
       near_tf[static_cast<std::size_t>(i)] = r.near_tf;
@@ -724,10 +754,16 @@ class ThreadProgram {
     if (shared_origin_) shared = transform_step(fp, m, (lanes_[0].*in).o, true);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
+      if (!has(entry_mask_, i)) {
+        (l.*out).o = shared;
+        PipelineUnits<F>::count_idle(u_.transformation_ops, shared_origin_ ? 9 : 18,
+                                     shared_origin_ ? 9 : 18, 0, 0);
+        continue;
+      }
       const Ray<F> src = l.*in;
       (l.*out).o = shared_origin_ ? shared : transform_step(fp, m, src.o, true);
       (l.*out).d = transform_step(fp, m, src.d, false);
-      if (has(entry_mask_, i)) ++l.counters.transformations;
+      ++l.counters.transformations;
     }
   }
 
@@ -758,8 +794,11 @@ class ThreadProgram {
     ++u_.intersection_packets;
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
+      if (!has(entry_mask_, i)) {
+        PipelineUnits<F>::count_idle(u_.intersection_ops, 3, 2, 1, 0);
+        continue;
+      }
       const Candidate<F> c = intersect_unit_triangle(fp, l.tri);
-      if (!has(entry_mask_, i)) continue;
       ++l.counters.intersections;
       if (!accepts(c, instance_, triangle_, l.hit)) continue;
       l.hit.t = c.t;
