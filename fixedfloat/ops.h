@@ -119,7 +119,14 @@ struct Rounder {
   using L = Layout<E, M>;
   Mode mode;
   std::uint64_t add;
-  constexpr explicit Rounder(const Mode& m) : mode(m), add(L::kHalf - 1u - L::kRebias) {}
+  // Width of the range of kept bits (bits(|v|) >> (52 - M)) that the nearest-even path takes:
+  // the whole normal range for nearest-even, empty for truncation (which then takes its own
+  // branch), so the common path needs no test of the mode.
+  std::uint64_t nearest_span;
+  constexpr explicit Rounder(const Mode& m)
+      : mode(m),
+        add(L::kHalf - 1u - L::kRebias),
+        nearest_span(m.rounding == Rounding::kNearestEven ? (L::kSpan >> L::kShift) : 0u) {}
 };
 
 // Truncation of a magnitude exactly on the grid; d is the sign of (exact magnitude - |v|). The
@@ -145,12 +152,13 @@ inline std::uint32_t round_mag(std::uint64_t mag, std::uint32_t sign, const Roun
   // The kept bits (exponent and the top M fraction bits) decide the range; their constants fit in
   // 32 bits, which keeps the common path free of 64-bit immediates.
   const std::uint64_t kept = mag >> L::kShift;
-  if (kept - (L::kLow >> L::kShift) < (L::kSpan >> L::kShift)) [[likely]] {
-    if (r.mode.rounding == Rounding::kNearestEven) [[likely]] {
-      // A carry out of the mantissa increments the exponent field; a carry out of the largest
-      // finite value gives exactly the infinity encoding.
-      return sign | static_cast<std::uint32_t>((mag + r.add + (kept & 1u)) >> L::kShift);
-    }
+  const std::uint64_t offset = kept - (L::kLow >> L::kShift);
+  if (offset < r.nearest_span) [[likely]] {
+    // Nearest-even in the normal range. A carry out of the mantissa increments the exponent
+    // field; a carry out of the largest finite value gives exactly the infinity encoding.
+    return sign | static_cast<std::uint32_t>((mag + r.add + (kept & 1u)) >> L::kShift);
+  }
+  if (offset < (L::kSpan >> L::kShift) && r.mode.rounding == Rounding::kTowardZero) {
     if ((mag & L::kLowBits) != 0)
       return sign | static_cast<std::uint32_t>((mag - L::kRebias) >> L::kShift);
     return sign | truncate_on_grid<E, M>(mag, r.mode, dir_fn());
