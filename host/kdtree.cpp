@@ -302,9 +302,6 @@ void Builder::build_triangles(std::span<const glm::vec3> positions,
   tris_ = tris;
   triangles_ = true;
   start(tris.size());
-  for (std::size_t v = 0; v < positions.size(); ++v)
-    for (int k = 0; k < 3; ++k)
-      check_coordinate(positions[v][k], "vertex", v);
   for (std::size_t i = 0; i < tris.size(); ++i) {
     if (!skip.empty() && skip[i] != 0) continue;
     const glm::uvec3 t = tris[i];
@@ -312,6 +309,10 @@ void Builder::build_triangles(std::span<const glm::vec3> positions,
       throw std::runtime_error("kd-tree: triangle " + std::to_string(i) +
                                " indexes a vertex beyond the " + std::to_string(positions.size()) +
                                " positions");
+    // Only the vertices of used triangles matter (and must be finite and storable).
+    for (const unsigned v : {t.x, t.y, t.z})
+      for (int k = 0; k < 3; ++k)
+        check_coordinate(positions[v][k], "vertex", v);
     const glm::vec3 lo = glm::min(glm::min(positions[t.x], positions[t.y]), positions[t.z]);
     const glm::vec3 hi = glm::max(glm::max(positions[t.x], positions[t.y]), positions[t.z]);
     const float l[3] = {lo.x, lo.y, lo.z};

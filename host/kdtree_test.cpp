@@ -620,7 +620,10 @@ TEST(KdTree, SkippedTrianglesAreLeftOut) {
   m.skip.assign(m.tris.size(), 0);
   for (std::size_t i = 0; i < m.skip.size(); i += 3)
     m.skip[i] = 1;
+  // A skipped (degenerate) triangle's vertices are not looked at.
+  m.pos[m.tris[0].y].x = std::numeric_limits<float>::quiet_NaN();
   const KdTree tree = build_kdtree(m.pos, m.tris, m.skip);
+  m.pos[m.tris[0].y].x = 0.0f;
   check_triangle_tree(tree, m);
   check_rays(tree, m, 600, 3);
   // All skipped: a single empty leaf.
