@@ -84,7 +84,8 @@ static inline bool unit_triangle_candidate(const Affine32& t_delta, const FloatR
   const glm::vec3 d = transform_vector(t_delta, ray.direction);
   const float tt = -o.z / d.z;
   // t <= t_best keeps exact ties for the caller's tie rule; NaN fails every compare.
-  if (!(tt > t_min && tt <= t_best) || d.z == 0.0f) return false;
+  if (!(tt > t_min && tt <= t_best && tt < std::numeric_limits<float>::infinity()) || d.z == 0.0f)
+    return false;
   const float uu = o.x + tt * d.x;
   const float vv = o.y + tt * d.y;
   if (!(uu >= 0.0f && vv >= 0.0f && uu + vv <= 1.0f)) return false;
@@ -211,16 +212,22 @@ static void traverse(const FloatNode* nodes, std::uint32_t root, const FloatRay&
       const std::uint32_t flip = std::signbit(dir) ? 1u : 0u;
       const std::uint32_t near_child = child + flip;
       const std::uint32_t far_child = child + (1u - flip);
-      // Equality visits both children: a child can be a slab thinner than the rounding of d
-      // (a flat triangle's box), whose interval [d, d] is empty in float but holds the hit.
-      if (!(d <= t_far)) {  // d > t_far, or NaN: the ray lies in the plane (either side will do)
-        node = near_child;
-      } else if (d < t_near) {
+      // As the traversal unit decides (units/datapath.h traversal_lane): far side only when the
+      // plane lies before the segment, near side only when beyond it, otherwise both. Equality
+      // visits both: a child can be a slab thinner than the rounding of d (a flat triangle's
+      // box), whose interval [d, d] holds the hit. NaN (the ray lies in the plane) visits both
+      // over the whole segment.
+      if (d < t_near) {
         node = far_child;
-      } else {
+      } else if (t_far < d) {
+        node = near_child;
+      } else if (d == d) {
         stack[top++] = StackEntry{far_child, d, t_far};
         node = near_child;
         t_far = d;
+      } else {
+        stack[top++] = StackEntry{far_child, t_near, t_far};
+        node = near_child;
       }
       n = nodes[node];
     }
@@ -511,7 +518,11 @@ class Shader {
       const float cos_d = (-nS) / std::sqrt(nn * SS);
       if (params_.shadows) {
         constexpr float kShadowEnd = 1.0f - 1.0f / 512.0f;
-        if (scene_.trace(FloatRay{light.position, S}, 0.0f, kShadowEnd, true).hit()) continue;
+        // Origin step of R' = ((1, 0, 0), ...): (L*1 + O*0) + (D*0 + 0).
+        glm::vec3 origin;
+        for (int r = 0; r < 3; ++r)
+          origin[r] = (light.position[r] * 1.0f + O[r] * 0.0f) + (D[r] * 0.0f + 0.0f);
+        if (scene_.trace(FloatRay{origin, S}, 0.0f, kShadowEnd, true).hit()) continue;
       }
       const std::uint32_t wd = fix8(cos_d);
       for (int c = 0; c < 3; ++c)
