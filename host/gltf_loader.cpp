@@ -273,7 +273,7 @@ void compute_missing_normals(Object& obj, const std::vector<std::uint8_t>& missi
 }
 
 Object convert_mesh(const tinygltf::Model& model, const Reader& reader, std::size_t mesh_index,
-                    std::uint32_t default_material, Scene& scene) {
+                    std::uint32_t default_material, bool& default_used, Scene& scene) {
   const tinygltf::Mesh& mesh = model.meshes[mesh_index];
   const std::string label = mesh_label(mesh, mesh_index);
   Object obj;
@@ -369,6 +369,7 @@ Object convert_mesh(const tinygltf::Model& model, const Reader& reader, std::siz
         idx[i] = static_cast<std::uint32_t>(i);
     }
     std::uint32_t material = default_material;
+    if (prim.material < 0) default_used = true;
     if (prim.material >= 0) {
       if (static_cast<std::size_t>(prim.material) >= model.materials.size())
         reader.fail(plabel + ": material " + std::to_string(prim.material) + " does not exist");
@@ -538,19 +539,20 @@ Scene load_gltf(const std::string& path) {
     derive_fixed_function_terms(mat, gm.alphaMode == "BLEND");
     scene.materials.push_back(std::move(mat));
   }
-  // glTF's default material for primitives without one: white, dielectric, fully rough.
+  // glTF's default material, for primitives without one: white, fully metallic and rough (the
+  // glTF default factors). Added only when a primitive uses it.
   const auto default_material = static_cast<std::uint32_t>(scene.materials.size());
-  {
+  bool default_used = false;
+  for (std::size_t m = 0; m < model.meshes.size(); ++m)
+    scene.objects.push_back(convert_mesh(model, reader, m, default_material, default_used, scene));
+  if (default_used) {
     Material mat;
     mat.name = "default";
-    mat.metallic = 1.0f;  // the glTF default factors
+    mat.metallic = 1.0f;
     mat.roughness = 1.0f;
     derive_fixed_function_terms(mat, false);
     scene.materials.push_back(mat);
   }
-
-  for (std::size_t m = 0; m < model.meshes.size(); ++m)
-    scene.objects.push_back(convert_mesh(model, reader, m, default_material, scene));
 
   // Nodes.
   const std::size_t node_count = model.nodes.size();

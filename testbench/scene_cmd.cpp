@@ -1,0 +1,237 @@
+// `saarcor scene`: loads a scene (glTF or built-in), evaluates it at a time, optionally exports it,
+// builds the memory image (both kd-tree levels, DESIGN.md section 4) and reports counts, tree
+// statistics, build times and bytes per bank (issue 3, "Command line").
+#include "testbench/scene_cmd.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+
+#include "host/gltf_export.h"
+#include "host/image_builder.h"
+#include "host/kdtree.h"
+#include "host/scene.h"
+
+namespace saarcor {
+
+namespace {
+
+using host::KdTreeStats;
+using nlohmann::json;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+json tree_json(const KdTreeStats& s) {
+  return json{{"nodes", s.nodes},
+              {"leaves", s.leaves},
+              {"empty_leaves", s.empty_leaves},
+              {"depth", s.depth},
+              {"items_per_leaf", s.items_per_leaf},
+              {"sah_cost", s.sah_cost},
+              {"expected_traversal_steps", s.expected_traversal_steps},
+              {"expected_leaf_visits", s.expected_leaf_visits},
+              {"expected_item_tests", s.expected_item_tests},
+              {"build_seconds", s.build_seconds}};
+}
+
+struct Trees {
+  KdTreeStats top;
+  std::vector<std::pair<std::uint32_t, KdTreeStats>> bottom;  // (object, stats) of stored objects
+};
+
+// The trees without a memory image (used when the image does not fit its banks): the same
+// builder and parameters the image builder uses.
+Trees build_trees_directly(const host::Scene& scene) {
+  Trees t;
+  std::vector<std::uint8_t> used(scene.objects.size(), 0);
+  for (const host::Instance& i : scene.instances)
+    used.at(i.object) = 1;
+  std::vector<host::Aabb> local(scene.objects.size());
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const host::Object& obj = scene.objects[o];
+    for (std::size_t k = 0; k < obj.triangles.size(); ++k) {
+      if (obj.degenerate[k]) continue;
+      for (int v = 0; v < 3; ++v)
+        local[o].grow(obj.positions[obj.triangles[k][v]]);
+    }
+    if (!used[o]) continue;
+    const host::KdTree tree = host::build_kdtree(obj.positions, obj.triangles, obj.degenerate);
+    t.bottom.emplace_back(static_cast<std::uint32_t>(o), tree.stats);
+  }
+  std::vector<host::Aabb> boxes;
+  for (const host::Instance& inst : scene.instances) {
+    const host::Aabb& b = local[inst.object];
+    host::Aabb w;
+    if (!b.empty()) {
+      for (int c = 0; c < 8; ++c) {
+        const glm::dvec4 p((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y,
+                           (c & 4) ? b.hi.z : b.lo.z, 1.0);
+        w.grow(glm::vec3(glm::dvec3(inst.object_to_world * p)));
+      }
+    }
+    boxes.push_back(w);
+  }
+  t.top = host::build_kdtree(boxes).stats;
+  return t;
+}
+
+json bottom_json(const Trees& t, const host::Scene& scene) {
+  KdTreeStats sum;
+  double leaf_items = 0.0;
+  std::uint64_t nonempty = 0;
+  json per_object = json::array();
+  for (const auto& [o, s] : t.bottom) {
+    sum.nodes += s.nodes;
+    sum.leaves += s.leaves;
+    sum.empty_leaves += s.empty_leaves;
+    sum.depth = std::max(sum.depth, s.depth);
+    sum.build_seconds += s.build_seconds;
+    leaf_items += s.items_per_leaf * (s.leaves - s.empty_leaves);
+    nonempty += s.leaves - s.empty_leaves;
+    json j = tree_json(s);
+    j["object"] = o;
+    j["name"] = scene.objects[o].name;
+    j["triangles"] = scene.objects[o].triangles.size();
+    per_object.push_back(j);
+  }
+  return json{{"trees", t.bottom.size()},
+              {"nodes", sum.nodes},
+              {"leaves", sum.leaves},
+              {"empty_leaves", sum.empty_leaves},
+              {"max_depth", sum.depth},
+              {"items_per_leaf", nonempty ? leaf_items / static_cast<double>(nonempty) : 0.0},
+              {"build_seconds", sum.build_seconds},
+              {"objects", per_object}};
+}
+
+}  // namespace
+
+int run_scene(const SceneOptions& options) {
+  if (!(options.bank_mb > 0.0) || options.bank_mb > 16384.0)
+    throw std::runtime_error("--bank-mb must be in (0, 16384], got " +
+                             std::to_string(options.bank_mb));
+  if (!std::isfinite(options.time) || options.time < 0.0)
+    throw std::runtime_error("--time must be a finite number >= 0, got " +
+                             std::to_string(options.time));
+  const auto t0 = std::chrono::steady_clock::now();
+  host::Scene scene = host::load_scene(options.scene);
+  const double load_seconds = seconds_since(t0);
+  if (options.time != 0.0) scene.set_time(options.time);
+  if (!options.export_path.empty()) host::export_gltf(scene, options.export_path);
+
+  std::optional<host::BuiltImage> built;
+  std::string image_error;
+  const auto t1 = std::chrono::steady_clock::now();
+  host::ImageParams params;
+  params.bank_words = static_cast<std::uint32_t>(std::llround(options.bank_mb * 262144.0));
+  try {
+    built = host::build_image(scene, params);
+  } catch (const std::runtime_error& e) {
+    image_error = e.what();
+  }
+  Trees trees;
+  if (built) {
+    trees.top = built->top.stats;
+    for (std::size_t o = 0; o < built->objects.size(); ++o)
+      if (built->objects[o].stored)
+        trees.bottom.emplace_back(static_cast<std::uint32_t>(o), built->objects[o].tree.stats);
+  } else {
+    trees = build_trees_directly(scene);
+  }
+  const double image_seconds = seconds_since(t1);
+
+  std::uint64_t dynamic = 0;
+  for (const host::Instance& i : scene.instances)
+    dynamic += i.dynamic ? 1 : 0;
+  json j;
+  j["scene"] = options.scene;
+  j["time"] = scene.time;
+  j["triangles"] = scene.instanced_triangles();
+  j["unique_triangles"] = scene.unique_triangles();
+  j["objects"] = scene.objects.size();
+  j["instances"] = scene.instances.size();
+  j["dynamic_instances"] = dynamic;
+  j["materials"] = scene.materials.size();
+  j["textures"] = scene.textures.size();
+  j["lights"] = scene.lights.size();
+  j["light_defaulted"] = scene.light_defaulted;
+  j["cameras"] = scene.cameras.size();
+  j["animation_seconds"] = scene.animation_seconds;
+  j["dropped_triangles"] = scene.dropped_triangles();
+  j["dropped_triangles_instanced"] = scene.instanced_dropped_triangles();
+  j["skipped_primitives"] = scene.skipped_primitives;
+  j["warnings"] = scene.warnings;
+  j["load_seconds"] = load_seconds;
+  j["kdtree"] = json{{"top", tree_json(trees.top)}, {"bottom", bottom_json(trees, scene)}};
+  if (built) {
+    j["bytes_per_bank"] = built->stats.bytes_per_bank;
+    j["bank_bytes"] = static_cast<std::uint64_t>(params.bank_words) * 4u;
+    j["image_seconds"] = image_seconds;
+    j["image_error"] = nullptr;
+  } else {
+    j["bytes_per_bank"] = nullptr;
+    j["image_error"] = image_error;
+  }
+  if (!options.export_path.empty()) j["exported"] = options.export_path;
+
+  if (options.json) {
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
+  }
+  std::printf("scene               %s (t = %.3f s)\n", options.scene.c_str(), scene.time);
+  std::printf("triangles           %llu after instancing, %llu unique\n",
+              static_cast<unsigned long long>(scene.instanced_triangles()),
+              static_cast<unsigned long long>(scene.unique_triangles()));
+  std::printf("dropped triangles   %llu unique (degenerate), %llu after instancing\n",
+              static_cast<unsigned long long>(scene.dropped_triangles()),
+              static_cast<unsigned long long>(scene.instanced_dropped_triangles()));
+  std::printf("skipped primitives  %llu\n",
+              static_cast<unsigned long long>(scene.skipped_primitives));
+  std::printf("objects             %zu\n", scene.objects.size());
+  std::printf("instances           %zu (%llu dynamic)\n", scene.instances.size(),
+              static_cast<unsigned long long>(dynamic));
+  std::printf("materials/textures  %zu / %zu\n", scene.materials.size(), scene.textures.size());
+  std::printf("lights              %zu%s\n", scene.lights.size(),
+              scene.light_defaulted ? " (default light)" : "");
+  std::printf("cameras             %zu%s\n", scene.cameras.size(),
+              scene.cameras.empty() ? " (default framing)" : "");
+  std::printf("animation           %.3f s\n", scene.animation_seconds);
+  std::printf("load time           %.3f s\n", load_seconds);
+  const auto tree_line = [](const char* name, const KdTreeStats& s) {
+    std::printf(
+        "%-19s %u nodes, %u leaves (%u empty), depth %u, %.2f items/leaf, SAH %.2f, "
+        "per ray %.2f steps / %.2f leaves / %.2f tests, %.3f s\n",
+        name, s.nodes, s.leaves, s.empty_leaves, s.depth, s.items_per_leaf, s.sah_cost,
+        s.expected_traversal_steps, s.expected_leaf_visits, s.expected_item_tests, s.build_seconds);
+  };
+  tree_line("kd-tree top", trees.top);
+  const json b = j["kdtree"]["bottom"];
+  std::printf(
+      "kd-tree bottom      %zu trees, %llu nodes, %llu leaves (%llu empty), max depth %u, %.2f "
+      "items/leaf, %.3f s\n",
+      trees.bottom.size(), b["nodes"].get<unsigned long long>(),
+      b["leaves"].get<unsigned long long>(), b["empty_leaves"].get<unsigned long long>(),
+      b["max_depth"].get<unsigned>(), b["items_per_leaf"].get<double>(),
+      b["build_seconds"].get<double>());
+  if (built) {
+    std::printf("bytes per bank     ");
+    for (std::uint64_t v : built->stats.bytes_per_bank)
+      std::printf(" %llu", static_cast<unsigned long long>(v));
+    std::printf("  (of %llu each)\n", static_cast<unsigned long long>(params.bank_words) * 4ull);
+    std::printf("image build         %.3f s\n", image_seconds);
+  } else {
+    std::printf("memory image        does not build: %s\n", image_error.c_str());
+  }
+  for (const std::string& w : scene.warnings)
+    std::printf("warning             %s\n", w.c_str());
+  if (!options.export_path.empty())
+    std::printf("exported            %s\n", options.export_path.c_str());
+  return 0;
+}
+
+}  // namespace saarcor

@@ -1,0 +1,190 @@
+// `saarcor scene` as a user runs it (issue 3, "Command line"): the JSON keys and values, --time,
+// --export then re-load, and one line on stderr with a non-zero exit for each class of bad input.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kSaarcor = std::string(SAARCOR_BIN_DIR) + "/saarcor";
+const std::string kScenes = SAARCOR_SHARED_SCENES;
+
+struct CmdResult {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+class SceneCmd : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("saarcor_scene_cmd_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  CmdResult run(const std::string& args) {
+    const std::string err_file = (dir_ / "stderr.txt").string();
+    const std::string cmd = kSaarcor + " scene " + args + " 2>" + err_file;
+    CmdResult r;
+    FILE* p = popen(cmd.c_str(), "r");
+    if (p == nullptr) return r;
+    std::array<char, 4096> buf{};
+    std::size_t n = 0;
+    while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0)
+      r.out.append(buf.data(), n);
+    const int st = pclose(p);
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    std::ifstream e(err_file);
+    std::stringstream ss;
+    ss << e.rdbuf();
+    r.err = ss.str();
+    return r;
+  }
+
+  // Asserts the failure shape every bad input must have: exit 1, one stderr line, nothing on
+  // stdout.
+  void expect_one_line_error(const std::string& args, const std::string& part) {
+    SCOPED_TRACE(args);
+    const CmdResult r = run(args);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    ASSERT_FALSE(r.err.empty());
+    EXPECT_EQ(r.err.rfind("saarcor: error: ", 0), 0u) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+    EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+  }
+
+  std::string write(const std::string& name, const std::string& text) {
+    const std::string p = (dir_ / name).string();
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(SceneCmd, JsonReportOfTheRoom) {
+  const CmdResult r = run("builtin:room --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["triangles"], 806);
+  EXPECT_EQ(j["unique_triangles"], 806);
+  EXPECT_EQ(j["objects"], 1);
+  EXPECT_EQ(j["instances"], 1);
+  EXPECT_EQ(j["lights"], 2);
+  EXPECT_EQ(j["cameras"], 1);
+  EXPECT_EQ(j["animation_seconds"], 0.0);
+  EXPECT_EQ(j["dropped_triangles"], 0);
+  EXPECT_TRUE(j["image_error"].is_null());
+  ASSERT_TRUE(j["kdtree"]["top"].is_object());
+  EXPECT_GE(j["kdtree"]["top"]["nodes"].get<int>(), 1);
+  EXPECT_EQ(j["kdtree"]["bottom"]["trees"], 1);
+  EXPECT_GT(j["kdtree"]["bottom"]["nodes"].get<int>(), 1);
+  ASSERT_TRUE(j["bytes_per_bank"].is_array());
+  ASSERT_EQ(j["bytes_per_bank"].size(), 6u);
+  // Banks 3-5 hold the scene: 806 triangles of 36-byte matrices at least, spread over three.
+  std::uint64_t scene_bytes = 0;
+  for (int b = 3; b < 6; ++b)
+    scene_bytes += j["bytes_per_bank"][b].get<std::uint64_t>();
+  EXPECT_GT(scene_bytes, 806u * 36u);
+}
+
+TEST_F(SceneCmd, TextReportNamesEveryFigure) {
+  const CmdResult r = run(kScenes + "/SimpleMeshes/SimpleMeshes.gltf");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* line :
+       {"triangles           2 after instancing, 1 unique", "objects             1",
+        "instances           2 (0 dynamic)", "lights              1 (default light)",
+        "cameras             0 (default framing)", "kd-tree top", "kd-tree bottom",
+        "bytes per bank"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+}
+
+TEST_F(SceneCmd, TimeMovesTheAnimatedInstances) {
+  const std::string box = kScenes + "/BoxAnimated/BoxAnimated.glb";
+  const CmdResult r = run(box + " --time 1.875 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_NEAR(j["animation_seconds"].get<double>(), 3.70833, 1e-5);
+  EXPECT_EQ(j["time"], 1.875);
+  EXPECT_EQ(j["dynamic_instances"], 1);
+  EXPECT_EQ(j["triangles"], 254);
+}
+
+TEST_F(SceneCmd, ExportThenReload) {
+  const std::string out = (dir_ / "dynamic.glb").string();
+  const CmdResult a = run("builtin:dynamic --json --export " + out);
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_TRUE(fs::exists(out));
+  const CmdResult b = run(out + " --json");
+  ASSERT_EQ(b.status, 0) << b.err;
+  const json ja = json::parse(a.out), jb = json::parse(b.out);
+  for (const char* key :
+       {"triangles", "unique_triangles", "objects", "instances", "dynamic_instances", "lights",
+        "cameras", "animation_seconds", "dropped_triangles"})
+    EXPECT_EQ(ja[key], jb[key]) << key;
+  EXPECT_EQ(ja["triangles"], 52790);
+  EXPECT_EQ(ja["bytes_per_bank"], jb["bytes_per_bank"]);
+  // .gltf with embedded buffers works too.
+  const std::string gltf = (dir_ / "room.gltf").string();
+  ASSERT_EQ(run("builtin:room --export " + gltf).status, 0);
+  const json jr = json::parse(run(gltf + " --json").out);
+  EXPECT_EQ(jr["triangles"], 806);
+}
+
+TEST_F(SceneCmd, ImageThatDoesNotFitStillReportsTheTrees) {
+  const CmdResult r = run("builtin:room --json --bank-mb 0.01");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_TRUE(j["bytes_per_bank"].is_null());
+  EXPECT_NE(j["image_error"].get<std::string>().find("does not fit"), std::string::npos)
+      << j["image_error"];
+  EXPECT_GT(j["kdtree"]["bottom"]["nodes"].get<int>(), 1);
+}
+
+TEST_F(SceneCmd, BadInputsExitNonZeroWithOneLine) {
+  expect_one_line_error((dir_ / "absent.gltf").string(), "absent.gltf: no such file");
+  expect_one_line_error(write("bad.gltf", "{ \"asset\": "), "cannot load glTF");
+  expect_one_line_error(
+      write("nobuf.gltf",
+            R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":12,"uri":"gone.bin"}]})"),
+      "gone.bin");
+  expect_one_line_error(
+      write("noimg.gltf", R"({"asset":{"version":"2.0"},"images":[{"uri":"gone.png"}]})"),
+      "image file missing or unreadable");
+  // A triangle whose vertex 1 has y = NaN (the buffer is embedded as base64).
+  expect_one_line_error(
+      write(
+          "nan.gltf",
+          R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+          R"("meshes":[{"name":"probe","primitives":[{"attributes":{"POSITION":0}}]}],)"
+          R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+          R"("bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":)"
+          R"("data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAwH8AAAAAAAAAAAAAgD8AAAAA"}]})"),
+      "mesh 0 'probe': accessor 0 (POSITION) has a non-finite value at vertex 1");
+  expect_one_line_error("builtin:nope", "unknown built-in scene");
+  expect_one_line_error("builtin:room --time -1", "--time");
+  expect_one_line_error("builtin:room --bank-mb 0", "--bank-mb");
+  const std::string unwritable = (dir_ / "no_such_dir" / "x.glb").string();
+  expect_one_line_error("builtin:cube --export " + unwritable, "cannot write");
+  EXPECT_FALSE(fs::exists(unwritable));
+  EXPECT_FALSE(fs::exists(unwritable + ".partial"));
+}
+
+}  // namespace
