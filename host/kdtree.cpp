@@ -205,6 +205,7 @@ class Builder {
   void build_node(std::uint32_t node, int depth, const Box& box, const std::size_t b[3],
                   const std::size_t e[3], std::uint32_t n);
   void make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0);
+  void emit_leaf(std::uint32_t node, std::vector<std::uint32_t>& ids);
   Split find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
                    std::uint32_t n) const;
   int clip_split(std::uint32_t id, const Box& box, int axis, float split, float llo[3],
@@ -226,6 +227,9 @@ class Builder {
   std::vector<Key> new_left_[3];
   std::vector<Key> new_right_[3];
   std::vector<std::uint32_t> leaf_scratch_;
+  std::vector<std::uint32_t> right_scratch_;
+  std::vector<std::uint32_t> both_left_;  // straddlers kept on each side
+  std::vector<std::uint32_t> both_right_;
   std::uint32_t item_count_ = 0;
   Box root_{};
 };
@@ -448,12 +452,17 @@ void Builder::make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0) {
   const Key* ev = ev_[0].data();
   for (std::size_t i = b0; i < e0; ++i)
     if (key_type(ev[i]) != kEnd) leaf_scratch_.push_back(key_id(ev[i]));
-  std::sort(leaf_scratch_.begin(), leaf_scratch_.end());
+  emit_leaf(node, leaf_scratch_);
+}
+
+// A leaf's list in ascending item id (deterministic; the hardware's tie rule may depend on it).
+void Builder::emit_leaf(std::uint32_t node, std::vector<std::uint32_t>& ids) {
+  std::sort(ids.begin(), ids.end());
   KdTreeNode& nd = tree_.nodes[node];
   nd.leaf = true;
   nd.first = static_cast<std::uint32_t>(tree_.items.size());
-  nd.count = static_cast<std::uint32_t>(leaf_scratch_.size());
-  tree_.items.insert(tree_.items.end(), leaf_scratch_.begin(), leaf_scratch_.end());
+  nd.count = static_cast<std::uint32_t>(ids.size());
+  tree_.items.insert(tree_.items.end(), ids.begin(), ids.end());
 }
 
 // Perfect splits: the straddling item clipped to the node's box and cut by the plane; fills both
@@ -690,11 +699,15 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
   lbox.hi[k] = split;
   rbox.lo[k] = split;
 
-  // Perfect splits: straddlers get new events from their bounds clipped to each child.
+  // Perfect splits: straddlers get new events from their bounds clipped to each child (not at
+  // the last level, whose children are leaves at once).
+  const bool last_level = depth + 1 >= p_.max_depth;
   for (int j = 0; j < 3; ++j) {
     new_left_[j].clear();
     new_right_[j].clear();
   }
+  both_left_.clear();
+  both_right_.clear();
   for (const std::uint32_t id : both_) {
     float llo[3];
     float lhi[3];
@@ -710,13 +723,47 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
       in_right = !in_left && (pieces & 2) != 0;
     }
     if (in_left) {
-      add_clipped(id, llo, lhi, new_left_);
+      if (!last_level) add_clipped(id, llo, lhi, new_left_);
+      both_left_.push_back(id);
       ++n_left;
     }
     if (in_right) {
-      add_clipped(id, rlo, rhi, new_right_);
+      if (!last_level) add_clipped(id, rlo, rhi, new_right_);
+      both_right_.push_back(id);
       ++n_right;
     }
+  }
+
+  const auto child = static_cast<std::uint32_t>(tree_.nodes.size());
+  {
+    KdTreeNode& nd = tree_.nodes[node];
+    nd.leaf = false;
+    nd.axis = static_cast<std::uint8_t>(k);
+    nd.split = split;
+    nd.child = child;
+  }
+  tree_.nodes.emplace_back();
+  tree_.nodes.emplace_back();
+
+  const auto leaf_size = static_cast<std::uint32_t>(p_.leaf_size);
+  if (last_level || (n_left <= leaf_size && n_right <= leaf_size)) {
+    // Both children are leaves: their lists come straight from the classification (one entry
+    // per item: its start or planar event on the split axis), no event lists are split.
+    leaf_scratch_.clear();
+    right_scratch_.clear();
+    const Key* ev = ev_[k].data();
+    for (std::size_t i = b[k]; i < e[k]; ++i) {
+      const Key key = ev[i];
+      if (key_type(key) == kEnd) continue;
+      const std::uint32_t id = key_id(key);
+      if (side[id] == kLeft) leaf_scratch_.push_back(id);
+      if (side[id] == kRight) right_scratch_.push_back(id);
+    }
+    leaf_scratch_.insert(leaf_scratch_.end(), both_left_.begin(), both_left_.end());
+    right_scratch_.insert(right_scratch_.end(), both_right_.begin(), both_right_.end());
+    emit_leaf(child, leaf_scratch_);
+    emit_leaf(child + 1, right_scratch_);
+    return;
   }
 
   std::size_t lb[3];
@@ -741,17 +788,6 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     re[j] = rb[j] + rn;
     a.top_ = re[j];
   }
-
-  const auto child = static_cast<std::uint32_t>(tree_.nodes.size());
-  {
-    KdTreeNode& nd = tree_.nodes[node];
-    nd.leaf = false;
-    nd.axis = static_cast<std::uint8_t>(k);
-    nd.split = split;
-    nd.child = child;
-  }
-  tree_.nodes.emplace_back();
-  tree_.nodes.emplace_back();
 
   std::size_t saved_top[3];
   for (int j = 0; j < 3; ++j)
