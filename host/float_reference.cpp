@@ -417,6 +417,8 @@ class Shader {
         params_(params) {
     const auto& f = image.image.format();
     epsilon_ = static_cast<float>(ff::decode(regs_.epsilon, f, ff::Subnormals::kFlush));
+    max_depth_ =
+        params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth) : regs_.max_depth;
     if (host_scene.lights.size() != regs_.light_count)
       throw std::runtime_error("float reference: the scene has " +
                                std::to_string(host_scene.lights.size()) + " lights but the image " +
@@ -549,7 +551,7 @@ class Shader {
         params_.secondary ? mul8(p.weight, 255u - std::min(255u, kr + kt)) : p.weight;
     for (int c = 0; c < 3; ++c)
       sum[c] += wl * std::min(255u, acc[c]);
-    if (!params_.secondary || p.depth >= regs_.max_depth) return;
+    if (!params_.secondary || p.depth >= max_depth_) return;
     const std::uint32_t wr = mul8(p.weight, kr);
     const std::uint32_t wt = mul8(p.weight, kt);
     const float e = epsilon_;
@@ -613,6 +615,7 @@ class Shader {
   const memif::FrameRegisters& regs_;
   FloatParams params_;
   float epsilon_ = 0.0f;
+  std::uint32_t max_depth_ = 0;
   std::vector<ShadeLight> lights_;
   std::vector<PendingRay> pending_;
 };

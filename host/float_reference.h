@@ -150,7 +150,8 @@ FloatRay primary_ray(const PrimaryBasis32& camera, int x, int y);
 struct FloatParams {
   bool shade = true;       // false: hit records only, the image stays black
   bool shadows = false;    // shadow rays towards every light
-  bool secondary = false;  // reflection and transparency rays up to FrameRegisters::max_depth
+  bool secondary = false;  // reflection and transparency rays up to the depth bound
+  int max_depth = -1;      // secondary-ray depth bound, -1 = FrameRegisters::max_depth
 };
 
 // Per pixel: the closest hit and the world-space primary ray (what a hit EXR stores).

@@ -390,10 +390,11 @@ struct LitQuad {
     inst.id = 1;
     scene.instances.push_back(inst);
   }
-  BuiltImage image() const {
+  BuiltImage image(std::uint32_t background = 0) const {
     ImageParams ip;
     ip.width = 9;
     ip.height = 9;
+    ip.background_rgb = background;
     return build_image(scene, ip);
   }
 };
@@ -451,6 +452,35 @@ TEST(FloatShading, ShadowRaysOnlyWhenEnabled) {
   EXPECT_GT(lit.rgb[centre], shadowed.rgb[centre]);
   // Away from the shadow both agree.
   EXPECT_EQ(lit.rgb[3 * (4 * 9 + 2)], shadowed.rgb[3 * (4 * 9 + 2)]);
+}
+
+// A half-mirror quad: the centre ray reflects straight back and misses, so the reflection adds
+// the background with the reflection weight (docs/shading.md section 7).
+TEST(FloatShading, ReflectionWeightsAndDepthBound) {
+  LitQuad q;
+  q.scene.materials[0].reflectivity = 0.5f;
+  const BuiltImage image = q.image(0x808080u);
+  const auto& bank = image.image.bank(memif::kShadingBank);
+  const memif::MaterialRecord mat =
+      memif::decode_material(&bank[image.image.registers().material_base]);
+  ASSERT_GT(mat.reflectivity, 0u);
+  ASSERT_LT(mat.reflectivity, 255u);
+  const std::size_t centre = 3 * (4 * 9 + 4);
+  const FloatFrame plain = render_float(image, q.scene, FloatParams{});
+  FloatParams secondary;
+  secondary.secondary = true;
+  const FloatFrame mirrored = render_float(image, q.scene, secondary);
+  secondary.max_depth = 0;
+  const FloatFrame depth0 = render_float(image, q.scene, secondary);
+  const std::uint32_t wl = mul8_ref(255, 255 - mat.reflectivity);
+  const std::uint32_t wr = mul8_ref(255, mat.reflectivity);
+  for (int c = 0; c < 3; ++c) {
+    const std::uint32_t local = plain.rgb[centre + static_cast<std::size_t>(c)];
+    EXPECT_EQ(mirrored.rgb[centre + static_cast<std::size_t>(c)],
+              std::min(255u, (wl * local + wr * 0x80u + 127u) / 255u));
+    EXPECT_EQ(depth0.rgb[centre + static_cast<std::size_t>(c)],
+              std::min(255u, (wl * local + 127u) / 255u));
+  }
 }
 
 TEST(FloatShading, RefusesASceneWithOtherLights) {
