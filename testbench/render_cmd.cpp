@@ -441,6 +441,16 @@ int run_render(const RenderOptions& opts) {
   std::optional<PixelCoord> pixel;
   if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
   if (opts.out.empty()) throw std::runtime_error("bad --out '': expected a file prefix");
+  // Output names are checked before the work, so a bad one costs no render.
+  auto ends_with = [](const std::string& s, const std::string& e) {
+    return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
+  };
+  if (!opts.hits.empty() && !ends_with(opts.hits, ".exr")) {
+    throw std::runtime_error("bad --hits '" + opts.hits + "': a hit EXR file name ends in .exr");
+  }
+  if (!opts.report.empty() && !ends_with(opts.report, ".json")) {
+    throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
+  }
 
   const ff::Format format =
       model.kind == ModelKind::kFunctional ? ff::Format{7, model.mantissa} : ff::kFp24;
