@@ -197,10 +197,20 @@ std::uint32_t round_text(const std::string& text, const Format& f, const Mode& m
   const double v = parse(FE_TONEAREST);
   const double up = parse(FE_UPWARD);
   const double down = parse(FE_DOWNWARD);
+  double r = v;
   int dir = 0;
   if (up != down && !std::isnan(v)) dir = (v == up) ? -1 : +1;
+  // Beyond binary64's range strtod says inf; the largest binary64 plus the error sign keeps
+  // truncation at the largest finite value of the format.
+  if (std::isinf(v) && v > 0 && std::isfinite(down)) {
+    r = down;
+    dir = +1;
+  } else if (std::isinf(v) && v < 0 && std::isfinite(up)) {
+    r = up;
+    dir = -1;
+  }
   *nearest = v;
-  return ff::round_pack(v, dir, f, m);
+  return ff::round_pack(r, dir, f, m);
 }
 
 std::string value_line(std::uint32_t bits, const Format& f) {

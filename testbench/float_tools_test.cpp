@@ -197,6 +197,11 @@ TEST(FloatInfo, ValueRoundsOnceExactly) {
   std::ostringstream even;
   float_info(o, even);
   EXPECT_NE(even.str().find("value (rne)      0x3f0000"), std::string::npos) << even.str();
+  o.value = "1e400";  // beyond binary64: inf in rne, the largest finite value in rtz
+  std::ostringstream huge;
+  float_info(o, huge);
+  EXPECT_NE(huge.str().find("value (rne)      0x7f0000"), std::string::npos) << huge.str();
+  EXPECT_NE(huge.str().find("value (rtz)      0x7effff"), std::string::npos) << huge.str();
   o.value = "twelve";
   std::ostringstream bad;
   EXPECT_THROW(float_info(o, bad), std::runtime_error);
