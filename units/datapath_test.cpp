@@ -39,6 +39,43 @@ TEST(TransformStep, OpOrderIsM0XPlusM1YThenM2ZPlusT) {
   EXPECT_EQ(dot_step(fp, Vec3<F>{f(1), f(2), f(3)}, Vec3<F>{f(4), f(5), f(6)}).bits, f(32).bits);
 }
 
+// Ray generation through transformations (paper 2.2.2, DESIGN.md 7): T = [A, B, C; D] has rows
+// (A_r, B_r, C_r, D_r); the origin step translates, the direction step does not.
+Mat34<F> columns(const Vec3<F>& a, const Vec3<F>& b, const Vec3<F>& c, const Vec3<F>& d) {
+  Mat34<F> t{};
+  for (int r = 0; r < 3; ++r)
+    t[r] = {a[r], b[r], c[r], d[r]};
+  return t;
+}
+Vec3<F> v3(double x, double y, double z) {
+  return {f(x), f(y), f(z)};
+}
+void expect_vec(const Vec3<F>& got, double x, double y, double z, const char* what) {
+  EXPECT_EQ(got[0].bits, f(x).bits) << what << " x";
+  EXPECT_EQ(got[1].bits, f(y).bits) << what << " y";
+  EXPECT_EQ(got[2].bits, f(z).bits) << what << " z";
+}
+
+TEST(RayGeneration, ShadowReflectionTransparency) {
+  UnitFp<F> fp;
+  const Vec3<F> zero = v3(0, 0, 0);
+  // Shadow: T = [L, O, D; 0], R' = ((1,0,0), (-1, 1, t)) -> (L, O + t*D - L).
+  const Vec3<F> light = v3(1, 2, 3), o = v3(0, 0, 0), d = v3(1, 1, 1);
+  const Mat34<F> ts = columns(light, o, d, zero);
+  expect_vec(transform_step(fp, ts, v3(1, 0, 0), true), 1, 2, 3, "shadow origin");
+  expect_vec(transform_step(fp, ts, v3(-1, 1, 2), false), 1, 0, -1, "shadow direction");
+  // T_R = [D, N, D; O] (translation O, the erratum). A ray straight down onto the floor y = 0
+  // from (0, 5, 0): t = 5, N = (0, 1, 0), c = N.D = -1, e = 0.25.
+  const Vec3<F> down = v3(0, -1, 0), n = v3(0, 1, 0), origin = v3(0, 5, 0);
+  const Mat34<F> tr = columns(down, n, down, origin);
+  // Reflection: R' = ((-e, 0, t), (1, -2c, 0)) -> (O + t*D - e*D, D - 2c*N).
+  expect_vec(transform_step(fp, tr, v3(-0.25, 0, 5), true), 0, 0.25, 0, "reflection origin");
+  expect_vec(transform_step(fp, tr, v3(1, 2, 0), false), 0, 1, 0, "reflection direction");
+  // Transparency: R' = ((e, 0, t), (1, 0, 0)) -> (O + t*D + e*D, D).
+  expect_vec(transform_step(fp, tr, v3(0.25, 0, 5), true), 0, -0.25, 0, "transparency origin");
+  expect_vec(transform_step(fp, tr, v3(1, 0, 0), false), 0, -1, 0, "transparency direction");
+}
+
 TEST(TraversalLane, BothChildrenSplitTheSegmentAtD) {
   ff::OpCounts ops;
   UnitFp<F> fp({}, &ops);

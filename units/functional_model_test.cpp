@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "host/image_builder.h"
 #include "host/scene.h"
@@ -106,8 +107,36 @@ int brute_force_mismatches(const host::BuiltImage& b, const FunctionalFrame& fr,
   return bad;
 }
 
+#ifdef SAARCOR_SANITIZED
+constexpr int kW = 32, kH = 24;  // the sanitizer run is ~20x slower
+#else
+constexpr int kW = 64, kH = 48;
+#endif
+
+TEST(FunctionalModel, PrimaryRaysComeFromTinit) {
+  const host::BuiltImage b = build("builtin:room", 16, 12);
+  const FunctionalFrame fr = run_functional<F>(b.image, FunctionalParams{});
+  const auto& regs = b.image.registers();
+  Mat34<F> t{};
+  for (int r = 0; r < 3; ++r)
+    t[r] = {F::from_bits(regs.cam_r[r]), F::from_bits(regs.cam_u[r]), F::from_bits(regs.cam_d[r]),
+            F::from_bits(regs.cam_p[r])};
+  UnitFp<F> fp;
+  for (auto [x, y] : {std::pair{0, 0}, std::pair{5, 3}, std::pair{15, 11}}) {
+    const Vec3<F> o = transform_step(fp, t, Vec3<F>{F::zero(), F::zero(), F::zero()}, true);
+    const Vec3<F> d =
+        transform_step(fp, t, Vec3<F>{F::from_int(x), F::from_int(y), F::one()}, false);
+    for (int k = 0; k < 3; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      EXPECT_EQ(fr.at(x, y).o[kk], o[k].bits);
+      EXPECT_EQ(fr.at(x, y).o[kk], regs.cam_p[kk]) << "origin = Cp exactly";
+      EXPECT_EQ(fr.at(x, y).d[kk], d[k].bits);
+    }
+  }
+}
+
 TEST(FunctionalModel, PacketWidthNeverChangesResults) {
-  const host::BuiltImage b = build("builtin:room");
+  const host::BuiltImage b = build("builtin:room", kW, kH);
   FunctionalParams p;
   p.packet = 1;
   const FunctionalFrame f1 = run_functional<F>(b.image, p);
@@ -118,7 +147,7 @@ TEST(FunctionalModel, PacketWidthNeverChangesResults) {
 }
 
 TEST(FunctionalModel, StackAndMailboxSizesNeverChangeResults) {
-  const host::BuiltImage b = build("builtin:room");
+  const host::BuiltImage b = build("builtin:room", kW, kH);
   FunctionalParams p;
   const FunctionalFrame ref = run_functional<F>(b.image, p);
   for (int mb : {0, 1, 32}) {
