@@ -240,17 +240,15 @@ std::vector<glm::uvec3> assemble(int mode, const std::vector<std::uint32_t>& idx
     for (std::size_t i = 0; i + 2 < idx.size(); i += 3)
       tris.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
   } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+    // glTF 2.0 section 3.7.2.1: triangle i = (v_i, v_{i+1+i%2}, v_{i+2-i%2}).
     for (std::size_t i = 0; i + 2 < idx.size(); ++i) {
-      // Every other triangle of a strip is flipped to keep the winding.
-      if (i % 2 == 0) {
-        tris.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
-      } else {
-        tris.emplace_back(idx[i + 1], idx[i], idx[i + 2]);
-      }
+      const std::size_t odd = i % 2;
+      tris.emplace_back(idx[i], idx[i + 1 + odd], idx[i + 2 - odd]);
     }
   } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
-    for (std::size_t i = 1; i + 1 < idx.size(); ++i)
-      tris.emplace_back(idx[0], idx[i], idx[i + 1]);
+    // glTF 2.0: triangle i = (v_{i+1}, v_{i+2}, v_0).
+    for (std::size_t i = 0; i + 2 < idx.size(); ++i)
+      tris.emplace_back(idx[i + 1], idx[i + 2], idx[0]);
   }
   return tris;
 }

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "host/gltf_export.h"
 #include "host/gltf_loader.h"
 #include "host/scene.h"
 
@@ -369,6 +370,24 @@ TEST(SceneDegenerate, ZeroAreaAndRelativelyTinyTrianglesAreMarked) {
 
 // ---- bad input: small glTF files written into a temporary directory ---------------------------
 
+std::string base64_encode(const std::vector<unsigned char>& in) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  std::size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    const unsigned v = (in[i] << 16) | (in[i + 1] << 8) | in[i + 2];
+    out += {t[(v >> 18) & 63], t[(v >> 12) & 63], t[(v >> 6) & 63], t[v & 63]};
+  }
+  if (i + 1 == in.size()) {
+    const unsigned v = in[i] << 16;
+    out += {t[(v >> 18) & 63], t[(v >> 12) & 63], '=', '='};
+  } else if (i + 2 == in.size()) {
+    const unsigned v = (in[i] << 16) | (in[i + 1] << 8);
+    out += {t[(v >> 18) & 63], t[(v >> 12) & 63], t[(v >> 6) & 63], '='};
+  }
+  return out;
+}
+
 class BadGltf : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -386,23 +405,7 @@ class BadGltf : public ::testing::Test {
     return p;
   }
 
-  static std::string base64(const std::vector<unsigned char>& in) {
-    static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    std::size_t i = 0;
-    for (; i + 2 < in.size(); i += 3) {
-      const unsigned v = (in[i] << 16) | (in[i + 1] << 8) | in[i + 2];
-      out += {t[(v >> 18) & 63], t[(v >> 12) & 63], t[(v >> 6) & 63], t[v & 63]};
-    }
-    if (i + 1 == in.size()) {
-      const unsigned v = in[i] << 16;
-      out += {t[(v >> 18) & 63], t[(v >> 12) & 63], '=', '='};
-    } else if (i + 2 == in.size()) {
-      const unsigned v = (in[i] << 16) | (in[i + 1] << 8);
-      out += {t[(v >> 18) & 63], t[(v >> 12) & 63], t[(v >> 6) & 63], '='};
-    }
-    return out;
-  }
+  static std::string base64(const std::vector<unsigned char>& in) { return base64_encode(in); }
 
   // A one-mesh glTF whose buffer holds `positions` (float xyz), drawn non-indexed with `mode`;
   // `extra` is spliced into the top-level object.
@@ -501,6 +504,129 @@ TEST_F(BadGltf, AccessorPastTheBufferIsRefused) {
   text.replace(text.find(from), from.size(), "\"count\":4,");
   const std::string e = error_of(write("short.gltf", text));
   EXPECT_NE(e.find("reads past the end of its buffer view"), std::string::npos) << e;
+}
+
+// ---- features the manifest models do not exercise ---------------------------------------------
+
+// Positions (float xyz) followed by an index block of the given component type, all in one
+// embedded buffer; one primitive with `mode`.
+std::string indexed_gltf(const std::vector<float>& positions,
+                         const std::vector<std::uint32_t>& indices, int component_type, int mode,
+                         const std::string& accessor_extra = "") {
+  std::vector<unsigned char> bytes(positions.size() * 4);
+  std::memcpy(bytes.data(), positions.data(), bytes.size());
+  const std::size_t index_offset = bytes.size();
+  for (std::uint32_t i : indices) {
+    const int size = component_type == 5121 ? 1 : component_type == 5123 ? 2 : 4;
+    for (int b = 0; b < size; ++b)
+      bytes.push_back(static_cast<unsigned char>(i >> (8 * b)));
+  }
+  while (bytes.size() % 4 != 0)
+    bytes.push_back(0);
+  const std::string n = std::to_string(positions.size() / 3);
+  return R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+         R"("meshes":[{"name":"probe","primitives":[{"attributes":{"POSITION":0},"indices":1,"mode":)" +
+         std::to_string(mode) +
+         R"(}]}],"accessors":[{"bufferView":0,"componentType":5126,"count":)" + n +
+         R"(,"type":"VEC3")" + accessor_extra + R"(},{"bufferView":1,"componentType":)" +
+         std::to_string(component_type) + R"(,"count":)" + std::to_string(indices.size()) +
+         R"(,"type":"SCALAR"}],"bufferViews":[{"buffer":0,"byteLength":)" +
+         std::to_string(index_offset) + R"(},{"buffer":0,"byteOffset":)" +
+         std::to_string(index_offset) + R"(,"byteLength":)" +
+         std::to_string(bytes.size() - index_offset) + R"(}],"buffers":[{"byteLength":)" +
+         std::to_string(bytes.size()) + R"(,"uri":"data:application/octet-stream;base64,)" +
+         base64_encode(bytes) + "\"}]}";
+}
+
+const std::vector<float> kQuad = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+
+TEST_F(BadGltf, IndicesOfEightSixteenAndThirtyTwoBits) {
+  const std::vector<std::uint32_t> idx = {0, 1, 2, 0, 2, 3};
+  for (int type : {5121, 5123, 5125}) {
+    SCOPED_TRACE(type);
+    const Scene s = load_scene(
+        write("idx" + std::to_string(type) + ".gltf", indexed_gltf(kQuad, idx, type, 4)));
+    ASSERT_EQ(s.objects[0].triangles.size(), 2u);
+    EXPECT_EQ(s.objects[0].triangles[1], glm::uvec3(0, 2, 3));
+  }
+  const std::string e = error_of(write("oob.gltf", indexed_gltf(kQuad, {0, 1, 4}, 5123, 4)));
+  EXPECT_NE(e.find("accessor 1 (indices) entry 2 = 4 is not below the 4 vertices"),
+            std::string::npos)
+      << e;
+}
+
+TEST_F(BadGltf, StripsAndFansBecomeTriangles) {
+  const Scene strip = load_scene(write("strip.gltf", indexed_gltf(kQuad, {0, 1, 3, 2}, 5123, 5)));
+  EXPECT_EQ(strip.objects[0].triangles,
+            (std::vector<glm::uvec3>{{0, 1, 3}, {1, 2, 3}}));  // glTF's order
+  const Scene fan = load_scene(write("fan.gltf", indexed_gltf(kQuad, {0, 1, 2, 3}, 5123, 6)));
+  EXPECT_EQ(fan.objects[0].triangles, (std::vector<glm::uvec3>{{1, 2, 0}, {2, 3, 0}}));
+}
+
+TEST_F(BadGltf, SparseAccessorReplacesVertices) {
+  // Vertex 3 of kQuad moved to (5, 5, 5) by a one-entry sparse block stored after the indices:
+  // sparse index (u16 3, padded to 4 bytes), then the value (3 floats).
+  std::vector<unsigned char> bytes(kQuad.size() * 4);
+  std::memcpy(bytes.data(), kQuad.data(), bytes.size());
+  for (std::uint16_t i : {0, 1, 2, 0, 2, 3}) {
+    bytes.push_back(static_cast<unsigned char>(i));
+    bytes.push_back(static_cast<unsigned char>(i >> 8));
+  }
+  const std::size_t sparse_idx = bytes.size();
+  bytes.push_back(3);
+  bytes.push_back(0);
+  bytes.push_back(0);
+  bytes.push_back(0);
+  const std::size_t sparse_val = bytes.size();
+  const float v[3] = {5, 5, 5};
+  bytes.insert(bytes.end(), reinterpret_cast<const unsigned char*>(v),
+               reinterpret_cast<const unsigned char*>(v) + 12);
+  const std::string text =
+      R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+      R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+      R"("accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3",)"
+      R"("sparse":{"count":1,"indices":{"bufferView":2,"componentType":5123},"values":{"bufferView":3}}},)"
+      R"({"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}],)"
+      R"("bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12},)"
+      R"({"buffer":0,"byteOffset":)" +
+      std::to_string(sparse_idx) + R"(,"byteLength":2},{"buffer":0,"byteOffset":)" +
+      std::to_string(sparse_val) + R"(,"byteLength":12}],"buffers":[{"byteLength":)" +
+      std::to_string(bytes.size()) + R"(,"uri":"data:application/octet-stream;base64,)" +
+      base64_encode(bytes) + "\"}]}";
+  const Scene s = load_scene(write("sparse.gltf", text));
+  ASSERT_EQ(s.objects[0].positions.size(), 4u);
+  EXPECT_EQ(s.objects[0].positions[3], glm::vec3(5, 5, 5));
+  EXPECT_EQ(s.objects[0].positions[2], glm::vec3(1, 1, 0));
+}
+
+TEST_F(BadGltf, DataUriImageAndPointLight) {
+  Texture t;
+  t.name = "probe";
+  t.width = 4;
+  t.height = 2;
+  for (std::uint32_t i = 0; i < 8; ++i)
+    t.rgba.push_back(0xFF000000u | (i * 30u) | ((255u - i * 30u) << 8));
+  const std::vector<unsigned char> png = encode_png(t);
+  const std::string extra =
+      R"(,"images":[{"uri":"data:image/png;base64,)" + base64_encode(png) +
+      R"("}],"textures":[{"source":0}],"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],)"
+      R"("extensionsUsed":["KHR_lights_punctual"],"extensions":{"KHR_lights_punctual":{"lights":[)"
+      R"({"type":"point","color":[1,0.5,0.25],"intensity":0.5}]}})";
+  std::string text = gltf(kTri, 4, "", extra);
+  // A second root node carries the light, 2 units up.
+  text.replace(text.find(R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}])"),
+               std::strlen(R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}])"),
+               R"("scenes":[{"nodes":[0,1]}],"nodes":[{"mesh":0},)"
+               R"({"translation":[0,2,0],"extensions":{"KHR_lights_punctual":{"light":0}}}])");
+  const Scene s = load_scene(write("datauri.gltf", text));
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].name, "embedded:0");
+  EXPECT_EQ(s.textures[0].rgba, t.rgba);
+  EXPECT_EQ(s.materials.at(0).texture, 0);
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_FALSE(s.light_defaulted);
+  EXPECT_EQ(s.lights[0].position, glm::vec3(0, 2, 0));
+  EXPECT_EQ(s.lights[0].color, glm::vec3(0.5f, 0.25f, 0.125f));
 }
 
 TEST_F(BadGltf, UnknownBuiltinListsTheKnownOnes) {
