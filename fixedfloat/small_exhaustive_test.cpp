@@ -94,6 +94,26 @@ TEST(SmallOracle, KnownResults) {
   }
 }
 
+// The harness must be able to fail: a unit in the wrong mode disagrees with the oracle on a large
+// share of the pairs (truncation vs nearest-even, keep vs flush).
+TEST(SmallOracle, HarnessDetectsAWrongMode) {
+  const Format f = F45::kFormat;
+  MpfrOracle oracle(f, kAllModes[0]);  // rne/flush
+  const FpUnit<F45> truncating(kAllModes[2]);
+  const FpUnit<F45> keeping(kAllModes[1]);
+  std::uint64_t rounding_diffs = 0;
+  std::uint64_t subnormal_diffs = 0;
+  for (std::uint32_t a = 0; a < kEncodings; ++a) {
+    for (std::uint32_t b = 0; b < kEncodings; b += 7) {
+      const std::uint32_t want = oracle.eval(Op::kMul, a, b);
+      rounding_diffs += eval_unit(truncating, Op::kMul, a, b) != want;
+      subnormal_diffs += eval_unit(keeping, Op::kMul, a, b) != want;
+    }
+  }
+  EXPECT_GT(rounding_diffs, 10'000u);
+  EXPECT_GT(subnormal_diffs, 1'000u);
+}
+
 std::string mode_param_name(const ::testing::TestParamInfo<int>& info) {
   std::string s = mode_name(kAllModes[info.param]);
   s[3] = '_';
