@@ -267,9 +267,10 @@ void Builder::start(std::size_t items) {
   side_.assign(items, kBoth);
   for (auto& a : ev_) {
     a.top_ = 0;
-    // Room for the initial lists plus the children stacked above them (about twice, with
-    // straddling duplicates); the arena grows if that is not enough.
-    a.ensure(std::max<std::size_t>(64, items * 2 * 4));
+    // Room for the initial lists (up to 2 events per item) and, stacked above them, the lists
+    // along the recursion path (about 2 + 1 + 1/2 + ... times the initial ones, plus straddling
+    // duplicates): 12 per item. Untouched pages cost nothing; growing copies everything.
+    a.ensure(std::max<std::size_t>(64, items * 12));
   }
   for (int k = 0; k < 3; ++k) {
     root_.lo[k] = std::numeric_limits<float>::infinity();
@@ -693,6 +694,9 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     }
     both_.resize(nb);
   }
+  // Items on one side only (each has at least one event per axis on that side alone).
+  const std::uint32_t left_only = n_left;
+  const std::uint32_t right_only = n_right;
 
   Box lbox = box;
   Box rbox = box;
@@ -775,8 +779,11 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     std::sort(new_right_[j].begin(), new_right_[j].end());
     const std::size_t m = e[j] - b[j];
     Arena& a = ev_[j];
-    const std::size_t cap_left = m + new_left_[j].size();
-    const std::size_t cap_right = m + new_right_[j].size();
+    // Bounds for the children's lists: the parent's minus at least one event per item of the
+    // other side, plus the new ones, plus one slot that the branch-free filter may write past
+    // the last kept event.
+    const std::size_t cap_left = m - right_only + new_left_[j].size() + 1;
+    const std::size_t cap_right = m - left_only + new_right_[j].size() + 1;
     a.ensure(a.top_ + cap_left + cap_right);
     Key* base = a.data();
     lb[j] = a.top_;
