@@ -267,6 +267,35 @@ FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene&
   return r;
 }
 
+// ---- cycle model (testbench/cycle_render.h) -----------------------------------------------------
+
+FrameResult render_cycle_frame(const ModelSpec& model, const PreparedScene& prep,
+                               const RenderSettings& settings) {
+  FrameResult r;
+  r.model = model.name;
+  const auto t0 = Clock::now();
+  const units::CycleFrame c =
+      run_cycle_render(prep.built.image, functional_params(settings), settings.cycle);
+  r.seconds = seconds_since(t0);
+  r.hits.width = c.frame.width;
+  r.hits.height = c.frame.height;
+  r.hits.pixels.resize(c.frame.pixels.size());
+  for (std::size_t i = 0; i < c.frame.pixels.size(); ++i)
+    r.hits.pixels[i] = functional_pixel_hit(c.frame.pixels[i], c.frame.format, prep.built);
+  r.image.width = c.frame.width;
+  r.image.height = c.frame.height;
+  r.image.rgb = c.frame.rgb;
+  r.rays = c.rays;
+  r.cycle = cycle_report_json(c);
+  r.table4 = table4_text(c, prep.spec);
+  r.counters["per_ray"] = r.cycle["per_ray"];
+  r.counters["ops"] = {{"traversal", ops_json(c.frame.units.traversal_ops)},
+                       {"transformation", ops_json(c.frame.units.transformation_ops)},
+                       {"intersection", ops_json(c.frame.units.intersection_ops)},
+                       {"rgs", ops_json(c.frame.units.rgs_ops)}};
+  return r;
+}
+
 void check_functional_format(const ModelSpec& model, const PreparedScene& prep) {
   const ff::Format want{7, model.mantissa};
   if (!(prep.built.params.format == want)) {
@@ -331,11 +360,12 @@ ModelSpec parse_model(const std::string& name) {
     return m;
   }
   if (name == "cycle") {
-    throw std::runtime_error(
-        "model 'cycle' is not available yet (the cycle model comes in a later issue); use "
-        "--model float or --model fp24");
+    m.kind = ModelKind::kCycle;
+    m.mantissa = 16;
+    return m;
   }
-  throw std::runtime_error("unknown model '" + name + "': expected float, fp24, or e7m10..e7m23");
+  throw std::runtime_error("unknown model '" + name +
+                           "': expected float, fp24, e7m10..e7m23, or cycle");
 }
 
 PreparedScene prepare_scene(const std::string& spec, const RenderSettings& settings,
@@ -384,7 +414,8 @@ FrameResult render_model(const ModelSpec& model, const PreparedScene& prep,
       check_functional_format(model, prep);
       return render_functional_frame(model, prep, settings);
     case ModelKind::kCycle:
-      break;
+      check_functional_format(model, prep);
+      return render_cycle_frame(model, prep, settings);
   }
   throw std::runtime_error("model '" + model.name + "' is not available yet");
 }
@@ -400,8 +431,14 @@ PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prep,
           units::trace_pixel(prep.built.image, functional_params(settings), pixel.x, pixel.y);
       return functional_pixel_hit(t.pixel, prep.built.params.format, prep.built);
     }
-    case ModelKind::kCycle:
-      break;
+    case ModelKind::kCycle: {
+      // The cycle model runs whole frames: the pixel's record from the frame (bit-identical to
+      // the fp24 model's replay by construction).
+      const FrameResult f = render_model(model, prep, settings);
+      return f.hits.pixels[static_cast<std::size_t>(pixel.y) *
+                               static_cast<std::size_t>(f.hits.width) +
+                           static_cast<std::size_t>(pixel.x)];
+    }
   }
   throw std::runtime_error("model '" + model.name + "' is not available yet");
 }
@@ -438,6 +475,12 @@ int run_render(const RenderOptions& opts) {
   settings.shadows = opts.shadows;
   settings.depth = opts.depth;
   settings.bank_mb = opts.bank_mb;
+  settings.cycle = opts.cycle;
+  if (model.kind == ModelKind::kCycle) {
+    resolve_cycle_params(opts.cycle);  // a bad --preset/--set fails before the scene loads
+  } else if (opts.cycle.any_given()) {
+    throw std::runtime_error("--preset, --set, --interval and --vcd apply to --model cycle only");
+  }
   std::optional<PixelCoord> pixel;
   if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
   if (opts.out.empty()) throw std::runtime_error("bad --out '': expected a file prefix");
@@ -452,8 +495,7 @@ int run_render(const RenderOptions& opts) {
     throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
   }
 
-  const ff::Format format =
-      model.kind == ModelKind::kFunctional ? ff::Format{7, model.mantissa} : ff::kFp24;
+  const ff::Format format = model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
   const PreparedScene prep = prepare_scene(opts.scene, settings, format);
 
   if (pixel) {
@@ -506,6 +548,12 @@ int run_render(const RenderOptions& opts) {
                           {"light_defaulted", prep.scene.light_defaulted},
                           {"load_seconds", prep.load_seconds},
                           {"build_seconds", prep.build_seconds}};
+    if (!frame.cycle.is_null()) {  // the cycle model's figures at the top, its parameters inside
+      nlohmann::json c = frame.cycle;
+      j["configuration"]["cycle"] = c["configuration"];
+      c.erase("configuration");
+      j.update(c);
+    }
     nlohmann::json out;
     for (const auto& [k, v] : outputs)
       out[k] = v;
@@ -518,6 +566,7 @@ int run_render(const RenderOptions& opts) {
               frame.seconds, frame.rays, rays_per_s);
   for (const auto& [k, v] : outputs)
     std::printf("  %-10s %s\n", (k + ":").c_str(), v.c_str());
+  if (!frame.table4.empty()) std::printf("%s", frame.table4.c_str());
   return 0;
 }
 

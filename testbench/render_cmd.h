@@ -11,6 +11,7 @@
 #include "fixedfloat/format.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "testbench/cycle_render.h"
 #include "testbench/hit_buffer.h"
 
 namespace saarcor {
@@ -35,8 +36,7 @@ struct ModelSpec {
   int mantissa = 16;  // functional model: Float<7, mantissa>
   std::string name = "fp24";
 };
-// "float", "fp24" (= "e7m16"), "e7m<M>" (Float<7,M>, M = 10..23). "cycle" throws "not available
-// yet" until the cycle model exists.
+// "float", "fp24" (= "e7m16"), "e7m<M>" (Float<7,M>, M = 10..23), "cycle" (the cycle model, fp24).
 ModelSpec parse_model(const std::string& name);
 inline constexpr int kMinMantissa = 10;
 inline constexpr int kMaxMantissa = 23;
@@ -47,6 +47,7 @@ struct RenderSettings {
   bool shadows = false;  // shadow rays (docs/shading.md section 6)
   int depth = 0;         // secondary rays (reflection, transparency) up to this depth; 0 = none
   double bank_mb = 4.0;  // SRAM bank size of the memory image (the prototype: 4 MB)
+  CycleRenderOptions cycle;  // --model cycle: preset, --set overrides, --interval, --vcd
 };
 
 // The scene loaded, set to the time, with its memory image built in `format`.
@@ -73,6 +74,8 @@ struct FrameResult {
   double seconds = 0.0;     // the model's run time (wall clock)
   std::uint64_t rays = 0;   // rays traced (primary, plus shadow and secondary when on)
   nlohmann::json counters;  // per-ray counters and op counts, totals and per ray
+  nlohmann::json cycle;     // --model cycle: the per-frame report (cycle_report_json)
+  std::string table4;       // --model cycle: the Table 4 printout
 };
 
 // Runs the model on a prepared scene. The functional model needs the image built in
@@ -98,6 +101,7 @@ struct RenderOptions {
   bool shadows = false;
   int depth = 0;
   double bank_mb = 4.0;
+  CycleRenderOptions cycle;
 };
 
 // Returns 0; throws std::runtime_error with one line on bad input.

@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
     auto* sub = app.add_subcommand(
         "render", "render one frame with a model; write PNG, EXR, hit EXR, report");
     sub->add_option("scene", render_opts.scene, "glTF file or builtin:NAME")->required();
-    sub->add_option("--model", render_opts.model, "float | fp24 | e7m10..e7m23 (cycle: later)")
+    sub->add_option("--model", render_opts.model, "float | fp24 | e7m10..e7m23 | cycle")
         ->capture_default_str();
     sub->add_option("--res", render_opts.res, "resolution WxH")->capture_default_str();
     sub->add_option("--time", render_opts.time, "animation time in seconds");
@@ -83,6 +83,17 @@ int main(int argc, char** argv) {
     sub->add_flag("--shadows", render_opts.shadows, "shadow rays");
     sub->add_option("--depth", render_opts.depth, "secondary-ray depth (0 = primary only)");
     sub->add_option("--bank-mb", render_opts.bank_mb, "SRAM bank size in MB")
+        ->capture_default_str();
+    // --model cycle (testbench/cycle_render.h)
+    sub->add_option("--preset", render_opts.cycle.preset, "cycle model preset (prototype, table2)")
+        ->capture_default_str();
+    sub->add_option("--set", render_opts.cycle.set,
+                    "cycle model parameter KEY=VALUE (repeatable; docs/cycle-model.md)");
+    sub->add_option("--interval", render_opts.cycle.interval,
+                    "cycle model: sample the figures every N cycles into the report");
+    sub->add_option("--vcd", render_opts.cycle.vcd, "cycle model: write a VCD trace");
+    sub->add_option("--vcd-from", render_opts.cycle.vcd_from, "first cycle of the VCD trace");
+    sub->add_option("--vcd-to", render_opts.cycle.vcd_to, "last cycle of the VCD trace")
         ->capture_default_str();
     sub->callback([&] { status = saarcor::run_render(render_opts); });
   }

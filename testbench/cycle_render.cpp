@@ -1,0 +1,203 @@
+// `saarcor render --model cycle`: options, report, Table 4 printout (docs/cycle-model.md).
+#include "testbench/cycle_render.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace saarcor {
+
+units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
+  units::CycleParams p = units::cycle_preset(opts.preset);
+  for (const std::string& kv : opts.set)
+    units::apply_cycle_setting(p, kv);
+  units::check_cycle_params(p);
+  if (!opts.vcd.empty() && opts.vcd_to < opts.vcd_from)
+    throw std::runtime_error("bad --vcd-to " + std::to_string(opts.vcd_to) +
+                             ": before --vcd-from " + std::to_string(opts.vcd_from));
+  return p;
+}
+
+units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
+                                   const units::FunctionalParams& shading,
+                                   const CycleRenderOptions& opts) {
+  const units::CycleParams p = resolve_cycle_params(opts);
+  units::CycleRunOptions ro;
+  ro.shading = shading;
+  ro.interval = opts.interval;
+  if (isatty(fileno(stderr)))
+    ro.progress = [](std::uint64_t cycles, int done, int total) {
+      std::fprintf(stderr, "\r  cycle %llu, packets %d / %d",
+                   static_cast<unsigned long long>(cycles), done, total);
+      if (done == total) std::fprintf(stderr, "\n");
+    };
+  std::ofstream vcd;
+  if (!opts.vcd.empty()) {
+    vcd.open(opts.vcd, std::ios::binary);
+    if (!vcd) throw std::runtime_error("cannot write --vcd '" + opts.vcd + "'");
+    ro.vcd = &vcd;
+    ro.vcd_from = opts.vcd_from;
+    ro.vcd_to = opts.vcd_to;
+  }
+  try {
+    units::CycleFrame f = units::run_cycle(image, p, ro);
+    if (!opts.vcd.empty()) {
+      vcd.close();
+      if (!vcd) throw std::runtime_error("cannot write --vcd '" + opts.vcd + "'");
+    }
+    return f;
+  } catch (...) {
+    if (!opts.vcd.empty()) {
+      vcd.close();
+      std::error_code ec;
+      std::filesystem::remove(opts.vcd, ec);
+    }
+    throw;
+  }
+}
+
+namespace {
+
+nlohmann::json figures_json(const units::CycleFigures& f) {
+  nlohmann::json j;
+  for (int i = 0; i < units::kTable4Units; ++i)
+    j["usage"][units::kTable4UnitNames[i]] = f.usage[static_cast<std::size_t>(i)];
+  for (int c = 0; c < units::kCacheUnits; ++c)
+    j["cache_hit"][units::cache_unit_name(units::CacheUnit(c))] =
+        f.cache_hit[static_cast<std::size_t>(c)];
+  j["bandwidth_mb_s"] = {{"dynrtc", f.bw_dynrtc}, {"shading", f.bw_shading}, {"total", f.bw_total}};
+  return j;
+}
+
+double per(std::uint64_t a, std::uint64_t b) {
+  return b == 0 ? 0.0 : static_cast<double>(a) / static_cast<double>(b);
+}
+
+}  // namespace
+
+nlohmann::json cycle_report_json(const units::CycleFrame& c) {
+  nlohmann::json j = figures_json(c.figures);
+  j["cycles"] = c.cycles;
+  j["fps"] = c.fps;
+  j["rays"] = c.rays;
+  j["rays_per_s"] = c.rays_per_s;
+  j["packets"] = c.packets;
+  j["cycles_per_packet"] = per(c.cycles, c.packets);
+  j["per_ray"] = {{"traversal_steps", per(c.per_ray_sum.traversal_steps, c.rays)},
+                  {"list_entries", per(c.per_ray_sum.list_entries, c.rays)},
+                  {"mailbox_skips", per(c.per_ray_sum.mailbox_skips, c.rays)},
+                  {"transformations", per(c.per_ray_sum.transformations, c.rays)},
+                  {"intersections", per(c.per_ray_sum.intersections, c.rays)}};
+  j["simd_efficiency"] = c.simd_efficiency;
+  j["host"] = {{"seconds", c.host_seconds},
+               {"sim_cycles_per_s", c.sim_cycles_per_s},
+               {"skipped_cycles", c.skipped_cycles}};
+  nlohmann::json units;
+  for (int i = 0; i < units::kTable4Units; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    units[units::kTable4UnitNames[i]] = {{"issue_cycles", c.issue_cycles[k]},
+                                         {"stall_cycles", c.stall_cycles[k]},
+                                         {"requests", c.requests[k]}};
+  }
+  j["units"] = units;
+  nlohmann::json caches;
+  for (int i = 0; i < units::kCacheUnits; ++i) {
+    const auto& cc = c.caches[static_cast<std::size_t>(i)];
+    caches[units::cache_unit_name(units::CacheUnit(i))] = {{"requests", cc.requests},
+                                                           {"hits", cc.hits},
+                                                           {"merges", cc.merges},
+                                                           {"misses", cc.misses},
+                                                           {"mem_bytes", cc.mem_bytes}};
+  }
+  j["caches"] = caches;
+  const units::UnitStats& u = c.frame.units;
+  j["ops"]["traversal_to_intersection"] = per(u.traversal_ops.total(), u.intersection_ops.total());
+  nlohmann::json conf;
+  for (const units::CycleParamInfo& p : units::describe(c.params))
+    conf[p.name] = {{"value", p.value}, {"unit", p.unit}, {"help", p.help}};
+  conf["depth.traversal"] = c.params.traversal_depth();
+  conf["depth.list"] = c.params.list_depth();
+  conf["depth.transformation"] = c.params.transformation_depth();
+  conf["depth.intersection"] = c.params.intersection_depth();
+  j["configuration"] = conf;
+  if (!c.series.empty()) {
+    nlohmann::json s = nlohmann::json::array();
+    for (const units::CycleFigures& f : c.series) {
+      nlohmann::json e = figures_json(f);
+      e["cycle"] = f.cycle;
+      s.push_back(e);
+    }
+    j["time_series"] = s;
+  }
+  return j;
+}
+
+const std::vector<Table4Row>& paper_table4() {
+  static const std::vector<Table4Row> rows = {
+      {"Scene6", 15.3, {68, 16, 85, 41}, {99, 97, 99}, {8, 218, 226}},
+      {"Castle", 5.9, {73, 18, 74, 48}, {99, 82, 94}, {50, 138, 188}},
+      {"Office", 12.4, {76, 16, 72, 36}, {99, 71, 90}, {69, 246, 246}},
+      {"Quake3", 8.5, {87, 15, 45, 21}, {99, 49, 79}, {104, 197, 301}},
+      {"Quake3-p", 6.8, {92, 13, 35, 16}, {99, 66, 82}, {65, 157, 222}},
+      {"UT2003", 6.5, {82, 19, 66, 42}, {98, 63, 86}, {105, 152, 257}},
+      {"Conference", 5.7, {89, 25, 51, 28}, {98, 63, 78}, {135, 132, 267}},
+      {"Terrain", 4.2, {80, 27, 34, 18}, {97, 27, 43}, {283, 98, 381}},
+      {"SunCOR", 8.7, {46, 36, 29, 12}, {90, 2, 6}, {513, 202, 715}},
+  };
+  return rows;
+}
+
+const Table4Row* paper_row_for(const std::string& scene) {
+  const std::string name = scene == "builtin:room"      ? "Scene6"
+                           : scene == "builtin:suncor"  ? "SunCOR"
+                           : scene == "builtin:terrain" ? "Terrain"
+                                                        : "";
+  for (const Table4Row& r : paper_table4())
+    if (name == r.scene) return &r;
+  return nullptr;
+}
+
+std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
+  std::string s;
+  char buf[512];
+  s += "Table 4 layout (paper: 1024x768, 90 MHz, 1 DynRTP, 64 threads)\n";
+  s +=
+      "                       |        | usage %             | cache hit %    | bandwidth MB/s     "
+      "| cycles/ | Mrays\n";
+  s +=
+      "scene                  |    fps | trav list xfrm  int | trav list xfrm | dynrtc shade total "
+      "| packet  | /s\n";
+  const auto& f = c.figures;
+  std::snprintf(buf, sizeof buf,
+                "%-22s | %6.1f | %4.0f %4.0f %4.0f %4.0f | %4.0f %4.0f %4.0f | %6.0f %5.0f %5.0f "
+                "| %7.1f | %5.2f\n",
+                ("model " + scene).substr(0, 22).c_str(), c.fps, f.usage[0], f.usage[1], f.usage[2],
+                f.usage[3], f.cache_hit[0], f.cache_hit[1], f.cache_hit[2], f.bw_dynrtc,
+                f.bw_shading, f.bw_total, per(c.cycles, c.packets), c.rays_per_s / 1e6);
+  s += buf;
+  if (const Table4Row* r = paper_row_for(scene)) {
+    // The paper's cycles per packet and rays/s follow from its fps at 1024x768 and 4-ray packets.
+    const double rays = r->fps * 1024.0 * 768.0;
+    std::snprintf(buf, sizeof buf,
+                  "%-22s | %6.1f | %4.0f %4.0f %4.0f %4.0f | %4.0f %4.0f %4.0f | %6.0f %5.0f %5.0f "
+                  "| %7.1f | %5.2f\n",
+                  (std::string("paper ") + r->scene).c_str(), r->fps, r->usage[0], r->usage[1],
+                  r->usage[2], r->usage[3], r->hit[0], r->hit[1], r->hit[2], r->bw[0], r->bw[1],
+                  r->bw[2], 90e6 / (rays / 4.0), rays / 1e6);
+    s += buf;
+  }
+  const units::UnitStats& u = c.frame.units;
+  std::snprintf(buf, sizeof buf,
+                "per ray: %.2f traversal steps, %.2f list entries, %.2f mailbox skips, %.2f "
+                "intersections; SIMD efficiency %.2f; traversal/intersection ops %.2f\n",
+                per(c.per_ray_sum.traversal_steps, c.rays), per(c.per_ray_sum.list_entries, c.rays),
+                per(c.per_ray_sum.mailbox_skips, c.rays), per(c.per_ray_sum.intersections, c.rays),
+                c.simd_efficiency, per(u.traversal_ops.total(), u.intersection_ops.total()));
+  s += buf;
+  return s;
+}
+
+}  // namespace saarcor

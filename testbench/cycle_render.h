@@ -1,0 +1,56 @@
+// `saarcor render --model cycle` (issue 6; DESIGN.md section 9 model 3): the cycle model's options
+// (--preset, --set KEY=VALUE, --interval, --vcd), its per-frame JSON report and the printout in
+// the layout of the paper's Table 4 (docs/cycle-model.md).
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "memif/image_format.h"
+#include "units/dynrtp.h"
+
+namespace saarcor {
+
+struct CycleRenderOptions {
+  std::string preset = "prototype";
+  std::vector<std::string> set;  // KEY=VALUE overrides, applied in order after the preset
+  std::uint64_t interval = 0;    // != 0: figures sampled every this many cycles
+  std::string vcd;               // VCD file of cycles [vcd_from, vcd_to]
+  std::uint64_t vcd_from = 0;
+  std::uint64_t vcd_to = 10000;
+  bool any_given() const {
+    return preset != "prototype" || !set.empty() || interval != 0 || !vcd.empty();
+  }
+};
+
+// The preset with the overrides applied and checked; throws one line naming the bad key.
+units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts);
+
+// Runs the cycle model on the image (VCD written when asked; no partial VCD file on error).
+units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
+                                   const units::FunctionalParams& shading,
+                                   const CycleRenderOptions& opts);
+
+// The per-frame report: cycles, fps, rays, rays_per_s, usage, cache_hit, bandwidth_mb_s, per_ray,
+// simd_efficiency, host, configuration, (time_series).
+nlohmann::json cycle_report_json(const units::CycleFrame& frame);
+
+// One row of the paper's Table 4 (1024x768, 90 MHz, one DynRTP, 64 threads).
+struct Table4Row {
+  const char* scene;
+  double fps;
+  double usage[4];  // traversal, list, transformation, intersection (%)
+  double hit[3];    // traversal, list, transformation (%)
+  double bw[3];     // DynRTC, shading, total (MB/s)
+};
+const std::vector<Table4Row>& paper_table4();
+// The paper's row to show beside a scene ("builtin:room" -> Scene6), or nullptr.
+const Table4Row* paper_row_for(const std::string& scene);
+
+// The model's figures as a Table 4 row (with cycles per packet and rays/s, which do not depend on
+// the resolution), and the paper's row beneath when there is one.
+std::string table4_text(const units::CycleFrame& frame, const std::string& scene);
+
+}  // namespace saarcor

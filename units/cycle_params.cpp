@@ -1,0 +1,196 @@
+// The cycle model's parameter table and presets (docs/cycle-model.md "Parameters").
+#include "units/cycle_params.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace saarcor::units {
+namespace {
+
+struct Binding {
+  CycleParamInfo info;
+  double (*get)(const CycleParams&);
+  void (*set)(CycleParams&, double);
+};
+
+#define SAARCOR_FIELD(expr, type)                                   \
+  [](const CycleParams& p) { return static_cast<double>(p.expr); }, \
+      [](CycleParams& p, double v) { p.expr = static_cast<type>(v); }
+
+const std::vector<Binding>& bindings() {
+  static const std::vector<Binding> table = {
+      {{"threads", 64, "threads", "threads (packets in flight) per DynRTP (D24)", 1, 4096, false},
+       SAARCOR_FIELD(threads, int)},
+      {{"packet", 4, "rays", "rays per packet, a power of two (D24)", 1, 64, true},
+       SAARCOR_FIELD(packet, int)},
+      {{"stack", 64, "entries", "traversal stack entries per packet (D26)", 1, 4096, false},
+       SAARCOR_FIELD(stack, int)},
+      {{"mailbox", 8, "entries", "object mailbox entries per thread, 0 = off (D28)", 0, 64, false},
+       SAARCOR_FIELD(mailbox, int)},
+      {{"shared_origin", 1, "bool", "n+1 transformation steps for shared-origin packets (D31)", 0,
+        1, false},
+       SAARCOR_FIELD(shared_origin, bool)},
+      {{"cache.traversal.items", 512, "items", "kd-node cache lines (D20)", 1, 1 << 20, true},
+       SAARCOR_FIELD(cache[0].items, int)},
+      {{"cache.traversal.ways", 1, "ways", "kd-node cache associativity", 1, 64, false},
+       SAARCOR_FIELD(cache[0].ways, int)},
+      {{"cache.list.items", 512, "items", "list-entry cache lines (D20)", 1, 1 << 20, true},
+       SAARCOR_FIELD(cache[1].items, int)},
+      {{"cache.list.ways", 1, "ways", "list-entry cache associativity", 1, 64, false},
+       SAARCOR_FIELD(cache[1].ways, int)},
+      {{"cache.transformation.items", 512, "items", "matrix-row cache lines (D20)", 1, 1 << 20,
+        true},
+       SAARCOR_FIELD(cache[2].items, int)},
+      {{"cache.transformation.ways", 1, "ways", "matrix-row cache associativity", 1, 64, false},
+       SAARCOR_FIELD(cache[2].ways, int)},
+      {{"cache.hit_latency", 2, "cycles", "cache hit: request push to response", 2, 64, false},
+       SAARCOR_FIELD(cache_hit_latency, int)},
+      {{"cache.misses", 8, "misses", "outstanding misses per cache (MSHRs, D20)", 1, 256, false},
+       SAARCOR_FIELD(cache_misses, int)},
+      {{"mem.latency", 4, "cycles", "SRAM read latency (D21)", 1, 1000, false},
+       SAARCOR_FIELD(mem_latency, int)},
+      {{"mem.switch_penalty", 1, "cycles", "bank switch penalty on a shared path (D21)", 0, 100,
+        false},
+       SAARCOR_FIELD(mem_switch_penalty, int)},
+      {{"lat.add", 3, "cycles", "fp adder latency (D7)", 1, 64, false},
+       SAARCOR_FIELD(lat_add, int)},
+      {{"lat.mul", 3, "cycles", "fp multiplier latency (D7)", 1, 64, false},
+       SAARCOR_FIELD(lat_mul, int)},
+      {{"lat.div", 8, "cycles", "fp divider latency", 1, 64, false}, SAARCOR_FIELD(lat_div, int)},
+      {{"lat.cmp", 1, "cycles", "fp comparator latency (D7)", 1, 64, false},
+       SAARCOR_FIELD(lat_cmp, int)},
+      {{"clock_mhz", 90, "MHz", "modelled clock (the prototype's 90 MHz)", 0.001, 100000, false},
+       SAARCOR_FIELD(clock_mhz, double)},
+      {{"watchdog", 100000, "cycles", "cycles without progress that stop a run", 1, 1e12, false},
+       SAARCOR_FIELD(watchdog, std::uint64_t)},
+  };
+  return table;
+}
+#undef SAARCOR_FIELD
+
+// Presets are data: named overrides of the table's defaults.
+struct Preset {
+  const char* name;
+  const char* help;
+  std::vector<std::pair<const char*, const char*>> settings;
+};
+const std::vector<Preset>& presets() {
+  static const std::vector<Preset> p = {
+      {"prototype", "the paper's FPGA prototype (Table 4): 64 threads, 4-ray packets, 90 MHz", {}},
+      {"table2", "Table 2's counted configuration: 32 threads", {{"threads", "32"}}},
+  };
+  return p;
+}
+
+std::string known_keys() {
+  std::string s;
+  for (const auto& b : bindings())
+    s += (s.empty() ? "" : ", ") + b.info.name;
+  return s;
+}
+
+std::string fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  return buf;
+}
+
+bool integral_param(const Binding& b) {
+  return b.info.name != "clock_mhz";
+}
+
+}  // namespace
+
+const std::vector<CycleParamInfo>& cycle_param_table() {
+  static const std::vector<CycleParamInfo> t = [] {
+    std::vector<CycleParamInfo> v;
+    for (const auto& b : bindings())
+      v.push_back(b.info);
+    return v;
+  }();
+  return t;
+}
+
+CycleParams prototype_params() {
+  CycleParams p;
+  for (const auto& b : bindings())
+    b.set(p, b.info.value);
+  return p;
+}
+
+std::vector<std::string> cycle_preset_names() {
+  std::vector<std::string> n;
+  for (const auto& p : presets())
+    n.emplace_back(p.name);
+  return n;
+}
+
+CycleParams cycle_preset(const std::string& name) {
+  for (const auto& pr : presets()) {
+    if (name != pr.name) continue;
+    CycleParams p = prototype_params();
+    for (const auto& [k, v] : pr.settings)
+      apply_cycle_setting(p, std::string(k) + "=" + v);
+    return p;
+  }
+  std::string known;
+  for (const auto& pr : presets())
+    known += (known.empty() ? "" : ", ") + std::string(pr.name);
+  throw std::runtime_error("unknown --preset '" + name + "' (known: " + known + ")");
+}
+
+void apply_cycle_setting(CycleParams& params, const std::string& key_value) {
+  const auto eq = key_value.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw std::runtime_error("bad --set '" + key_value + "': expected KEY=VALUE");
+  const std::string key = key_value.substr(0, eq);
+  const std::string text = key_value.substr(eq + 1);
+  for (const auto& b : bindings()) {
+    if (b.info.name != key) continue;
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || end != text.c_str() + text.size() || errno != 0 || !std::isfinite(v))
+      throw std::runtime_error("bad --set " + key + "=" + text + ": not a number");
+    const bool integral = integral_param(b);
+    if (integral && v != std::floor(v))
+      throw std::runtime_error("bad --set " + key + "=" + text + ": expected an integer");
+    if (v < b.info.min || v > b.info.max)
+      throw std::runtime_error("bad --set " + key + "=" + text + ": expected " + fmt(b.info.min) +
+                               ".." + fmt(b.info.max) + " " + b.info.unit);
+    if (b.info.pow2) {
+      const auto n = static_cast<std::uint64_t>(v);
+      if ((n & (n - 1)) != 0)
+        throw std::runtime_error("bad --set " + key + "=" + text + ": expected a power of two");
+    }
+    b.set(params, v);
+    return;
+  }
+  throw std::runtime_error("unknown --set key '" + key + "' (known: " + known_keys() + ")");
+}
+
+void check_cycle_params(const CycleParams& p) {
+  for (int c = 0; c < kCacheUnits; ++c) {
+    const auto& cc = p.cache[c];
+    if (cc.ways > cc.items || cc.items % cc.ways != 0)
+      throw std::runtime_error(std::string("bad cache.") + cache_unit_name(CacheUnit(c)) +
+                               ".ways=" + std::to_string(cc.ways) + ": must divide cache." +
+                               cache_unit_name(CacheUnit(c)) +
+                               ".items=" + std::to_string(cc.items));
+  }
+  if (p.threads < 1) throw std::runtime_error("bad threads=" + std::to_string(p.threads));
+}
+
+std::vector<CycleParamInfo> describe(const CycleParams& params) {
+  std::vector<CycleParamInfo> v;
+  for (const auto& b : bindings()) {
+    CycleParamInfo i = b.info;
+    i.value = b.get(params);
+    v.push_back(i);
+  }
+  return v;
+}
+
+}  // namespace saarcor::units

@@ -1,0 +1,72 @@
+// The cycle model's parameters (DESIGN.md sections 5, 6 and 10; DIGEST D7, D20-D33): one table
+// declares every parameter once (name, default, unit, help, range); presets are data (named sets of
+// overrides); `--set KEY=VALUE` goes through the same table. The defaults are the paper's
+// prototype: one DynRTP, 64 threads of 4-ray packets, 512-item direct-mapped caches, 90 MHz.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace saarcor::units {
+
+// Item caches of the DynRTC by the unit that reads them.
+enum class CacheUnit { kTraversal = 0, kList = 1, kTransformation = 2 };
+inline constexpr int kCacheUnits = 3;
+inline const char* cache_unit_name(CacheUnit c) {
+  constexpr const char* kNames[] = {"traversal", "list", "transformation"};
+  return kNames[static_cast<int>(c)];
+}
+
+struct CycleParams {
+  int threads = 0;            // threads per DynRTP (D24)
+  int packet = 0;             // rays per packet
+  int stack = 0;              // traversal stack entries per packet (D26)
+  int mailbox = 0;            // object mailbox entries per thread (D28)
+  bool shared_origin = true;  // the n+1 transformation rule (D31)
+  struct Cache {
+    int items = 0;
+    int ways = 0;
+  } cache[kCacheUnits];
+  int cache_hit_latency = 0;
+  int cache_misses = 0;  // outstanding misses per cache (MSHRs)
+  int mem_latency = 0;   // SRAM read latency in cycles (D21)
+  int mem_switch_penalty = 0;
+  int lat_add = 0, lat_mul = 0, lat_div = 0, lat_cmp = 0;  // fp unit latencies (D7)
+  double clock_mhz = 0.0;
+  std::uint64_t watchdog = 0;  // cycles without progress that stop a run
+
+  // Pipeline depths of the units, from the fp latencies (docs/cycle-model.md).
+  int traversal_depth() const { return lat_add + lat_div + lat_cmp; }
+  int list_depth() const { return lat_cmp; }
+  int transformation_depth() const { return lat_mul + lat_add + lat_add; }
+  int intersection_depth() const { return lat_div + lat_mul + lat_add + lat_add + lat_cmp; }
+};
+
+struct CycleParamInfo {
+  std::string name;
+  double value;  // the default (in param_table()) or the current value (in describe())
+  std::string unit;
+  std::string help;
+  double min, max;
+  bool pow2;  // must be a power of two
+};
+
+// Every parameter, with its default.
+const std::vector<CycleParamInfo>& cycle_param_table();
+// The prototype configuration (the table's defaults).
+CycleParams prototype_params();
+// Names of the presets ("prototype", ...).
+std::vector<std::string> cycle_preset_names();
+// The preset `name`; throws std::runtime_error "unknown --preset 'x' (known: ...)".
+CycleParams cycle_preset(const std::string& name);
+// Applies "KEY=VALUE"; throws std::runtime_error naming the key for an unknown key, a value that
+// is not a number, or one out of range.
+void apply_cycle_setting(CycleParams& params, const std::string& key_value);
+// Cross-parameter checks (cache ways divide items); throws naming the key.
+void check_cycle_params(const CycleParams& params);
+// The resolved configuration: every parameter with its current value.
+std::vector<CycleParamInfo> describe(const CycleParams& params);
+
+}  // namespace saarcor::units

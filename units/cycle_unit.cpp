@@ -1,0 +1,160 @@
+// The shared stages of the DynRTP units (docs/cycle-model.md "Units").
+#include "units/cycle_unit.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace saarcor::units {
+
+CycleUnit::CycleUnit(hw::Kernel& kernel, std::string name, UnitId id, ThreadTable& threads,
+                     int depth, memif::Cache* cache)
+    : hw::Module(kernel, std::move(name)),
+      threads_(threads),
+      id_(id),
+      depth_(depth),
+      cache_(cache),
+      waiting_(static_cast<std::size_t>(threads.size()), 0) {
+  issued_ = &stats().counter(this->name() + ".issue_cycles", "cycles",
+                             "cycles in which the unit issued a step (its usage)");
+  served_ =
+      &stats().counter(this->name() + ".requests", "requests", "thread-program requests served");
+}
+
+int CycleUnit::evaluate() {
+  int progress = deliver();
+  progress += issue();
+  progress += receive();
+  progress += accept();
+  progress += extra();
+  if (progress == 0 && inside_ > 0) stall();  // threads inside, all waiting for memory
+  return progress;
+}
+
+int CycleUnit::deliver() {
+  int moved = 0;
+  while (!pipeline_.empty() && pipeline_.front().done_at <= now()) {
+    const ThreadToken t = pipeline_.front().thread;
+    const Request next = threads_.request(t);
+    if (next.unit == UnitId::kNone) {
+      pipeline_.pop_front();
+      --inside_;
+      retire(t);
+      ++moved;
+      continue;
+    }
+    ThreadPath* out = outputs_[unit_index(next.unit)];
+    if (out == nullptr)
+      throw std::logic_error(name() + ": no path to the " + unit_name(next.unit) + " unit");
+    if (!out->can_push()) {
+      stall();
+      break;
+    }
+    out->push(t);
+    pipeline_.pop_front();
+    --inside_;
+    ++moved;
+  }
+  return moved;
+}
+
+int CycleUnit::issue() {
+  if (steps_left_ == 0) {
+    ThreadToken t;
+    if (chained_) {
+      t = chain_thread_;
+      chained_ = false;
+    } else if (!ready_.empty()) {
+      t = ready_.front();
+      ready_.pop_front();
+    } else {
+      return 0;
+    }
+    const Request r = threads_.request(t);
+    threads_.execute(t);
+    ++*served_;
+    steps_left_ = r.steps < 1 ? 1 : r.steps;
+    const Request next = threads_.request(t);
+    if (next.unit == id_ && chains(r, next)) {
+      chained_ = true;
+      chain_thread_ = t;
+    } else {
+      pipeline_.push_back({now() + static_cast<std::uint64_t>(steps_left_ - 1 + depth_), t});
+    }
+  }
+  --steps_left_;
+  ++*issued_;
+  return 1;
+}
+
+int CycleUnit::receive() {
+  if (cache_ == nullptr || !cache_->responses().can_pop()) return 0;
+  const memif::CacheResponse r = cache_->responses().pop();
+  const ThreadToken t = r.label.tag;
+  if (--waiting_[t] == 0) {
+    --waiting_threads_;
+    ready_.push_back(t);
+  }
+  return 1;
+}
+
+int CycleUnit::accept() {
+  if (!fetching_) {
+    ThreadPath* from = nullptr;
+    for (ThreadPath* p : inputs_)
+      if (p->can_pop()) {
+        from = p;
+        break;
+      }
+    if (from == nullptr) return 0;
+    const ThreadToken t = from->pop();
+    ++inside_;
+    const Fetch f = fetch(threads_.request(t));
+    if (f.count == 0) {
+      ready_.push_back(t);
+      return 1;
+    }
+    fetching_ = true;
+    fetch_thread_ = t;
+    fetch_next_ = f.first;
+    fetch_left_ = f.count;
+    waiting_[t] = f.count;
+    ++waiting_threads_;
+  }
+  // One cache request per cycle (a matrix's rows go out over consecutive cycles, D32).
+  if (!cache_->requests().can_push()) {
+    stall();
+    return 0;
+  }
+  cache_->requests().push(
+      {fetch_next_, {static_cast<std::uint16_t>(unit_index(id_)), fetch_thread_}});
+  ++fetch_next_;
+  if (--fetch_left_ == 0) fetching_ = false;
+  return 1;
+}
+
+std::uint64_t CycleUnit::next_wakeup(std::uint64_t now) const {
+  if (steps_left_ > 0 || chained_ || !ready_.empty() || fetching_) return now + 1;
+  std::uint64_t t = hw::kNever;
+  if (!pipeline_.empty()) t = std::max(now + 1, pipeline_.front().done_at);
+  t = std::min(t, extra_wakeup(now));
+  return t;
+}
+
+std::string CycleUnit::dump_state() const {
+  std::ostringstream s;
+  s << "threads inside " << inside_ << ", waiting for the cache " << waiting_threads_ << ", ready "
+    << ready_.size() << ", in the pipeline " << pipeline_.size();
+  if (fetching_) s << ", fetching for thread " << fetch_thread_ << " (" << fetch_left_ << " left)";
+  if (!pipeline_.empty())
+    s << ", next out: thread " << pipeline_.front().thread << " at cycle "
+      << pipeline_.front().done_at;
+  for (std::size_t t = 0; t < waiting_.size(); ++t)
+    if (waiting_[t] > 0) {
+      const Request r = threads_.request(static_cast<ThreadToken>(t));
+      s << "\n  thread " << t << " waits for " << waiting_[t] << " item(s) for "
+        << phase_name(r.phase) << " item " << r.item;
+    }
+  return s.str();
+}
+
+}  // namespace saarcor::units

@@ -1,0 +1,121 @@
+// The shape every DynRTP unit of the cycle model shares (paper section 3.1, Figure 2; DESIGN.md
+// section 5; DIGEST D20, D25, D32): thread ids arrive on input paths (FIFO queues, one per path,
+// served by a fixed priority), the unit fetches the item the thread's request names through its
+// cache (one request per packet; a matrix is several row items), the thread waits for the data
+// without blocking the unit, ready threads are issued in the order their data arrived, a request
+// occupies the unit's issue slot for its steps, and after the pipeline depth the thread leaves on
+// the path to the unit its next request names.
+//
+// What a thread computes is decided only by the thread program (units/thread_program.h): the unit
+// calls ThreadTable::execute(t) once per request, at issue. Timing decides when, never what.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "hw/kernel.h"
+#include "memif/cache.h"
+#include "units/thread_program.h"
+
+namespace saarcor::units {
+
+inline constexpr int kUnitCount = 5;  // UnitId::kRgs .. kIntersection
+inline int unit_index(UnitId u) {
+  return static_cast<int>(u);
+}
+
+// The threads of one DynRTP as the units see them (the thread program behind an interface, so the
+// units are independent of the float format).
+class ThreadTable {
+ public:
+  virtual ~ThreadTable() = default;
+  virtual int size() const = 0;
+  virtual Request request(std::uint32_t thread) const = 0;
+  virtual void execute(std::uint32_t thread) = 0;
+  // The RGC hands thread `thread` primary packet `packet` (path a starts from here).
+  virtual void start_primary(std::uint32_t thread, int packet) = 0;
+  virtual int packets() const = 0;
+};
+
+// A thread id on a path between units.
+using ThreadToken = std::uint32_t;
+using ThreadPath = hw::Channel<ThreadToken>;
+
+class CycleUnit : public hw::Module {
+ public:
+  // `cache` may be null (a unit that reads no scene data); `depth` = pipeline depth in cycles.
+  CycleUnit(hw::Kernel& kernel, std::string name, UnitId id, ThreadTable& threads, int depth,
+            memif::Cache* cache);
+
+  // Inputs in priority order (the first non-empty path is served, D25).
+  void add_input(ThreadPath* path) { inputs_.push_back(path); }
+  // The path towards unit `to` (also a path back into this unit: the unit's own loop).
+  void set_output(UnitId to, ThreadPath* path) { outputs_[unit_index(to)] = path; }
+
+  UnitId id() const { return id_; }
+  int depth() const { return depth_; }
+  std::uint64_t issue_cycles() const { return issued_->value; }
+  std::uint64_t requests_served() const { return served_->value; }
+  // Threads inside the unit (fetching, waiting for data, ready, issuing, in the pipeline).
+  int occupancy() const { return inside_; }
+
+  int evaluate() override;
+  std::string dump_state() const override;
+  std::uint64_t next_wakeup(std::uint64_t now) const override;
+
+ protected:
+  // The items of the unit's cache a request needs: `count` consecutive items from `first`.
+  struct Fetch {
+    std::uint32_t first = 0;
+    int count = 0;
+  };
+  virtual Fetch fetch(const Request& r) const = 0;
+  // Whether the thread's next request, on this unit again, issues right behind the current one
+  // without a pipeline round trip (the faces of a box clip; RGS phases).
+  virtual bool chains(const Request& /*done*/, const Request& /*next*/) const { return false; }
+  // Called when a thread's request is `kDone` after this unit (only the RGS frees threads).
+  virtual void retire(ThreadToken /*thread*/) {}
+  // Extra work of the cycle after the shared steps (the RGS admits packets here).
+  virtual int extra() { return 0; }
+  virtual std::uint64_t extra_wakeup(std::uint64_t /*now*/) const { return hw::kNever; }
+
+  // The cycle, as a script (evaluate() calls these in this order).
+  int deliver();  // threads whose pipeline latency elapsed leave on their next path
+  int issue();    // the issue slot: one step of the current request, or the next ready thread
+  int receive();  // one cache response: its thread becomes ready when all its items arrived
+  int accept();   // one thread from the input paths; its cache requests go out one per cycle
+
+  ThreadTable& threads_;
+  std::array<ThreadPath*, kUnitCount> outputs_{};
+  int inside_ = 0;
+
+ private:
+  struct InFlight {
+    std::uint64_t done_at;
+    ThreadToken thread;
+  };
+  UnitId id_;
+  int depth_;
+  memif::Cache* cache_;
+  std::vector<ThreadPath*> inputs_;
+  // Fetch stage: the thread whose cache requests are being sent.
+  bool fetching_ = false;
+  ThreadToken fetch_thread_ = 0;
+  std::uint32_t fetch_next_ = 0;
+  int fetch_left_ = 0;
+  std::vector<int> waiting_;  // per thread: cache responses still expected
+  int waiting_threads_ = 0;
+  std::deque<ThreadToken> ready_;
+  // Issue slot.
+  int steps_left_ = 0;
+  bool chained_ = false;
+  ThreadToken chain_thread_ = 0;
+  std::deque<InFlight> pipeline_;
+  hw::Counter* issued_;
+  hw::Counter* served_;
+};
+
+}  // namespace saarcor::units

@@ -1,0 +1,365 @@
+// The DynRTP assembled for the cycle model (paper section 3.1, Figure 2 paths a-g; DESIGN.md
+// sections 5 and 6; docs/cycle-model.md): thread table, units, paths, memory interface, the frame
+// loop and its figures.
+#include "units/dynrtp.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "hw/kernel.h"
+#include "memif/memory_system.h"
+#include "units/dynrtc_units.h"
+
+namespace saarcor::units {
+namespace {
+
+// The thread table: one thread program per thread, all sharing the DynRTP's float units and the
+// frame sink (their only shared state; both sum order-independently).
+template <class F>
+class Threads final : public ThreadTable {
+ public:
+  Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads)
+      : params_(params), units_(params.mode) {
+    w_ = static_cast<int>(image.registers().width);
+    h_ = static_cast<int>(image.registers().height);
+    tiling_ = packet_tiling(w_, h_, params.packet);
+    sink_.reset(w_, h_);
+    for (int i = 0; i < threads; ++i)
+      programs_.push_back(std::make_unique<ThreadProgram<F>>(image, params_, units_, sink_));
+  }
+  int size() const override { return static_cast<int>(programs_.size()); }
+  Request request(std::uint32_t t) const override { return programs_[t]->request(); }
+  void execute(std::uint32_t t) override { programs_[t]->execute(); }
+  void start_primary(std::uint32_t t, int packet) override {
+    programs_[t]->start_primary(packet_pixels(tiling_, w_, h_, packet));
+  }
+  int packets() const override { return tiling_.count(); }
+
+  PipelineUnits<F>& units() { return units_; }
+  FrameSink& sink() { return sink_; }
+  const FunctionalParams& params() const { return params_; }
+
+ private:
+  FunctionalParams params_;
+  PipelineUnits<F> units_;
+  FrameSink sink_;
+  PacketTiling tiling_;
+  int w_ = 0, h_ = 0;
+  std::vector<std::unique_ptr<ThreadProgram<F>>> programs_;
+};
+
+template <class F>
+void collect(FunctionalFrame& frame, Threads<F>& threads) {
+  const PipelineUnits<F>& u = threads.units();
+  FrameSink& sink = threads.sink();
+  UnitStats& s = frame.units;
+  s.traversal_ops = u.traversal_ops;
+  s.transformation_ops = u.transformation_ops;
+  s.intersection_ops = u.intersection_ops;
+  s.rgs_ops = u.rgs_ops;
+  s.traversal_steps = u.traversal_steps;
+  s.inner_steps = u.inner_steps;
+  s.clip_steps = u.clip_steps;
+  s.list_steps = u.list_steps;
+  s.transformation_steps = u.transformation_steps;
+  s.shading_transformation_steps = u.shading_transformation_steps;
+  s.intersection_packets = u.intersection_packets;
+  s.sub_packets = u.sub_packets;
+  frame.format = F::kFormat;
+  frame.width = sink.width;
+  frame.height = sink.height;
+  frame.params = threads.params();
+  frame.by_kind = sink.by_kind;
+  frame.rays_issued = sink.rays_issued;
+  frame.rays_returned = sink.rays_returned;
+  frame.rgb.resize(sink.pixels.size() * 3u);
+  for (std::size_t i = 0; i < sink.pixels.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k)
+      frame.rgb[3u * i + k] = static_cast<std::uint8_t>(
+          std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
+  frame.pixels = sink.pixels;
+}
+
+memif::CacheConfig cache_config(const CycleParams& p, CacheUnit c) {
+  memif::CacheConfig cc;
+  cc.items = p.cache[static_cast<int>(c)].items;
+  cc.ways = p.cache[static_cast<int>(c)].ways;
+  cc.hit_latency = p.cache_hit_latency;
+  cc.max_misses = p.cache_misses;
+  return cc;
+}
+
+constexpr memif::ItemType kCacheItem[kCacheUnits] = {memif::ItemType::kNode, memif::ItemType::kList,
+                                                     memif::ItemType::kRow};
+constexpr UnitId kTable4Unit[kTable4Units] = {UnitId::kTraversal, UnitId::kList,
+                                              UnitId::kTransformation, UnitId::kIntersection};
+
+// The paths of Figure 2 by (from, to); the other hand-overs of the thread program (a unit's own
+// loop, list -> traversal when a leaf's list ends, ...) get descriptive names.
+std::string path_name(UnitId from, UnitId to) {
+  struct P {
+    UnitId from, to;
+    const char* name;
+  };
+  static constexpr P kPaths[] = {{UnitId::kRgs, UnitId::kTransformation, "path_a"},
+                                 {UnitId::kTransformation, UnitId::kTraversal, "path_b"},
+                                 {UnitId::kTraversal, UnitId::kList, "path_c"},
+                                 {UnitId::kList, UnitId::kTransformation, "path_d"},
+                                 {UnitId::kTransformation, UnitId::kIntersection, "path_e"},
+                                 {UnitId::kIntersection, UnitId::kTraversal, "path_f"},
+                                 {UnitId::kTraversal, UnitId::kRgs, "path_g"}};
+  for (const P& p : kPaths)
+    if (p.from == from && p.to == to) return p.name;
+  if (from == to) return std::string(unit_name(from)) + "_loop";
+  return std::string(unit_name(from)) + "_to_" + unit_name(to);
+}
+
+// Input priorities (D25): in-flight work before new rays; a unit's own loop first.
+std::vector<UnitId> input_order(UnitId u) {
+  switch (u) {
+    case UnitId::kTraversal:
+      return {UnitId::kTraversal, UnitId::kIntersection, UnitId::kList, UnitId::kRgs,
+              UnitId::kTransformation};
+    case UnitId::kList:
+      return {UnitId::kList, UnitId::kIntersection, UnitId::kTraversal, UnitId::kTransformation,
+              UnitId::kRgs};
+    case UnitId::kTransformation:
+      return {UnitId::kList, UnitId::kTransformation, UnitId::kIntersection, UnitId::kTraversal,
+              UnitId::kRgs};
+    case UnitId::kIntersection:
+      return {UnitId::kTransformation, UnitId::kIntersection, UnitId::kList, UnitId::kTraversal,
+              UnitId::kRgs};
+    default:
+      return {UnitId::kTraversal, UnitId::kList, UnitId::kIntersection, UnitId::kTransformation,
+              UnitId::kRgs};
+  }
+}
+
+double mb_per_s(std::uint64_t bytes, std::uint64_t cycles, double clock_mhz) {
+  if (cycles == 0) return 0.0;
+  return static_cast<double>(bytes) * clock_mhz * 1e6 / static_cast<double>(cycles) / 1048576.0;
+}
+
+double percent(std::uint64_t a, std::uint64_t b) {
+  return b == 0 ? 0.0 : 100.0 * static_cast<double>(a) / static_cast<double>(b);
+}
+
+// The DynRTP: units and paths around a thread table, over one memory system.
+class DynRtp {
+ public:
+  DynRtp(hw::Kernel& k, memif::MemoryImage& image, const CycleParams& p, ThreadTable& threads)
+      : mi_(k, image, memory_config(p)) {
+    const std::string pre = "dynrtp0.";
+    rgs_ = &k.make<RaySource>(pre + "rgs", threads, 1);
+    units_[unit_index(UnitId::kRgs)] = rgs_;
+    units_[unit_index(UnitId::kTraversal)] = &k.make<TraversalUnit>(
+        pre + "traversal", threads, p.traversal_depth(), mi_.cache(0, memif::ItemType::kNode));
+    units_[unit_index(UnitId::kList)] = &k.make<ListUnit>(pre + "list", threads, p.list_depth(),
+                                                          mi_.cache(0, memif::ItemType::kList));
+    units_[unit_index(UnitId::kTransformation)] =
+        &k.make<TransformationUnit>(pre + "transformation", threads, p.transformation_depth(),
+                                    mi_.cache(0, memif::ItemType::kRow));
+    units_[unit_index(UnitId::kIntersection)] =
+        &k.make<IntersectionUnit>(pre + "intersection", threads, p.intersection_depth());
+    // Thread-id queues hold every thread: a full path can never hold a unit (deadlock freedom
+    // by construction); the priorities of D25 decide only the order.
+    const int capacity = threads.size() + 1;
+    for (int from = 0; from < kUnitCount; ++from)
+      for (int to = 0; to < kUnitCount; ++to) {
+        const auto f = static_cast<UnitId>(from), t = static_cast<UnitId>(to);
+        paths_[from][to] = &k.make_channel<ThreadToken>(pre + path_name(f, t), capacity, 1);
+        units_[from]->set_output(t, paths_[from][to]);
+      }
+    for (int to = 0; to < kUnitCount; ++to)
+      for (UnitId from : input_order(static_cast<UnitId>(to)))
+        units_[to]->add_input(paths_[unit_index(from)][to]);
+  }
+
+  static memif::MemorySystemConfig memory_config(const CycleParams& p) {
+    memif::MemorySystemConfig mc;
+    mc.node_cache = cache_config(p, CacheUnit::kTraversal);
+    mc.list_cache = cache_config(p, CacheUnit::kList);
+    mc.row_cache = cache_config(p, CacheUnit::kTransformation);
+    mc.controller.latency = p.mem_latency;
+    mc.controller.switch_penalty = p.mem_switch_penalty;
+    mc.controller.clock_hz = p.clock_mhz * 1e6;
+    mc.host.clock_hz = p.clock_mhz * 1e6;
+    return mc;
+  }
+
+  RaySource& rgs() { return *rgs_; }
+  CycleUnit& unit(UnitId u) { return *units_[unit_index(u)]; }
+  memif::MemorySystem& memory() { return mi_; }
+
+ private:
+  memif::MemorySystem mi_;
+  RaySource* rgs_ = nullptr;
+  std::array<CycleUnit*, kUnitCount> units_{};
+  std::array<std::array<ThreadPath*, kUnitCount>, kUnitCount> paths_{};
+};
+
+// Cumulative counts the figures are computed from.
+struct Snapshot {
+  std::uint64_t cycle = 0;
+  std::array<std::uint64_t, kTable4Units> issued{};
+  std::array<std::uint64_t, kCacheUnits> requests{}, hits{}, bytes{};
+  std::uint64_t shading_bytes = 0;
+};
+
+Snapshot snapshot(hw::Kernel& k, DynRtp& d) {
+  Snapshot s;
+  s.cycle = k.now();
+  for (int i = 0; i < kTable4Units; ++i)
+    s.issued[static_cast<std::size_t>(i)] = d.unit(kTable4Unit[i]).issue_cycles();
+  for (int c = 0; c < kCacheUnits; ++c) {
+    const memif::Cache& cache = d.memory().cache(0, kCacheItem[c]);
+    s.requests[static_cast<std::size_t>(c)] = cache.requests_count();
+    s.hits[static_cast<std::size_t>(c)] = cache.hits() + cache.merges();
+    s.bytes[static_cast<std::size_t>(c)] = k.stats().get_counter(cache.name() + ".mem_bytes").value;
+  }
+  s.shading_bytes = k.stats().get_counter("dynrtp0.shading.mem_bytes").value +
+                    k.stats().get_counter("dynrtp0.frame.mem_bytes").value;
+  return s;
+}
+
+CycleFigures figures(const Snapshot& a, const Snapshot& b, double clock_mhz) {
+  CycleFigures f;
+  f.cycle = b.cycle;
+  const std::uint64_t n = b.cycle - a.cycle;
+  for (std::size_t i = 0; i < kTable4Units; ++i)
+    f.usage[i] = percent(b.issued[i] - a.issued[i], n);
+  std::uint64_t dyn = 0;
+  for (std::size_t c = 0; c < kCacheUnits; ++c) {
+    const std::uint64_t req = b.requests[c] - a.requests[c];
+    f.cache_hit[c] = req == 0 ? 100.0 : percent(b.hits[c] - a.hits[c], req);
+    dyn += b.bytes[c] - a.bytes[c];
+  }
+  f.bw_dynrtc = mb_per_s(dyn, n, clock_mhz);
+  f.bw_shading = mb_per_s(b.shading_bytes - a.shading_bytes, n, clock_mhz);
+  f.bw_total = f.bw_dynrtc + f.bw_shading;
+  return f;
+}
+
+template <class F>
+std::string thread_report(Threads<F>& threads) {
+  std::ostringstream s;
+  s << "threads (id: unit, phase, item, rays):";
+  for (int t = 0; t < threads.size(); ++t) {
+    const Request r = threads.request(static_cast<std::uint32_t>(t));
+    if (r.unit == UnitId::kNone) continue;
+    s << "\n  thread " << t << ": " << unit_name(r.unit) << ", " << phase_name(r.phase);
+    if (r.item != memif::kNone) s << ", item " << r.item;
+    s << ", mask 0x" << std::hex << r.mask << std::dec;
+  }
+  return s.str();
+}
+
+template <class F>
+CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
+                            const CycleRunOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_cycle_params(p);
+  FunctionalParams fp = opt.shading;
+  fp.packet = p.packet;
+  fp.stack_depth = p.stack;
+  fp.mailbox = p.mailbox;
+  fp.shared_origin = p.shared_origin;
+  // The memory system takes the image it serves (a host may upload into it); the run never does.
+  memif::MemoryImage image = image_in;
+  Threads<F> threads(image, fp, p.threads);
+  hw::KernelConfig kc;
+  kc.watchdog_cycles = p.watchdog;
+  kc.shuffle_seed = opt.shuffle_seed;
+  hw::Kernel k(kc);
+  DynRtp dyn(k, image, p, threads);
+  if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
+
+  CycleFrame out;
+  out.params = p;
+  out.packets = static_cast<std::uint64_t>(threads.packets());
+  const auto done = [&] { return dyn.rgs().finished(); };
+  const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
+  Snapshot start = snapshot(k, dyn), last = start;
+  while (!done()) {
+    std::uint64_t budget = chunk;
+    if (opt.max_cycles != 0) {
+      if (k.now() >= opt.max_cycles)
+        throw std::runtime_error("cycle model: the frame did not finish within " +
+                                 std::to_string(opt.max_cycles) + " cycles");
+      budget = std::min(budget, opt.max_cycles - k.now());
+    }
+    const hw::RunResult r = k.run(done, budget);
+    if (r.status == hw::RunResult::Status::kWatchdog)
+      throw std::runtime_error("cycle model: watchdog at cycle " + std::to_string(r.cycles) +
+                               ": no progress for " + std::to_string(p.watchdog) + " cycles\n" +
+                               thread_report(threads) + "\n" + r.report);
+    if (opt.interval != 0) {
+      const Snapshot now = snapshot(k, dyn);
+      if (now.cycle > last.cycle) out.series.push_back(figures(last, now, p.clock_mhz));
+      last = now;
+    }
+    if (opt.progress)
+      opt.progress(k.now(), static_cast<int>(dyn.rgs().packets_retired()), threads.packets());
+  }
+  if (opt.vcd != nullptr) k.finish_trace();
+  const Snapshot end = snapshot(k, dyn);
+
+  collect(out.frame, threads);
+  out.cycles = k.now();
+  out.figures = figures(start, end, p.clock_mhz);
+  for (int i = 0; i < kTable4Units; ++i) {
+    CycleUnit& u = dyn.unit(kTable4Unit[i]);
+    out.issue_cycles[static_cast<std::size_t>(i)] = u.issue_cycles();
+    out.stall_cycles[static_cast<std::size_t>(i)] =
+        k.stats().get_counter(u.name() + ".stall_cycles").value;
+    out.requests[static_cast<std::size_t>(i)] = u.requests_served();
+  }
+  std::uint64_t served = dyn.rgs().requests_served();
+  for (std::uint64_t r : out.requests)
+    served += r;
+  out.frame.units.requests = served;
+  out.frame.units.packets = out.packets;
+  for (int c = 0; c < kCacheUnits; ++c) {
+    const memif::Cache& cache = dyn.memory().cache(0, kCacheItem[c]);
+    auto& cc = out.caches[static_cast<std::size_t>(c)];
+    cc.requests = cache.requests_count();
+    cc.hits = cache.hits();
+    cc.misses = cache.misses();
+    cc.merges = cache.merges();
+    cc.mem_bytes = end.bytes[static_cast<std::size_t>(c)];
+  }
+  for (int kd = 0; kd < kRayKinds; ++kd) {
+    out.rays += out.frame.rays_issued[static_cast<std::size_t>(kd)];
+    out.per_ray_sum += out.frame.by_kind[static_cast<std::size_t>(kd)];
+  }
+  const double seconds = static_cast<double>(out.cycles) / (p.clock_mhz * 1e6);
+  out.fps = seconds > 0 ? 1.0 / seconds : 0.0;
+  out.rays_per_s = seconds > 0 ? static_cast<double>(out.rays) / seconds : 0.0;
+  const std::uint64_t steps = out.frame.units.traversal_steps;
+  out.simd_efficiency = steps == 0 ? 0.0
+                                   : static_cast<double>(out.per_ray_sum.traversal_steps) /
+                                         static_cast<double>(steps) / p.packet;
+  out.packets_retired = dyn.rgs().packets_retired();
+  out.skipped_cycles = k.skipped_cycles();
+  out.stats_json = k.stats().json();
+  out.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.frame.seconds = out.host_seconds;
+  out.sim_cycles_per_s =
+      out.host_seconds > 0 ? static_cast<double>(out.cycles) / out.host_seconds : 0.0;
+  return out;
+}
+
+}  // namespace
+
+CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
+                     const CycleRunOptions& options) {
+  if (image.format() == ff::kFp24)
+    return run_cycle_format<ff::Float<7, 16>>(image, params, options);
+  throw std::runtime_error("cycle model: the image is in " + ff::format_name(image.format()) +
+                           "; the cycle model is built for fp24 (e7m16)");
+}
+
+}  // namespace saarcor::units

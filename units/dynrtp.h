@@ -1,0 +1,71 @@
+// The cycle model of one DynRTP (paper section 3.1, Figure 2; DESIGN.md sections 5, 6 and 9 model
+// 3): the traversal, mailboxed list, transformation and intersection units, the ray source and
+// hit sink, the thread table and the memory interface, clocked by the hw/ kernel. Bit-identical
+// to the functional fp24 model by construction (the same thread program per thread, executed in
+// the same per-thread order); the timing gives the paper's Table 4 figures.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "memif/image_format.h"
+#include "units/cycle_params.h"
+#include "units/functional_model.h"
+
+namespace saarcor::units {
+
+// The four DynRTC units Table 4 reports, in its column order.
+inline constexpr int kTable4Units = 4;
+inline constexpr const char* kTable4UnitNames[kTable4Units] = {"traversal", "list",
+                                                               "transformation", "intersection"};
+
+struct CycleRunOptions {
+  FunctionalParams shading;     // shade / shadows / secondary / max_depth (packet, stack, mailbox,
+                                // shared_origin come from CycleParams)
+  std::uint64_t interval = 0;   // != 0: sample the figures every `interval` cycles
+  std::ostream* vcd = nullptr;  // VCD trace of cycles [vcd_from, vcd_to]
+  std::uint64_t vcd_from = 0, vcd_to = 0;
+  std::uint64_t shuffle_seed = 0;  // != 0: random module evaluation order (figures must not move)
+  std::uint64_t max_cycles = 0;    // != 0: stop with an error after this many cycles
+  std::function<void(std::uint64_t cycles, int packets_done, int packets)> progress;
+};
+
+// Unit usage, cache hit rates and bandwidth over a span of cycles.
+struct CycleFigures {
+  std::uint64_t cycle = 0;                             // end of the span
+  std::array<double, kTable4Units> usage{};            // percent of cycles issuing a step
+  std::array<double, kCacheUnits> cache_hit{};         // percent, (hits + merges) / requests
+  double bw_dynrtc = 0, bw_shading = 0, bw_total = 0;  // MB/s (2^20 bytes) at the modelled clock
+};
+
+struct CycleFrame {
+  FunctionalFrame frame;  // hit records, image, per-ray counters, op counts (as the fp24 model)
+  CycleParams params;
+  std::uint64_t cycles = 0;
+  std::uint64_t rays = 0;          // rays issued, all kinds
+  double fps = 0, rays_per_s = 0;  // at the modelled clock
+  CycleFigures figures;            // the whole frame
+  std::array<std::uint64_t, kTable4Units> issue_cycles{}, stall_cycles{}, requests{};
+  struct CacheCount {
+    std::uint64_t requests = 0, hits = 0, misses = 0, merges = 0, mem_bytes = 0;
+  };
+  std::array<CacheCount, kCacheUnits> caches{};
+  RayCounters per_ray_sum;     // all kinds
+  double simd_efficiency = 0;  // active rays per traversal packet step / P
+  std::uint64_t packets = 0, packets_retired = 0;
+  double host_seconds = 0, sim_cycles_per_s = 0;
+  std::uint64_t skipped_cycles = 0;
+  std::vector<CycleFigures> series;  // with interval != 0: the figures of each interval
+  std::string stats_json;            // the hw/ statistics registry
+};
+
+// Renders the image's frame. Throws std::runtime_error for a bad configuration or image, and when
+// the watchdog fires (the message names every thread and where it waits).
+CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
+                     const CycleRunOptions& options = {});
+
+}  // namespace saarcor::units
