@@ -267,8 +267,9 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   fp.stack_depth = p.stack;
   fp.mailbox = p.mailbox;
   fp.shared_origin = p.shared_origin;
-  // The memory system takes the image it serves (a host may upload into it); the run never does.
-  memif::MemoryImage image = image_in;
+  // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
+  // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
+  memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
   Threads<F> threads(image, fp, p.threads);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;

@@ -1,0 +1,389 @@
+// The cycle model of the DynRTP (units/dynrtp.h; docs/cycle-model.md): bit-identical to the
+// functional fp24 model on every scene under a covering design of configurations (threads, packet
+// width, caches, latencies, shadow and secondary rays); ray and thread conservation; thread
+// scaling; the prototype configuration on the room beside the paper's Table 4 row for Scene6;
+// parameters and bad input.
+#include "units/dynrtp.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "host/builtin_scenes.h"
+#include "host/image_builder.h"
+#include "host/scene.h"
+
+namespace saarcor::units {
+namespace {
+
+host::BuiltImage build(const std::string& spec, int w, int h, std::uint32_t bank_mb = 4) {
+  const host::Scene scene = host::load_scene(spec);
+  host::ImageParams ip;
+  ip.width = w;
+  ip.height = h;
+  ip.bank_words = bank_mb * 262144u;
+  return host::build_image(scene, ip);
+}
+
+std::string shared(const std::string& rel) {
+  return std::string(SAARCOR_SHARED_SCENES) + "/" + rel;
+}
+
+// A configuration of the covering design.
+struct Config {
+  const char* name;
+  std::vector<std::string> set;
+  bool shadows_and_secondary = false;
+  std::uint64_t random_latencies = 0;  // != 0: seed for random lat.* and mem.latency
+};
+
+const std::vector<Config>& configs() {
+  static const std::vector<Config> c = {
+      {"prototype", {}},
+      {"t1-p1-tiny",
+       {"threads=1", "packet=1", "cache.traversal.items=8", "cache.list.items=8",
+        "cache.transformation.items=8"}},
+      {"t4-p16-tiny-2way",
+       {"threads=4", "packet=16", "cache.traversal.items=8", "cache.traversal.ways=2",
+        "cache.list.items=8", "cache.list.ways=2", "cache.transformation.items=8",
+        "cache.transformation.ways=2"}},
+      {"t16-p4-random-lat", {"threads=16"}, false, 7},
+      {"t64-p16-tiny",
+       {"packet=16", "cache.traversal.items=8", "cache.list.items=8",
+        "cache.transformation.items=8", "mailbox=2"}},
+      {"t4-p1-random-lat-shadows", {"threads=4", "packet=1"}, true, 11},
+      {"t64-p4-shadows-secondary", {"stack=48", "cache.misses=2"}, true},
+      {"t16-p16-random-lat-tiny",
+       {"threads=16", "packet=16", "cache.traversal.items=8", "cache.list.items=8",
+        "cache.transformation.items=8", "shared_origin=0"},
+       false,
+       23},
+  };
+  return c;
+}
+
+CycleParams params_of(const Config& c) {
+  CycleParams p = prototype_params();
+  for (const auto& kv : c.set)
+    apply_cycle_setting(p, kv);
+  if (c.random_latencies != 0) {
+    std::mt19937 rng(static_cast<unsigned>(c.random_latencies));
+    std::uniform_int_distribution<int> d(1, 12), m(1, 40);
+    p.lat_add = d(rng);
+    p.lat_mul = d(rng);
+    p.lat_div = d(rng);
+    p.lat_cmp = d(rng);
+    p.mem_latency = m(rng);
+    p.cache_hit_latency = 2 + d(rng) % 4;
+  }
+  return p;
+}
+
+FunctionalParams shading_of(const Config& c) {
+  FunctionalParams f;
+  f.shadows = c.shadows_and_secondary;
+  f.secondary = c.shadows_and_secondary;
+  return f;
+}
+
+FunctionalParams functional_of(const Config& c, const CycleParams& p) {
+  FunctionalParams f = shading_of(c);
+  f.packet = p.packet;
+  f.stack_depth = p.stack;
+  f.mailbox = p.mailbox;
+  f.shared_origin = p.shared_origin;
+  return f;
+}
+
+bool same_record(const FrameSink::Pixel& a, const FrameSink::Pixel& b) {
+  return a.t == b.t && a.u == b.u && a.v == b.v && a.cos == b.cos && a.instance == b.instance &&
+         a.triangle == b.triangle && a.o == b.o && a.d == b.d && a.counters == b.counters;
+}
+
+// The cycle model against the functional model on one image and configuration: every hit record
+// (and per-ray counter) bit for bit, the image, the op counts; conservation of rays and threads.
+void expect_bit_exact(const host::BuiltImage& b, const Config& c, const std::string& what) {
+  const CycleParams p = params_of(c);
+  CycleRunOptions o;
+  o.shading = shading_of(c);
+  const CycleFrame cy = run_cycle(b.image, p, o);
+  const FunctionalFrame fn = run_functional(b.image, functional_of(c, p));
+  ASSERT_EQ(cy.frame.pixels.size(), fn.pixels.size()) << what;
+  int bad = 0;
+  for (std::size_t i = 0; i < fn.pixels.size(); ++i)
+    if (!same_record(cy.frame.pixels[i], fn.pixels[i]) && ++bad <= 3)
+      ADD_FAILURE() << what << ": pixel " << i % static_cast<std::size_t>(fn.width) << ","
+                    << i / static_cast<std::size_t>(fn.width) << " differs";
+  EXPECT_EQ(bad, 0) << what;
+  EXPECT_EQ(cy.frame.rgb, fn.rgb) << what;
+  // The same work, whatever the timing.
+  EXPECT_EQ(cy.frame.units.traversal_ops, fn.units.traversal_ops) << what;
+  EXPECT_EQ(cy.frame.units.transformation_ops, fn.units.transformation_ops) << what;
+  EXPECT_EQ(cy.frame.units.intersection_ops, fn.units.intersection_ops) << what;
+  EXPECT_EQ(cy.frame.units.requests, fn.units.requests) << what;
+  // Conservation: every ray issued returns exactly once, every packet frees its thread.
+  for (int k = 0; k < kRayKinds; ++k) {
+    EXPECT_EQ(cy.frame.rays_issued[static_cast<std::size_t>(k)],
+              cy.frame.rays_returned[static_cast<std::size_t>(k)])
+        << what << " " << ray_kind_name(static_cast<RayKind>(k));
+    EXPECT_EQ(cy.frame.rays_issued[static_cast<std::size_t>(k)],
+              fn.rays_issued[static_cast<std::size_t>(k)])
+        << what;
+  }
+  EXPECT_EQ(cy.frame.rays_issued[0],
+            static_cast<std::uint64_t>(fn.width) * static_cast<std::uint64_t>(fn.height))
+      << what;
+  EXPECT_EQ(cy.packets_retired, cy.packets) << what;
+  EXPECT_GT(cy.cycles, 0u);
+}
+
+// Scenes and the configurations each runs: every scene runs the prototype and two others, in
+// rotation, so every configuration meets many scenes (the full cross product is the deep test).
+struct SceneCase {
+  std::string spec;
+  int w, h;
+  std::uint32_t bank_mb = 4;  // the prototype's 4 MB banks; larger scenes need more
+};
+std::vector<SceneCase> scene_cases() {
+  std::vector<SceneCase> s;
+  for (const std::string& n : host::builtin_scene_names())
+    s.push_back({"builtin:" + n, 32, 24, n == "terrain" ? 32u : 4u});
+  for (const char* m : {"Triangle/Triangle.gltf",
+                        "TriangleWithoutIndices/TriangleWithoutIndices.gltf",
+                        "Box/Box.gltf",
+                        "Box/Box.glb",
+                        "SimpleMeshes/SimpleMeshes.gltf",
+                        "Cameras/Cameras.gltf",
+                        "BoxTextured/BoxTextured.gltf",
+                        "Duck/Duck.gltf",
+                        "AnimatedTriangle/AnimatedTriangle.gltf",
+                        "BoxAnimated/BoxAnimated.gltf",
+                        "AnimatedCube/AnimatedCube.gltf",
+                        "InterpolationTest/InterpolationTest.gltf",
+                        "CesiumMilkTruck/CesiumMilkTruck.gltf",
+                        "SpheresScaledInstances/spheres_scaled_instances.gltf",
+                        "RiggedSimple/RiggedSimple.gltf",
+                        "CesiumMan/CesiumMan.gltf",
+                        "AnimatedMorphCube/AnimatedMorphCube.gltf",
+                        "DamagedHelmet/DamagedHelmet.gltf",
+                        "VC/VC.gltf",
+                        "2CylinderEngine/2CylinderEngine.gltf",
+                        "ReciprocatingSaw/ReciprocatingSaw.gltf"})
+    s.push_back({shared(m), 32, 24, std::string(m).rfind("Recip", 0) == 0 ? 8u : 4u});
+  return s;
+}
+
+class BitExact : public ::testing::TestWithParam<int> {};
+
+TEST_P(BitExact, CycleModelEqualsFunctionalModel) {
+  const auto cases = scene_cases();
+  const int i = GetParam();
+  const SceneCase& sc = cases[static_cast<std::size_t>(i)];
+  const host::BuiltImage b = build(sc.spec, sc.w, sc.h, sc.bank_mb);
+  const auto& cf = configs();
+  const std::size_t n = cf.size() - 1;
+  for (std::size_t k : {std::size_t{0}, 1 + (2 * static_cast<std::size_t>(i)) % n,
+                        1 + (2 * static_cast<std::size_t>(i) + 1) % n})
+    expect_bit_exact(b, cf[k], sc.spec + " [" + cf[k].name + "]");
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, BitExact, ::testing::Range(0, 27));
+
+TEST(DynRtc, SceneCasesCoverEveryBuiltinAndModel) {
+  EXPECT_EQ(scene_cases().size(), 27u);  // 6 built-ins + 21 glTF files (MANIFEST glTF table)
+}
+
+// Idle skipping and the evaluation order of modules change no figure.
+TEST(DynRtc, EvaluationOrderChangesNothing) {
+  const host::BuiltImage b = build("builtin:room", 32, 24);
+  const CycleParams p = prototype_params();
+  const CycleFrame a = run_cycle(b.image, p);
+  CycleRunOptions o;
+  o.shuffle_seed = 99;
+  const CycleFrame c = run_cycle(b.image, p, o);
+  EXPECT_EQ(a.cycles, c.cycles);
+  EXPECT_EQ(a.issue_cycles, c.issue_cycles);
+  EXPECT_EQ(a.stats_json, c.stats_json);
+}
+
+// Thread scaling (paper section 5: nearly linear up to 32 threads, about +10% from 32 to 64).
+TEST(DynRtc, ThreadScalingOnTheRoom) {
+  const host::BuiltImage b = build("builtin:room", 64, 48);
+  std::map<int, std::uint64_t> cycles;
+  std::printf("thread scaling, builtin:room 64x48, prototype otherwise\n");
+  std::printf("threads   cycles  cycles/packet  speed-up  trav  list  xfrm   int (usage %%)\n");
+  for (int t : {1, 2, 4, 8, 16, 32, 64}) {
+    CycleParams p = prototype_params();
+    p.threads = t;
+    const CycleFrame c = run_cycle(b.image, p);
+    cycles[t] = c.cycles;
+    std::printf("%7d %8llu %14.1f %9.2f %5.1f %5.1f %5.1f %5.1f\n", t,
+                static_cast<unsigned long long>(c.cycles),
+                static_cast<double>(c.cycles) / static_cast<double>(c.packets),
+                static_cast<double>(cycles[1]) / static_cast<double>(c.cycles), c.figures.usage[0],
+                c.figures.usage[1], c.figures.usage[2], c.figures.usage[3]);
+  }
+  EXPECT_GE(static_cast<double>(cycles[1]) / static_cast<double>(cycles[32]), 8.0);
+  const double gain = static_cast<double>(cycles[32]) / static_cast<double>(cycles[64]) - 1.0;
+  std::printf("64 threads against 32: %+.1f%% (paper: about +10%%)\n", 100.0 * gain);
+  EXPECT_GE(gain, -0.01);  // more threads never cost more than noise of the arrival order
+  EXPECT_LE(gain, 0.25);
+  for (int t : {2, 4, 8, 16, 32})
+    EXPECT_LE(cycles[t], cycles[t / 2]) << t << " threads";
+}
+
+// The prototype configuration on the room (the paper's Scene6 stand-in) beside Table 4's Scene6
+// row (1024x768 there; usage, hit rates and cycles per packet do not depend on the resolution).
+TEST(DynRtc, PrototypeOnTheRoomBesideTable4) {
+  const host::BuiltImage b = build("builtin:room", 128, 96);
+  const CycleFrame c = run_cycle(b.image, prototype_params());
+  const auto& f = c.figures;
+  const double per_packet = static_cast<double>(c.cycles) / static_cast<double>(c.packets);
+  const UnitStats& u = c.frame.units;
+  const double ratio = f.usage[3] / f.usage[2];
+  const double op_ratio = static_cast<double>(u.traversal_ops.total()) /
+                          static_cast<double>(u.intersection_ops.total());
+  const double step_ratio = static_cast<double>(c.per_ray_sum.traversal_steps) /
+                            static_cast<double>(c.per_ray_sum.intersections);
+  const double tri_per_packet =
+      static_cast<double>(u.intersection_packets) / static_cast<double>(c.packets);
+  std::printf("builtin:room 128x96, prototype configuration, against Table 4 Scene6\n");
+  std::printf(
+      "                 usage %% trav list xfrm  int | hit %% trav list xfrm | cycles/packet\n");
+  std::printf("model room             %4.0f %4.0f %4.0f %4.0f |       %4.0f %4.0f %4.0f | %6.1f\n",
+              f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.cache_hit[0], f.cache_hit[1],
+              f.cache_hit[2], per_packet);
+  std::printf("paper Scene6             68   16   85   41 |         99   97   99 |   29.9\n");
+  std::printf("intersection/transformation usage %.2f (paper 0.41-0.65 over all scenes)\n", ratio);
+  std::printf("traversal/intersection: ops %.2f, steps per ray %.2f (paper: about 4:1)\n", op_ratio,
+              step_ratio);
+  std::printf("triangle tests per packet %.1f (Scene6 calibration: about 3); DynRTC %.1f MB/s\n",
+              tri_per_packet, f.bw_dynrtc);
+  for (int k = 0; k < kCacheUnits; ++k)
+    EXPECT_GT(f.cache_hit[static_cast<std::size_t>(k)], 90.0) << cache_unit_name(CacheUnit(k));
+  // Usage is the work the thread program asks for, spread over the frame: P intersection cycles
+  // per triangle test and n+1 transformation steps per matrix (D30, D31). The ratio follows from
+  // the scene's triangle tests per packet (docs/cycle-model.md explains the room's 0.7x).
+  const double predicted =
+      static_cast<double>(u.intersection_packets * 4) / static_cast<double>(u.transformation_steps);
+  EXPECT_NEAR(ratio, predicted, 0.01);
+  EXPECT_GT(ratio, 0.4);
+  EXPECT_LT(ratio, 0.8);
+  EXPECT_EQ(c.issue_cycles[2], u.transformation_steps);
+  EXPECT_EQ(c.issue_cycles[3], u.intersection_packets * 4);
+  EXPECT_EQ(c.issue_cycles[1], u.list_steps);
+  EXPECT_EQ(c.issue_cycles[0], u.traversal_steps + u.clip_steps);
+}
+
+TEST(DynRtc, ParametersPresetsAndBadSettings) {
+  const CycleParams p = prototype_params();
+  EXPECT_EQ(p.threads, 64);
+  EXPECT_EQ(p.packet, 4);
+  EXPECT_EQ(p.stack, 64);
+  EXPECT_EQ(p.cache[0].items, 512);
+  EXPECT_EQ(p.traversal_depth(), 12);
+  EXPECT_EQ(p.transformation_depth(), 9);
+  EXPECT_EQ(p.intersection_depth(), 18);
+  EXPECT_EQ(cycle_preset("table2").threads, 32);
+  CycleParams q = p;
+  apply_cycle_setting(q, "cache.list.ways=4");
+  apply_cycle_setting(q, "clock_mhz=120.5");
+  EXPECT_EQ(q.cache[1].ways, 4);
+  EXPECT_DOUBLE_EQ(q.clock_mhz, 120.5);
+  EXPECT_EQ(describe(q).size(), cycle_param_table().size());
+  const auto fails = [](const std::string& kv, const std::string& needle) {
+    CycleParams r = prototype_params();
+    try {
+      apply_cycle_setting(r, kv);
+      check_cycle_params(r);
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(needle), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+      return;
+    }
+    ADD_FAILURE() << kv << " was accepted";
+  };
+  fails("threads=0", "threads");
+  fails("threads=-3", "threads");
+  fails("packet=3", "power of two");
+  fails("packet=128", "packet");
+  fails("cache.traversal.items=100", "power of two");
+  fails("cache.list.ways=1024", "cache.list.ways");
+  fails("lat.div=0", "lat.div");
+  fails("lat.add=2.5", "integer");
+  fails("mem.latency=fast", "not a number");
+  fails("cache.bogus.items=8", "unknown --set key 'cache.bogus.items'");
+  fails("threads", "KEY=VALUE");
+  fails("=4", "KEY=VALUE");
+  try {
+    cycle_preset("asic");
+    ADD_FAILURE() << "preset asic accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("prototype"), std::string::npos);
+  }
+  // ways must divide items: 8 items, 16 ways.
+  CycleParams r = prototype_params();
+  apply_cycle_setting(r, "cache.transformation.items=8");
+  apply_cycle_setting(r, "cache.transformation.ways=16");
+  EXPECT_THROW(check_cycle_params(r), std::runtime_error);
+}
+
+TEST(DynRtc, OnlyTheFp24ImageRuns) {
+  const host::Scene scene = host::load_scene("builtin:cube");
+  host::ImageParams ip;
+  ip.width = 8;
+  ip.height = 8;
+  ip.format = ff::Format{7, 20};
+  const host::BuiltImage b = host::build_image(scene, ip);
+  try {
+    run_cycle(b.image, prototype_params());
+    ADD_FAILURE() << "e7m20 image accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("fp24"), std::string::npos);
+  }
+}
+
+// A stuck run stops with a report naming each waiting thread, its unit, phase and item.
+TEST(DynRtc, WatchdogNamesStuckThreads) {
+  const host::BuiltImage b = build("builtin:room", 16, 12);
+  CycleParams p = prototype_params();
+  p.threads = 2;
+  p.watchdog = 20;      // shorter than one memory round trip:
+  p.mem_latency = 200;  // the first misses look like a hang
+  try {
+    run_cycle(b.image, p);
+    ADD_FAILURE() << "the watchdog did not fire";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("watchdog"), std::string::npos) << m;
+    EXPECT_NE(m.find("thread 0: "), std::string::npos) << m;
+    EXPECT_NE(m.find("thread 1: "), std::string::npos) << m;
+    EXPECT_NE(m.find("dynrtp0.traversal"), std::string::npos) << m;
+  }
+}
+
+// --interval: the figures of each interval; their cycle-weighted mean is the frame's figure.
+TEST(DynRtc, TimeSeriesAddsUpToTheFrame) {
+  const host::BuiltImage b = build("builtin:room", 32, 24);
+  CycleRunOptions o;
+  o.interval = 5000;
+  const CycleFrame c = run_cycle(b.image, prototype_params(), o);
+  ASSERT_GE(c.series.size(), 3u);
+  EXPECT_EQ(c.series.back().cycle, c.cycles);
+  double busy = 0;
+  std::uint64_t prev = 0;
+  for (const CycleFigures& f : c.series) {
+    EXPECT_GT(f.cycle, prev);
+    busy += f.usage[2] * static_cast<double>(f.cycle - prev);
+    prev = f.cycle;
+  }
+  EXPECT_NEAR(busy / static_cast<double>(c.cycles), c.figures.usage[2], 1e-9);
+}
+
+}  // namespace
+}  // namespace saarcor::units
