@@ -475,9 +475,21 @@ Scene load_gltf(const std::string& path) {
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
 
   Scene scene;
+  // Extensions: geometry we cannot decode (Draco, meshopt, ...) must not load as garbage, so an
+  // unsupported *required* extension is refused; material and texture extensions only change
+  // appearance, so they are ignored with a warning.
+  const auto supported = [](const std::string& ext) {
+    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization";
+  };
+  const auto cosmetic = [](const std::string& ext) {
+    return ext.rfind("KHR_materials_", 0) == 0 || ext == "KHR_texture_transform";
+  };
   for (const std::string& ext : model.extensionsRequired) {
-    if (ext != "KHR_lights_punctual" && ext != "KHR_materials_emissive_strength")
-      scene.warn("required extension " + ext + " is not supported: ignored");
+    if (!supported(ext) && !cosmetic(ext))
+      reader.fail("requires extension " + ext + ", which is not supported");
+  }
+  for (const std::string& ext : model.extensionsUsed) {
+    if (!supported(ext)) scene.warn("extension " + ext + " is not supported: ignored");
   }
 
   // Every external image must exist, even one the shader will not use: a missing file is a

@@ -629,6 +629,22 @@ TEST_F(BadGltf, DataUriImageAndPointLight) {
   EXPECT_EQ(s.lights[0].color, glm::vec3(0.5f, 0.25f, 0.125f));
 }
 
+TEST_F(BadGltf, UnsupportedRequiredExtensionIsRefused) {
+  const std::string extra =
+      R"(,"extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"])";
+  const std::string e = error_of(write("draco.gltf", gltf(kTri, 4, "", extra)));
+  EXPECT_NE(e.find("requires extension KHR_draco_mesh_compression, which is not supported"),
+            std::string::npos)
+      << e;
+  // Only used (not required), or cosmetic: a warning.
+  const Scene s = load_scene(write(
+      "cosmetic.gltf",
+      gltf(
+          kTri, 4, "",
+          R"(,"extensionsUsed":["KHR_materials_unlit"],"extensionsRequired":["KHR_materials_unlit"])")));
+  EXPECT_TRUE(has_warning(s, "extension KHR_materials_unlit is not supported: ignored"));
+}
+
 TEST_F(BadGltf, UnknownBuiltinListsTheKnownOnes) {
   const std::string e = error_of("builtin:nope");
   EXPECT_NE(e.find("unknown built-in scene 'builtin:nope'"), std::string::npos) << e;
