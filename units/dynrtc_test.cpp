@@ -13,169 +13,18 @@
 #include <sstream>
 #include <string>
 
-#include "host/builtin_scenes.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "units/dynrtc_testing.h"
 
 namespace saarcor::units {
 namespace {
 
-host::BuiltImage build(const std::string& spec, int w, int h, std::uint32_t bank_mb = 4) {
-  const host::Scene scene = host::load_scene(spec);
-  host::ImageParams ip;
-  ip.width = w;
-  ip.height = h;
-  ip.bank_words = bank_mb * 262144u;
-  return host::build_image(scene, ip);
-}
-
-std::string shared(const std::string& rel) {
-  return std::string(SAARCOR_SHARED_SCENES) + "/" + rel;
-}
-
-// A configuration of the covering design.
-struct Config {
-  const char* name;
-  std::vector<std::string> set;
-  bool shadows_and_secondary = false;
-  std::uint64_t random_latencies = 0;  // != 0: seed for random lat.* and mem.latency
-};
-
-const std::vector<Config>& configs() {
-  static const std::vector<Config> c = {
-      {"prototype", {}},
-      {"t1-p1-tiny",
-       {"threads=1", "packet=1", "cache.traversal.items=8", "cache.list.items=8",
-        "cache.transformation.items=8"}},
-      {"t4-p16-tiny-2way",
-       {"threads=4", "packet=16", "cache.traversal.items=8", "cache.traversal.ways=2",
-        "cache.list.items=8", "cache.list.ways=2", "cache.transformation.items=8",
-        "cache.transformation.ways=2"}},
-      {"t16-p4-random-lat", {"threads=16"}, false, 7},
-      {"t64-p16-tiny",
-       {"packet=16", "cache.traversal.items=8", "cache.list.items=8",
-        "cache.transformation.items=8", "mailbox=2"}},
-      {"t4-p1-random-lat-shadows", {"threads=4", "packet=1"}, true, 11},
-      {"t64-p4-shadows-secondary", {"stack=48", "cache.misses=2"}, true},
-      {"t16-p16-random-lat-tiny",
-       {"threads=16", "packet=16", "cache.traversal.items=8", "cache.list.items=8",
-        "cache.transformation.items=8", "shared_origin=0"},
-       false,
-       23},
-  };
-  return c;
-}
-
-CycleParams params_of(const Config& c) {
-  CycleParams p = prototype_params();
-  for (const auto& kv : c.set)
-    apply_cycle_setting(p, kv);
-  if (c.random_latencies != 0) {
-    std::mt19937 rng(static_cast<unsigned>(c.random_latencies));
-    std::uniform_int_distribution<int> d(1, 12), m(1, 40);
-    p.lat_add = d(rng);
-    p.lat_mul = d(rng);
-    p.lat_div = d(rng);
-    p.lat_cmp = d(rng);
-    p.mem_latency = m(rng);
-    p.cache_hit_latency = 2 + d(rng) % 4;
-  }
-  return p;
-}
-
-FunctionalParams shading_of(const Config& c) {
-  FunctionalParams f;
-  f.shadows = c.shadows_and_secondary;
-  f.secondary = c.shadows_and_secondary;
-  return f;
-}
-
-FunctionalParams functional_of(const Config& c, const CycleParams& p) {
-  FunctionalParams f = shading_of(c);
-  f.packet = p.packet;
-  f.stack_depth = p.stack;
-  f.mailbox = p.mailbox;
-  f.shared_origin = p.shared_origin;
-  return f;
-}
-
-bool same_record(const FrameSink::Pixel& a, const FrameSink::Pixel& b) {
-  return a.t == b.t && a.u == b.u && a.v == b.v && a.cos == b.cos && a.instance == b.instance &&
-         a.triangle == b.triangle && a.o == b.o && a.d == b.d && a.counters == b.counters;
-}
-
-// The cycle model against the functional model on one image and configuration: every hit record
-// (and per-ray counter) bit for bit, the image, the op counts; conservation of rays and threads.
-void expect_bit_exact(const host::BuiltImage& b, const Config& c, const std::string& what) {
-  const CycleParams p = params_of(c);
-  CycleRunOptions o;
-  o.shading = shading_of(c);
-  const CycleFrame cy = run_cycle(b.image, p, o);
-  const FunctionalFrame fn = run_functional(b.image, functional_of(c, p));
-  ASSERT_EQ(cy.frame.pixels.size(), fn.pixels.size()) << what;
-  int bad = 0;
-  for (std::size_t i = 0; i < fn.pixels.size(); ++i)
-    if (!same_record(cy.frame.pixels[i], fn.pixels[i]) && ++bad <= 3)
-      ADD_FAILURE() << what << ": pixel " << i % static_cast<std::size_t>(fn.width) << ","
-                    << i / static_cast<std::size_t>(fn.width) << " differs";
-  EXPECT_EQ(bad, 0) << what;
-  EXPECT_EQ(cy.frame.rgb, fn.rgb) << what;
-  // The same work, whatever the timing.
-  EXPECT_EQ(cy.frame.units.traversal_ops, fn.units.traversal_ops) << what;
-  EXPECT_EQ(cy.frame.units.transformation_ops, fn.units.transformation_ops) << what;
-  EXPECT_EQ(cy.frame.units.intersection_ops, fn.units.intersection_ops) << what;
-  EXPECT_EQ(cy.frame.units.requests, fn.units.requests) << what;
-  // Conservation: every ray issued returns exactly once, every packet frees its thread.
-  for (int k = 0; k < kRayKinds; ++k) {
-    EXPECT_EQ(cy.frame.rays_issued[static_cast<std::size_t>(k)],
-              cy.frame.rays_returned[static_cast<std::size_t>(k)])
-        << what << " " << ray_kind_name(static_cast<RayKind>(k));
-    EXPECT_EQ(cy.frame.rays_issued[static_cast<std::size_t>(k)],
-              fn.rays_issued[static_cast<std::size_t>(k)])
-        << what;
-  }
-  EXPECT_EQ(cy.frame.rays_issued[0],
-            static_cast<std::uint64_t>(fn.width) * static_cast<std::uint64_t>(fn.height))
-      << what;
-  EXPECT_EQ(cy.packets_retired, cy.packets) << what;
-  EXPECT_GT(cy.cycles, 0u);
-}
-
-// Scenes and the configurations each runs: every scene runs the prototype and two others, in
-// rotation, so every configuration meets many scenes (the full cross product is the deep test).
-struct SceneCase {
-  std::string spec;
-  int w, h;
-  std::uint32_t bank_mb = 4;  // the prototype's 4 MB banks; larger scenes need more
-};
-std::vector<SceneCase> scene_cases() {
-  std::vector<SceneCase> s;
-  for (const std::string& n : host::builtin_scene_names())
-    s.push_back({"builtin:" + n, 32, 24, n == "terrain" ? 32u : 4u});
-  for (const char* m : {"Triangle/Triangle.gltf",
-                        "TriangleWithoutIndices/TriangleWithoutIndices.gltf",
-                        "Box/Box.gltf",
-                        "Box/Box.glb",
-                        "SimpleMeshes/SimpleMeshes.gltf",
-                        "Cameras/Cameras.gltf",
-                        "BoxTextured/BoxTextured.gltf",
-                        "Duck/Duck.gltf",
-                        "AnimatedTriangle/AnimatedTriangle.gltf",
-                        "BoxAnimated/BoxAnimated.gltf",
-                        "AnimatedCube/AnimatedCube.gltf",
-                        "InterpolationTest/InterpolationTest.gltf",
-                        "CesiumMilkTruck/CesiumMilkTruck.gltf",
-                        "SpheresScaledInstances/spheres_scaled_instances.gltf",
-                        "RiggedSimple/RiggedSimple.gltf",
-                        "CesiumMan/CesiumMan.gltf",
-                        "AnimatedMorphCube/AnimatedMorphCube.gltf",
-                        "DamagedHelmet/DamagedHelmet.gltf",
-                        "VC/VC.gltf",
-                        "2CylinderEngine/2CylinderEngine.gltf",
-                        "ReciprocatingSaw/ReciprocatingSaw.gltf"})
-    s.push_back({shared(m), 32, 24, std::string(m).rfind("Recip", 0) == 0 ? 8u : 4u});
-  return s;
-}
+using testing::build;
+using testing::configs;
+using testing::expect_bit_exact;
+using testing::scene_cases;
+using testing::SceneCase;
 
 class BitExact : public ::testing::TestWithParam<int> {};
 

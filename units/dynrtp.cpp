@@ -27,14 +27,21 @@ class Threads final : public ThreadTable {
     h_ = static_cast<int>(image.registers().height);
     tiling_ = packet_tiling(w_, h_, params.packet);
     sink_.reset(w_, h_);
-    for (int i = 0; i < threads; ++i)
+    for (int i = 0; i < threads; ++i) {
       programs_.push_back(std::make_unique<ThreadProgram<F>>(image, params_, units_, sink_));
+      requests_.push_back(programs_.back()->request());
+    }
   }
   int size() const override { return static_cast<int>(programs_.size()); }
-  Request request(std::uint32_t t) const override { return programs_[t]->request(); }
-  void execute(std::uint32_t t) override { programs_[t]->execute(); }
+  // A thread's request changes only when it executes or starts a packet: kept, not recomputed.
+  Request request(std::uint32_t t) const override { return requests_[t]; }
+  void execute(std::uint32_t t) override {
+    programs_[t]->execute();
+    requests_[t] = programs_[t]->request();
+  }
   void start_primary(std::uint32_t t, int packet) override {
     programs_[t]->start_primary(packet_pixels(tiling_, w_, h_, packet));
+    requests_[t] = programs_[t]->request();
   }
   int packets() const override { return tiling_.count(); }
 
@@ -49,6 +56,7 @@ class Threads final : public ThreadTable {
   PacketTiling tiling_;
   int w_ = 0, h_ = 0;
   std::vector<std::unique_ptr<ThreadProgram<F>>> programs_;
+  std::vector<Request> requests_;
 };
 
 template <class F>
@@ -117,22 +125,21 @@ std::string path_name(UnitId from, UnitId to) {
   return std::string(unit_name(from)) + "_to_" + unit_name(to);
 }
 
-// Input priorities (D25): in-flight work before new rays; a unit's own loop first.
+// Input priorities (D25): in-flight work before new rays; a unit's own loop first. Only the
+// hand-overs the thread program can make are listed (a path nobody reads would hold its thread
+// until the watchdog names it).
 std::vector<UnitId> input_order(UnitId u) {
   switch (u) {
-    case UnitId::kTraversal:
+    case UnitId::kTraversal:  // loop (next node, pop), f, end of a leaf's list, shadow rays, b
       return {UnitId::kTraversal, UnitId::kIntersection, UnitId::kList, UnitId::kRgs,
               UnitId::kTransformation};
-    case UnitId::kList:
-      return {UnitId::kList, UnitId::kIntersection, UnitId::kTraversal, UnitId::kTransformation,
-              UnitId::kRgs};
-    case UnitId::kTransformation:
-      return {UnitId::kList, UnitId::kTransformation, UnitId::kIntersection, UnitId::kTraversal,
-              UnitId::kRgs};
-    case UnitId::kIntersection:
-      return {UnitId::kTransformation, UnitId::kIntersection, UnitId::kList, UnitId::kTraversal,
-              UnitId::kRgs};
-    default:
+    case UnitId::kList:  // loop (mailbox skip), after an intersection, c
+      return {UnitId::kList, UnitId::kIntersection, UnitId::kTraversal};
+    case UnitId::kTransformation:  // d before a (D25)
+      return {UnitId::kList, UnitId::kRgs};
+    case UnitId::kIntersection:  // e
+      return {UnitId::kTransformation};
+    default:  // the RGS: g, the end of a list or an intersection, shadow-ray generation
       return {UnitId::kTraversal, UnitId::kList, UnitId::kIntersection, UnitId::kTransformation,
               UnitId::kRgs};
   }
