@@ -72,9 +72,10 @@ TEST(RenderArgs, Models) {
   EXPECT_EQ(parse_model("fp24").mantissa, 16);
   EXPECT_EQ(parse_model("e7m12").mantissa, 12);
   EXPECT_EQ(parse_model("e7m23").mantissa, 23);
-  EXPECT_NE(error_of([] { parse_model("cycle"); }).find("not available yet"), std::string::npos);
+  EXPECT_EQ(parse_model("cycle").kind, ModelKind::kCycle);  // landed with the cycle model
+  EXPECT_EQ(parse_model("cycle").mantissa, 16);
   EXPECT_EQ(error_of([] { parse_model("fp16"); }),
-            "unknown model 'fp16': expected float, fp24, or e7m10..e7m23");
+            "unknown model 'fp16': expected float, fp24, e7m10..e7m23, or cycle");
   EXPECT_NE(error_of([] { parse_model("e7m9"); }).find("unknown model 'e7m9'"), std::string::npos);
   EXPECT_NE(error_of([] { parse_model("e7m24"); }).find("unknown model"), std::string::npos);
 }
@@ -303,7 +304,7 @@ TEST(SaarcorBinary, OneLineErrors) {
   expect_one_line_error(saarcor("render /nonexistent/x.gltf --res 8x8"), "/nonexistent/x.gltf");
   expect_one_line_error(saarcor("render builtin:cube --res 8by8"), "bad --res '8by8'");
   expect_one_line_error(saarcor("render builtin:cube --model magic"), "unknown model 'magic'");
-  expect_one_line_error(saarcor("render builtin:cube --model cycle"), "not available yet");
+  expect_one_line_error(saarcor("render builtin:cube --model fp16"), "unknown model 'fp16'");
   expect_one_line_error(saarcor("compare " + (d / "none.exr").string() + " x.exr"),
                         "none.exr: no such file");
   {
