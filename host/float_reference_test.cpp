@@ -11,7 +11,6 @@
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -502,14 +501,24 @@ std::vector<std::string> manifest_gltf_models() {
   std::vector<std::string> out;
   std::string line;
   bool in_table = false;
-  const std::regex path_re("`([^`]+\\.(gltf|glb))`");
+  const auto is_model = [](const std::string& p) {
+    const auto ends = [&](const std::string& e) {
+      return p.size() > e.size() && p.compare(p.size() - e.size(), e.size(), e) == 0;
+    };
+    return ends(".gltf") || ends(".glb");
+  };
   while (std::getline(in, line)) {
     if (line.rfind("## ", 0) == 0) in_table = line.find("glTF models") != std::string::npos;
     if (!in_table || line.rfind("| `", 0) != 0) continue;
+    // The first column lists the model files, each in backticks.
     const std::string first = line.substr(0, line.find('|', 1));
-    for (auto it = std::sregex_iterator(first.begin(), first.end(), path_re);
-         it != std::sregex_iterator(); ++it)
-      out.push_back((*it)[1].str());
+    for (std::size_t a = first.find('`'); a != std::string::npos;) {
+      const std::size_t b = first.find('`', a + 1);
+      if (b == std::string::npos) break;
+      const std::string path = first.substr(a + 1, b - a - 1);
+      if (is_model(path)) out.push_back(path);
+      a = first.find('`', b + 1);
+    }
   }
   return out;
 }
