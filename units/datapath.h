@@ -69,8 +69,8 @@ inline std::uint32_t magnitude_key(F x) {
 // One step: per output component r, (m_r0*x + m_r1*y) + (m_r2*z + t_r). A direction step feeds
 // zero as the translation (the adder still runs: -0 + +0 = +0, a real datapath effect).
 template <class F>
-inline Vec3<F> transform_step(const UnitFp<F>& fp, const Mat34<F>& m, const Vec3<F>& v,
-                              bool translate) {
+[[gnu::flatten]] inline Vec3<F> transform_step(const UnitFp<F>& fp, const Mat34<F>& m,
+                                               const Vec3<F>& v, bool translate) {
   Vec3<F> out;
   for (int r = 0; r < 3; ++r) {
     const F t = translate ? m[r][3] : F::zero();
@@ -82,7 +82,7 @@ inline Vec3<F> transform_step(const UnitFp<F>& fp, const Mat34<F>& m, const Vec3
 
 // The dot product as one row of a zero-translation step: (a.x*b.x + a.y*b.y) + (a.z*b.z + 0).
 template <class F>
-inline F dot_step(const UnitFp<F>& fp, const Vec3<F>& a, const Vec3<F>& b) {
+[[gnu::flatten]] inline F dot_step(const UnitFp<F>& fp, const Vec3<F>& a, const Vec3<F>& b) {
   return fp.add(fp.add(fp.mul(a[0], b[0]), fp.mul(a[1], b[1])),
                 fp.add(fp.mul(a[2], b[2]), F::zero()));
 }
@@ -103,8 +103,8 @@ struct TraversalLane {
 };
 
 template <class F>
-inline TraversalLane<F> traversal_lane(const UnitFp<F>& fp, F split, F o_axis, F d_axis, F tn,
-                                       F tf) {
+[[gnu::flatten]] inline TraversalLane<F> traversal_lane(const UnitFp<F>& fp, F split, F o_axis,
+                                                        F d_axis, F tn, F tf) {
   const F d = fp.div(fp.sub(split, o_axis), d_axis);
   const bool before = fp.lt(d, tn);  // plane before the segment: far side only
   const bool after = fp.lt(tf, d);   // plane beyond the segment: near side only
@@ -130,7 +130,8 @@ inline bool terminated(const UnitFp<F>& fp, F t_best, F tn) {
 // comparator-multiplexer max/min keep the old bound on NaN (origin on a parallel face).
 // 1 add, 1 div, 1 cmp.
 template <class F>
-inline void clip_face(const UnitFp<F>& fp, F plane, F o_axis, F d_axis, bool entry, F& tn, F& tf) {
+[[gnu::flatten]] inline void clip_face(const UnitFp<F>& fp, F plane, F o_axis, F d_axis, bool entry,
+                                       F& tn, F& tf) {
   const F t = fp.div(fp.sub(plane, o_axis), d_axis);
   if (entry)
     tn = fp.max(tn, t);
@@ -147,7 +148,7 @@ struct Candidate {
 
 // t = -O'z / D'z, u = O'x + t*D'x, v = O'y + t*D'y; u + v is the third adder.
 template <class F>
-inline Candidate<F> intersect_unit_triangle(const UnitFp<F>& fp, const Ray<F>& r) {
+[[gnu::flatten]] inline Candidate<F> intersect_unit_triangle(const UnitFp<F>& fp, const Ray<F>& r) {
   Candidate<F> c;
   c.c = r.d[2];
   c.t = fp.div(r.o[2].neg(), r.d[2]);
