@@ -1,28 +1,38 @@
 // SAH kd-tree builder: Wald & Havran, "On building fast kd-trees for ray tracing, and on doing
-// that in O(N log N)" (2006), with perfect splits. Builds the paper's (section 2) bottom-level
-// trees over an object's triangles and the top-level tree over instance bounds; the node layout
-// follows DESIGN.md section 4 (root at 0, children adjacent, split positions in fp24).
+// that in O(N log N)" (2006), with perfect splits, below a binned-SAH stage (Wald 2007, Shevtsov
+// et al. 2007) at the top. Builds the paper's (section 2) bottom-level trees over an object's
+// triangles and the top-level tree over instance bounds; the node layout follows DESIGN.md
+// section 4 (root at 0, children adjacent, split positions in fp24).
 //
 // How it works (docs/kdtree.md has the long form):
-// - Every item yields, per axis, a start and an end event at its bounds (a planar event when both
-//   coincide). Event positions are rounded outward onto the split grid (the values representable
-//   in params.split_format): starts down, ends up. A candidate plane is therefore always a value
-//   the hardware can store, and the sweep's left/right counts are exact for that stored plane.
-// - Events are sorted once (radix sort on a 64-bit key: position, type, item id). Per node, one
-//   linear sweep per axis finds the SAH-best plane; the items are classified against it, the
-//   events split into the children's lists in order (no re-sort), and only the items that
-//   straddle the plane get new events from their clipped bounds (sorted, then merged in).
-// - Memory: each axis has one event arena used as a stack (a node's children are written above
-//   it and popped when the subtree is done), so there is no per-node allocation.
+// - Item bounds are rounded outward onto the split grid (the values representable in
+//   params.split_format): lower bounds down, upper bounds up. Every candidate plane is a grid
+//   value, so it is a value the hardware can store, and the left/right counts are exact for it.
+// - Binned stage (nodes with more than params.binned_above items): per node one pass bins every
+//   item's bounds on all three axes; candidates are grid values at even spacing plus the two
+//   empty-space planes at the items' bounds. One pass then writes the children's item lists,
+//   clipping only the straddlers (perfect splits). When the bins find no plane worth a split,
+//   the exact stage decides.
+// - Exact stage: every item yields, per axis, a start and an end event at its bounds (a planar
+//   event when both coincide); the events are sorted once (64-bit keys: position, type, local
+//   item id). Per node, one linear sweep per axis finds the SAH-best plane; the items are
+//   classified against it, the events split into the children's lists in order (no re-sort), and
+//   only the straddlers get new events from their clipped bounds (sorted, then merged in).
+// - Memory: the binned stage's item lists and each axis's event list are stacks (a node's
+//   children are written above it and popped when the subtree is done): no per-node allocation.
 #include "host/kdtree.h"
 
 #include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace saarcor::host {
 namespace {
@@ -104,7 +114,7 @@ inline std::uint32_t key_id(Key k) {
 void radix_sort(Key* data, std::size_t n, std::vector<Key>& scratch) {
   constexpr int kDigit = 12;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
-  if (n < 64) {
+  if (n < 1024) {  // the 4096-bucket passes cost more than a comparison sort here
     std::sort(data, data + n);
     return;
   }
@@ -130,14 +140,16 @@ void radix_sort(Key* data, std::size_t n, std::vector<Key>& scratch) {
   if (src != data) std::copy(src, src + n, data);
 }
 
-// One axis's events, used as a stack: a node's list is a range; its children go on top.
-class Arena {
+// A list used as a stack (one axis's events, or the binned stage's items): a node's list is a
+// range; its children go on top and are popped when the subtree is done.
+template <class T>
+class Stack {
  public:
-  Key* data() const { return buf_.get(); }
+  T* data() const { return buf_.get(); }
   void ensure(std::size_t n) {
     if (n <= cap_) return;
     const std::size_t cap = std::max(n, cap_ + cap_ / 2);
-    auto buf = std::make_unique_for_overwrite<Key[]>(cap);
+    auto buf = std::make_unique_for_overwrite<T[]>(cap);
     if (top_ > 0) std::copy(buf_.get(), buf_.get() + top_, buf.get());
     buf_ = std::move(buf);
     cap_ = cap;
@@ -145,9 +157,23 @@ class Arena {
   std::size_t top_ = 0;
 
  private:
-  std::unique_ptr<Key[]> buf_;
+  std::unique_ptr<T[]> buf_;
   std::size_t cap_ = 0;
 };
+using Arena = Stack<Key>;
+
+// An item in the binned stage: its bounds (clipped to the node, on the split grid) and its id.
+// The upper bound is kept as the largest grid value that does not reach the plane when the item
+// lies left of it: key[k] = pred(hi) (the grid value below hi) for an item with extent, hi = lo
+// for a planar one (bit k of `planar`). Then "left of grid plane s" is key < s in both cases,
+// which the binning counts without a correction.
+struct BinItem {
+  float lo[3];
+  float key[3];
+  std::uint32_t id;
+  std::uint32_t planar;
+};
+constexpr int kMaxBins = 256;
 
 struct Box {
   float lo[3];
@@ -186,6 +212,15 @@ struct Split {
   bool planar_left = true;
 };
 
+struct BinnedSplit {
+  double cost = std::numeric_limits<double>::infinity();
+  int axis = -1;
+  float pos = 0.0f;
+  bool planar_left = false;
+  std::uint32_t left = 0;  // items on the left (straddlers included), exact for the plane
+  std::uint32_t right = 0;
+};
+
 class Builder {
  public:
   // Parameters are checked before anything is derived from them (the grid needs a valid format).
@@ -200,8 +235,28 @@ class Builder {
   static const KdBuildParams& checked(const KdBuildParams& p);
   void check_coordinate(float v, const char* what, std::size_t index) const;
   void start(std::size_t items);
-  void add_item_events(std::uint32_t id, const float lo[3], const float hi[3]);
+  void add_item(std::uint32_t id, const float lo[3], const float hi[3]);
+  // Grid neighbours of a grid value.
+  float grid_pred(float x) const { return grid_.down(float_next_down(x)); }
+  float grid_succ(float x) const { return grid_.up(float_next_up(x)); }
+  // lo, hi on the grid.
+  void set_bin_item(BinItem& it, std::uint32_t id, const float lo[3], const float hi[3]) const {
+    it.id = id;
+    it.planar = 0;
+    for (int k = 0; k < 3; ++k) {
+      it.lo[k] = lo[k];
+      const bool planar = lo[k] == hi[k];
+      it.key[k] = planar ? hi[k] : grid_pred(hi[k]);
+      it.planar |= static_cast<std::uint32_t>(planar) << k;
+    }
+  }
+  float item_hi(const BinItem& it, int k) const {
+    return (it.planar >> k) & 1u ? it.key[k] : grid_succ(it.key[k]);
+  }
   void run();
+  void bin_node(std::uint32_t node, int depth, const Box& box, std::size_t b, std::uint32_t n);
+  BinnedSplit find_binned_split(const Box& box, const BinItem* items, std::uint32_t n) const;
+  void exact_subtree(std::uint32_t node, int depth, const Box& box, std::size_t b, std::uint32_t n);
   void build_node(std::uint32_t node, int depth, const Box& box, const std::size_t b[3],
                   const std::size_t e[3], std::uint32_t n);
   void make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0);
@@ -221,11 +276,14 @@ class Builder {
   std::span<const Aabb> boxes_;
   bool triangles_ = true;
 
+  Stack<BinItem> items_;            // the binned stage's lists
+  std::vector<std::uint32_t> gid_;  // exact stage: local item id (in the events) -> item id
   Arena ev_[3];
-  std::vector<std::uint8_t> side_;
+  std::vector<std::uint8_t> side_;  // by local id
   std::vector<std::uint32_t> both_;
   std::vector<Key> new_left_[3];
   std::vector<Key> new_right_[3];
+  std::vector<Key> sort_scratch_;
   std::vector<std::uint32_t> leaf_scratch_;
   std::vector<std::uint32_t> right_scratch_;
   std::vector<std::uint32_t> both_left_;  // straddlers kept on each side
@@ -246,6 +304,12 @@ const KdBuildParams& Builder::checked(const KdBuildParams& p) {
                              " outside 0..1000");
   if (p.leaf_size < 0)
     throw std::runtime_error("kd-tree: negative leaf size " + std::to_string(p.leaf_size));
+  if (p.binned_above < 0)
+    throw std::runtime_error("kd-tree: negative binned-above threshold " +
+                             std::to_string(p.binned_above));
+  if (p.bins < 2 || p.bins > kMaxBins)
+    throw std::runtime_error("kd-tree: bins " + std::to_string(p.bins) + " outside 2.." +
+                             std::to_string(kMaxBins));
   return p;
 }
 
@@ -264,36 +328,27 @@ void Builder::start(std::size_t items) {
   if (items >= kMaxItems)
     throw std::runtime_error("kd-tree: " + std::to_string(items) + " items exceed the limit of " +
                              std::to_string(kMaxItems - 1));
-  side_.assign(items, kBoth);
-  for (auto& a : ev_) {
-    a.top_ = 0;
-    // Room for the initial lists (up to 2 events per item) and, stacked above them, the lists
-    // along the recursion path (about 2 + 1 + 1/2 + ... times the initial ones, plus straddling
-    // duplicates): 12 per item. Untouched pages cost nothing; growing copies everything.
-    a.ensure(std::max<std::size_t>(64, items * 12));
-  }
+  // Room for the root list and, stacked above it, the lists along the recursion path (about
+  // 1 + 1 + 1/2 + ... times the root's, plus straddlers' duplicates). Untouched pages cost
+  // nothing; growing copies everything.
+  items_.top_ = 0;
+  items_.ensure(std::max<std::size_t>(64, items * 4));
   for (int k = 0; k < 3; ++k) {
     root_.lo[k] = std::numeric_limits<float>::infinity();
     root_.hi[k] = -std::numeric_limits<float>::infinity();
   }
 }
 
-void Builder::add_item_events(std::uint32_t id, const float lo[3], const float hi[3]) {
+void Builder::add_item(std::uint32_t id, const float lo[3], const float hi[3]) {
+  float l[3];
+  float h[3];
   for (int k = 0; k < 3; ++k) {
-    const float a = grid_.down(lo[k]);
-    const float b = grid_.up(hi[k]);
-    Key* out = ev_[k].data() + ev_[k].top_;
-    if (a == b) {
-      out[0] = make_key(ordered(a), kPlanar, id);
-      ev_[k].top_ += 1;
-    } else {
-      out[0] = make_key(ordered(a), kStart, id);
-      out[1] = make_key(ordered(b), kEnd, id);
-      ev_[k].top_ += 2;
-    }
-    root_.lo[k] = std::min(root_.lo[k], a);
-    root_.hi[k] = std::max(root_.hi[k], b);
+    l[k] = grid_.down(lo[k]);
+    h[k] = grid_.up(hi[k]);
+    root_.lo[k] = std::min(root_.lo[k], l[k]);
+    root_.hi[k] = std::max(root_.hi[k], h[k]);
   }
+  set_bin_item(items_.data()[items_.top_++], id, l, h);
   ++item_count_;
 }
 
@@ -322,7 +377,7 @@ void Builder::build_triangles(std::span<const glm::vec3> positions,
     const glm::vec3 hi = glm::max(glm::max(positions[t.x], positions[t.y]), positions[t.z]);
     const float l[3] = {lo.x, lo.y, lo.z};
     const float h[3] = {hi.x, hi.y, hi.z};
-    add_item_events(static_cast<std::uint32_t>(i), l, h);
+    add_item(static_cast<std::uint32_t>(i), l, h);
   }
   run();
 }
@@ -345,7 +400,7 @@ void Builder::build_boxes(std::span<const Aabb> boxes) {
     }
     const float l[3] = {boxes[i].lo.x, boxes[i].lo.y, boxes[i].lo.z};
     const float h[3] = {boxes[i].hi.x, boxes[i].hi.y, boxes[i].hi.z};
-    add_item_events(static_cast<std::uint32_t>(i), l, h);
+    add_item(static_cast<std::uint32_t>(i), l, h);
   }
   run();
 }
@@ -361,17 +416,341 @@ void Builder::run() {
     tree_.bounds = Aabb{};
     return;
   }
-  std::vector<Key> scratch;
-  std::size_t b[3];
-  std::size_t e[3];
-  for (int k = 0; k < 3; ++k) {
-    radix_sort(ev_[k].data(), ev_[k].top_, scratch);
-    b[k] = 0;
-    e[k] = ev_[k].top_;
-  }
   tree_.bounds.lo = glm::vec3(root_.lo[0], root_.lo[1], root_.lo[2]);
   tree_.bounds.hi = glm::vec3(root_.hi[0], root_.hi[1], root_.hi[2]);
-  build_node(0, 0, root_, b, e, item_count_);
+  const std::size_t n = items_.top_;
+  bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n));
+}
+
+// The exact stage for a subtree: events from the items' bounds (already on the grid), with
+// local ids 0..n-1 so that the per-item side bytes stay in cache, sorted once.
+void Builder::exact_subtree(std::uint32_t node, int depth, const Box& box, std::size_t b,
+                            std::uint32_t n) {
+  gid_.resize(n);
+  if (side_.size() < n) side_.resize(n);
+  const BinItem* items = items_.data() + b;
+  std::size_t eb[3];
+  std::size_t ee[3];
+  for (int k = 0; k < 3; ++k) {
+    Arena& a = ev_[k];
+    // Room for the subtree's list (up to 2 events per item) and the lists stacked above it
+    // along the recursion path: 12 per item.
+    a.top_ = 0;
+    a.ensure(std::max<std::size_t>(64, std::size_t{n} * 12));
+    Key* out = a.data();
+    std::size_t m = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const float lo = items[i].lo[k];
+      const float hi = item_hi(items[i], k);
+      if (lo == hi) {
+        out[m++] = make_key(ordered(lo), kPlanar, i);
+      } else {
+        out[m++] = make_key(ordered(lo), kStart, i);
+        out[m++] = make_key(ordered(hi), kEnd, i);
+      }
+    }
+    radix_sort(out, m, sort_scratch_);
+    a.top_ = m;
+    eb[k] = 0;
+    ee[k] = m;
+  }
+  for (std::uint32_t i = 0; i < n; ++i)
+    gid_[i] = items[i].id;
+  build_node(node, depth, box, eb, ee, n);
+}
+
+// Binned SAH (Wald 2007; for kd-trees Shevtsov et al. 2007) with exact counts on the grid.
+// Per axis, a grid value x falls into bin f(x) = trunc(clamp((x - lo) * bins / extent, 0,
+// bins - 1)), monotone in x. Candidate plane j is the smallest grid value s_j with f(s_j) > j,
+// so for every grid value x: x < s_j <=> f(x) <= j. An item is left of s_j iff lo < s_j, i.e.
+// f(lo) <= j; it is no longer right of s_j iff key < s_j (BinItem), i.e. f(key) <= j (planars at
+// a candidate count right). The counts are therefore exact for the stored plane s_j, with two
+// bin lookups per item and axis and no correction. A bin spans at least 4 grid steps, so s_j
+// lies within a quarter bin of the even position, which is used for the areas; only the
+// winner's s_j is searched. The two empty-space planes at the items' lowest and highest bounds
+// are evaluated besides.
+BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
+                                       std::uint32_t n) const {
+  BinnedSplit best;
+  const double d[3] = {static_cast<double>(box.hi[0]) - box.lo[0],
+                       static_cast<double>(box.hi[1]) - box.lo[1],
+                       static_cast<double>(box.hi[2]) - box.lo[2]};
+  const double half_area = d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+  if (!(half_area > 0.0)) return best;
+  const double inv_area = 1.0 / half_area;
+  const double kt = p_.traversal_cost;
+  const double ki = p_.intersection_cost;
+  const double bonus = p_.empty_bonus;
+  // Fewer bins for smaller nodes: the per-node cost is proportional to the bins, the per-item
+  // cost is not; the top of the tree, which decides the most, gets the most.
+  // Fewer bins for smaller nodes: the per-node cost is proportional to the bins, the per-item
+  // cost is not; the top of the tree, which decides the most, gets the most. On each axis a bin
+  // spans at least 4 grid steps (finer candidates would collapse onto the same grid values).
+  const int nb_node = std::clamp(static_cast<int>(n), std::min(32, p_.bins), p_.bins);
+  const double step_rel = std::ldexp(1.0, -p_.split_format.man_bits);
+  const double min_normal = std::ldexp(1.0, p_.split_format.emin());
+  int nb[3];
+  float scale[3];
+  float base[3];
+  float top[3];
+  std::uint32_t hist_lo[3][kMaxBins];
+  std::uint32_t hist_hi[3][kMaxBins];
+  float tlo[3];
+  float tkey[3];
+  for (int k = 0; k < 3; ++k) {
+    const double mag = std::max(std::fabs(static_cast<double>(box.lo[k])),
+                                std::fabs(static_cast<double>(box.hi[k])));
+    const double grid_step = std::max(mag * step_rel, min_normal);
+    nb[k] =
+        static_cast<int>(std::clamp(d[k] / (4.0 * grid_step), 2.0, static_cast<double>(nb_node)));
+    base[k] = box.lo[k];
+    // Flat: all in bin 0. Any finite scale keeps f monotone (and free of 0 * inf).
+    scale[k] = d[k] > 0.0 ? static_cast<float>(std::min(nb[k] / d[k], 0x1p127)) : 0.0f;
+    top[k] = static_cast<float>(nb[k] - 1);
+    std::fill(hist_lo[k], hist_lo[k] + nb[k], 0u);
+    std::fill(hist_hi[k], hist_hi[k] + nb[k], 0u);
+    tlo[k] = std::numeric_limits<float>::infinity();
+    tkey[k] = -std::numeric_limits<float>::infinity();
+  }
+#if defined(__SSE2__)
+  // The same arithmetic four lanes at a time (IEEE single, as the scalar f below): lanes
+  // lo0 lo1 lo2 key0 and key0 key1 key2 id (id lane: times 0, unused).
+  static_assert(sizeof(BinItem) == 32 && offsetof(BinItem, key) == 12);
+  {
+    const __m128 base_a = _mm_setr_ps(base[0], base[1], base[2], base[0]);
+    const __m128 scale_a = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
+    const __m128 top_a = _mm_setr_ps(top[0], top[1], top[2], 0.0f);
+    const __m128 scale_b = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
+    const __m128 zero = _mm_setzero_ps();
+    __m128 vlo = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    __m128 vkey = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    alignas(16) std::int32_t idx[8];
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const float* p = items[i].lo;
+      const __m128 a = _mm_loadu_ps(p);
+      const __m128 c = _mm_loadu_ps(p + 3);
+      vlo = _mm_min_ps(vlo, a);
+      vkey = _mm_max_ps(vkey, c);
+      const __m128 fa =
+          _mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(a, base_a), scale_a), zero), top_a);
+      const __m128 fc =
+          _mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(c, base_a), scale_b), zero), top_a);
+      _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(fa));
+      _mm_store_si128(reinterpret_cast<__m128i*>(idx + 4), _mm_cvttps_epi32(fc));
+      ++hist_lo[0][idx[0]];
+      ++hist_lo[1][idx[1]];
+      ++hist_lo[2][idx[2]];
+      ++hist_hi[0][idx[4]];
+      ++hist_hi[1][idx[5]];
+      ++hist_hi[2][idx[6]];
+    }
+    alignas(16) float l4[4];
+    alignas(16) float k4[4];
+    _mm_store_ps(l4, vlo);
+    _mm_store_ps(k4, vkey);
+    for (int k = 0; k < 3; ++k) {
+      tlo[k] = l4[k];
+      tkey[k] = k4[k];
+    }
+  }
+#else
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const BinItem& it = items[i];
+    for (int k = 0; k < 3; ++k) {
+      const float lo = it.lo[k];
+      const float key = it.key[k];
+      tlo[k] = std::min(tlo[k], lo);
+      tkey[k] = std::max(tkey[k], key);
+      const int j = static_cast<int>(std::min(std::max((lo - base[k]) * scale[k], 0.0f), top[k]));
+      const int h = static_cast<int>(std::min(std::max((key - base[k]) * scale[k], 0.0f), top[k]));
+      ++hist_lo[k][j];
+      ++hist_hi[k][h];
+    }
+  }
+#endif
+  // s_j by search on the grid (see above); +inf when no grid value in the box reaches bin j + 1.
+  auto threshold = [&](int k, int j) {
+    const auto want = static_cast<float>(j + 1);
+    auto f = [&](float x) { return std::min(std::max((x - base[k]) * scale[k], 0.0f), top[k]); };
+    float x = grid_.up(std::min(static_cast<float>(box.lo[k] + d[k] * (j + 1) / nb[k]), box.hi[k]));
+    while (x < box.hi[k] && f(x) < want)
+      x = grid_succ(x);
+    if (!(f(x) >= want)) return std::numeric_limits<float>::infinity();
+    for (float below = grid_pred(x); below > box.lo[k] && f(below) >= want; below = grid_pred(x))
+      x = below;
+    return x;
+  };
+  int bin_j = -1;  // the winner's candidate when it is a bin plane
+  for (int k = 0; k < 3; ++k) {
+    if (!(d[k] > 0.0)) continue;
+    const double sum = d[(k + 1) % 3] + d[(k + 2) % 3];
+    const double prod = d[(k + 1) % 3] * d[(k + 2) % 3];
+    const double lo = box.lo[k];
+    const double hi = box.hi[k];
+    auto cost_at = [&](double x, std::uint32_t nl, std::uint32_t nr) {
+      const double al = (x - lo) * sum + prod;
+      const double ar = (hi - x) * sum + prod;
+      return (nl == 0 || nr == 0 ? bonus : 1.0) * (kt + ki * inv_area * (al * nl + ar * nr));
+    };
+    // A plane with an empty side is never better than the empty-space plane at the items'
+    // bound below, so only planes with items on both sides are weighed, without the bonus:
+    // compared as aL * nL + aR * nR, with the children's half areas stepping evenly (the even
+    // position is within a quarter bin of s_j).
+    const int nc = nb[k] - 1;
+    const double da = d[k] / nb[k] * sum;
+    double al = prod;
+    double ar = d[k] * sum + prod;
+    double best_m = std::numeric_limits<double>::infinity();
+    std::uint32_t nl = 0;
+    std::uint32_t not_right = 0;
+    int best_j = -1;
+    std::uint32_t best_nl = 0;
+    std::uint32_t best_nr = 0;
+    for (int j = 0; j < nc; ++j) {
+      nl += hist_lo[k][j];
+      not_right += hist_hi[k][j];
+      al += da;
+      ar -= da;
+      const std::uint32_t nr = n - not_right;
+      const double m = al * nl + ar * nr;
+      if (nl != 0 && nr != 0 && m < best_m) {
+        best_m = m;
+        best_j = j;
+        best_nl = nl;
+        best_nr = nr;
+      }
+    }
+    if (best_j >= 0) {
+      const double c = kt + ki * inv_area * best_m;
+      if (c < best.cost) {
+        best = BinnedSplit{c, k, 0.0f, false, best_nl, best_nr};
+        bin_j = best_j;  // s_j searched once the winner is known
+      }
+    }
+    // Empty-space planes at the items' bounds (all items on one side, planars with them):
+    // the lowest lower bound, and the grid value above the highest key (the highest upper
+    // bound, or one grid step beyond it when that is a planar item's).
+    if (tlo[k] > box.lo[k] && tlo[k] < box.hi[k]) {
+      const double c = cost_at(tlo[k], 0, n);
+      if (c < best.cost) {
+        best = BinnedSplit{c, k, tlo[k], false, 0, n};
+        bin_j = -1;
+      }
+    }
+    const float thi = grid_succ(tkey[k]);
+    if (thi < box.hi[k] && thi > box.lo[k]) {
+      const double c = cost_at(thi, n, 0);
+      if (c < best.cost) {
+        best = BinnedSplit{c, k, thi, true, n, 0};
+        bin_j = -1;
+      }
+    }
+  }
+  if (bin_j >= 0) {
+    const int k = best.axis;
+    best.pos = threshold(k, bin_j);
+    // Only a box a few grid steps wide can leave no grid value strictly inside.
+    if (!(best.pos > box.lo[k] && best.pos < box.hi[k])) return BinnedSplit{};
+  }
+  return best;
+}
+
+void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_t b,
+                       std::uint32_t n) {
+  if (n <= static_cast<std::uint32_t>(p_.binned_above)) {
+    exact_subtree(node, depth, box, b, n);
+    return;
+  }
+  if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth) {
+    leaf_scratch_.clear();
+    for (std::uint32_t i = 0; i < n; ++i)
+      leaf_scratch_.push_back(items_.data()[b + i].id);
+    emit_leaf(node, leaf_scratch_);
+    return;
+  }
+  const BinnedSplit best = find_binned_split(box, items_.data() + b, n);
+  if (best.axis < 0 || !(best.cost < static_cast<double>(p_.intersection_cost) * n)) {
+    // The bins found nothing worth it: the exact sweep decides (leaf or a plane between bins).
+    exact_subtree(node, depth, box, b, n);
+    return;
+  }
+  const int k = best.axis;
+  const float split = best.pos;
+  Box lbox = box;
+  Box rbox = box;
+  lbox.hi[k] = split;
+  rbox.lo[k] = split;
+
+  // One pass: classify (as the exact stage does) and write the children's lists, whose sizes
+  // the binning counted (clipping may only drop pieces).
+  const std::size_t lb = items_.top_;
+  const std::size_t rb = lb + best.left;
+  items_.ensure(rb + best.right);
+  BinItem* all = items_.data();
+  const std::uint8_t planar_side = best.planar_left ? kLeft : kRight;
+  std::uint32_t nl = 0;
+  std::uint32_t nr = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const BinItem& it = all[b + i];
+    const float lo = it.lo[k];
+    const bool planar = (it.planar >> k) & 1u;
+    const std::uint8_t v = planar && lo == split ? planar_side
+                           : it.key[k] < split   ? kLeft
+                           : lo >= split         ? kRight
+                                                 : kBoth;
+    if (v == kLeft) {
+      all[lb + nl++] = it;
+      continue;
+    }
+    if (v == kRight) {
+      all[rb + nr++] = it;
+      continue;
+    }
+    // Perfect split of a straddler, with the exact stage's rules.
+    float llo[3];
+    float lhi[3];
+    float rlo[3];
+    float rhi[3];
+    const int pieces = clip_split(it.id, box, k, split, llo, lhi, rlo, rhi);
+    bool in_left = (pieces & 1) && llo[k] < split;
+    bool in_right = (pieces & 2) && rhi[k] > split;
+    if (!in_left && !in_right) {
+      in_left = (pieces & 1) != 0;
+      in_right = !in_left && (pieces & 2) != 0;
+    }
+    const std::uint32_t id = it.id;
+    if (in_left) {
+      for (int j = 0; j < 3; ++j) {
+        llo[j] = grid_.down(llo[j]);
+        lhi[j] = grid_.up(lhi[j]);
+      }
+      set_bin_item(all[lb + nl++], id, llo, lhi);
+    }
+    if (in_right) {
+      for (int j = 0; j < 3; ++j) {
+        rlo[j] = grid_.down(rlo[j]);
+        rhi[j] = grid_.up(rhi[j]);
+      }
+      set_bin_item(all[rb + nr++], id, rlo, rhi);
+    }
+  }
+
+  const auto child = static_cast<std::uint32_t>(tree_.nodes.size());
+  {
+    KdTreeNode& nd = tree_.nodes[node];
+    nd.leaf = false;
+    nd.axis = static_cast<std::uint8_t>(k);
+    nd.split = split;
+    nd.child = child;
+  }
+  tree_.nodes.emplace_back();
+  tree_.nodes.emplace_back();
+  const std::size_t top = rb + nr;
+  items_.top_ = top;
+  bin_node(child, depth + 1, lbox, lb, nl);
+  items_.top_ = top;
+  bin_node(child + 1, depth + 1, rbox, rb, nr);
+  items_.top_ = lb;
 }
 
 Split Builder::find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
@@ -452,7 +831,7 @@ void Builder::make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0) {
   leaf_scratch_.clear();
   const Key* ev = ev_[0].data();
   for (std::size_t i = b0; i < e0; ++i)
-    if (key_type(ev[i]) != kEnd) leaf_scratch_.push_back(key_id(ev[i]));
+    if (key_type(ev[i]) != kEnd) leaf_scratch_.push_back(gid_[key_id(ev[i])]);
   emit_leaf(node, leaf_scratch_);
 }
 
@@ -717,7 +1096,7 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     float lhi[3];
     float rlo[3];
     float rhi[3];
-    const int pieces = clip_split(id, box, k, split, llo, lhi, rlo, rhi);
+    const int pieces = clip_split(gid_[id], box, k, split, llo, lhi, rlo, rhi);
     // A clipped piece that only touches the plane is left to the other side.
     bool in_left = (pieces & 1) && llo[k] < split;
     bool in_right = (pieces & 2) && rhi[k] > split;
@@ -728,12 +1107,12 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     }
     if (in_left) {
       if (!last_level) add_clipped(id, llo, lhi, new_left_);
-      both_left_.push_back(id);
+      both_left_.push_back(gid_[id]);
       ++n_left;
     }
     if (in_right) {
       if (!last_level) add_clipped(id, rlo, rhi, new_right_);
-      both_right_.push_back(id);
+      both_right_.push_back(gid_[id]);
       ++n_right;
     }
   }
@@ -760,8 +1139,8 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
       const Key key = ev[i];
       if (key_type(key) == kEnd) continue;
       const std::uint32_t id = key_id(key);
-      if (side[id] == kLeft) leaf_scratch_.push_back(id);
-      if (side[id] == kRight) right_scratch_.push_back(id);
+      if (side[id] == kLeft) leaf_scratch_.push_back(gid_[id]);
+      if (side[id] == kRight) right_scratch_.push_back(gid_[id]);
     }
     leaf_scratch_.insert(leaf_scratch_.end(), both_left_.begin(), both_left_.end());
     right_scratch_.insert(right_scratch_.end(), both_right_.begin(), both_right_.end());

@@ -38,6 +38,12 @@ struct KdBuildParams {
   float empty_bonus = 0.8f;  // cost factor for a split that cuts off empty space
   int max_depth = 24;        // per level; top + bottom must fit the 64-entry traversal stack
   int leaf_size = 2;         // never split a node with this many items or fewer
+  // Hybrid build (docs/kdtree.md): a node with more than `binned_above` items is split by binned
+  // SAH over its items' clipped bounds (`bins` bins per axis, plus the two empty-space planes at
+  // the items' bounds); a subtree at or below it by Wald & Havran's exact event sweep. A huge
+  // value gives the pure event builder.
+  int binned_above = 0;
+  int bins = 128;  // 2..256
   // Split planes are rounded (nearest even) into this format before items are classified, so the
   // tree is exact for the plane the hardware stores (DESIGN.md section 4: split position in fp24).
   ff::Format split_format = ff::kFp24;

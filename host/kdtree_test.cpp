@@ -926,6 +926,67 @@ TEST(KdTopLevel, RandomBoxesFlatBoxesAndPoints) {
   check_box_tree(st, same);
 }
 
+// The hybrid (docs/kdtree.md): the exact event sweep alone, binning down to the leaf decisions,
+// very few and the most bins, a threshold between, and a coarse split grid under binning (bins
+// collapse onto few grid values) all keep every invariant; the binned tree costs little more.
+TEST(KdTree, BinnedAndExactStagesKeepTheInvariants) {
+  Mesh m = random_triangles(900 / kScale, 31, 10.0f, 0.7f);
+  append(m, sphere(16, 24, glm::vec3(2.0f, 1.0f, 0.0f), 4.0f));
+  append(m, terrain(24 / kScale, 20 / kScale, 9));
+  struct Config {
+    const char* name;
+    int binned_above;
+    int bins;
+    ff::Format format;
+  };
+  const Config configs[] = {{"exact", 1 << 30, 128, ff::kFp24},
+                            {"binned", 0, 128, ff::kFp24},
+                            {"two bins", 0, 2, ff::kFp24},
+                            {"256 bins, exact below 200", 200, 256, ff::kFp24},
+                            {"binned e5m6", 0, 64, ff::Format{5, 6}}};
+  double sah[2] = {0.0, 0.0};
+  std::size_t nodes[2] = {0, 0};
+  int i = 0;
+  for (const Config& c : configs) {
+    SCOPED_TRACE(c.name);
+    KdBuildParams p;
+    p.binned_above = c.binned_above;
+    p.bins = c.bins;
+    p.split_format = c.format;
+    const KdTree tree = build_kdtree(m.pos, m.tris, {}, p);
+    EXPECT_GT(tree.stats.leaves, 100u);
+    check_triangle_tree(tree, m, p);
+    check_rays(tree, m, 1500 / kScale, 40 + i);
+    check_points(tree, m, 200 / kScale, 50 + i);
+    if (i < 2) {
+      sah[i] = tree.stats.sah_cost;
+      nodes[i] = tree.nodes.size();
+    }
+    ++i;
+  }
+  EXPECT_NE(nodes[0], nodes[1]);  // two different builders ran
+  EXPECT_LT(sah[1], 1.1 * sah[0]);
+  EXPECT_GT(sah[1], 0.9 * sah[0]);
+  // The top level through both stages.
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(-20.0f, 20.0f);
+  std::vector<Aabb> boxes;
+  for (int b = 0; b < 600; ++b) {
+    Aabb box;
+    const glm::vec3 lo(u(rng), u(rng), u(rng));
+    box.grow(lo);
+    box.grow(lo + glm::vec3(b % 7 == 0 ? 0.0f : 1.5f, 1.0f, b % 5 == 0 ? 0.0f : 2.0f));
+    boxes.push_back(box);
+  }
+  for (const int above : {0, 1 << 30}) {
+    KdBuildParams p;
+    p.binned_above = above;
+    const KdTree top = build_kdtree(boxes, p);
+    EXPECT_GT(top.stats.leaves, 50u);
+    check_box_tree(top, boxes);
+  }
+}
+
 // ---- bad input -------------------------------------------------------------------------------
 
 void expect_error(const std::function<void()>& f, const std::string& text) {
@@ -968,6 +1029,15 @@ TEST(KdTree, BadInputIsRefusedWithOneClearLine) {
   p = {};
   p.intersection_cost = 0.0f;
   expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, "kd-tree: cost parameters");
+  p = {};
+  p.bins = 1;
+  expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, "kd-tree: bins 1 outside 2..256");
+  p.bins = 257;
+  expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, "kd-tree: bins 257 outside 2..256");
+  p = {};
+  p.binned_above = -1;
+  expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); },
+               "kd-tree: negative binned-above threshold -1");
   p = {};
   p.split_format = ff::Format{9, 30};
   expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, "kd-tree: invalid split format");
