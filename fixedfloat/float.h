@@ -78,8 +78,7 @@ struct OpCounts {
 template <class F>
 class FpUnit {
  public:
-  explicit FpUnit(Mode mode = {}, OpCounts* counts = nullptr)
-      : mode_(mode), rounder_(mode), counts_(counts) {}
+  explicit FpUnit(Mode mode = {}, OpCounts* counts = nullptr) : rounder_(mode), counts_(counts) {}
 
   F add(F a, F b) const {
     if (counts_) ++counts_->add;
@@ -103,35 +102,36 @@ class FpUnit {
   }
   bool lt(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return fast::lt<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_);
+    return fast::lt<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_.mode);
   }
   bool le(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return fast::le<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_);
+    return fast::le<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_.mode);
   }
   bool eq(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return fast::eq<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_);
+    return fast::eq<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_.mode);
   }
   F min(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return F{fast::min<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
+    return F{fast::min<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_.mode)};
   }
   F max(F a, F b) const {
     if (counts_) ++counts_->cmp;
-    return F{fast::max<F::kExpBits, F::kManBits>(a.bits, b.bits, mode_)};
+    return F{fast::max<F::kExpBits, F::kManBits>(a.bits, b.bits, rounder_.mode)};
   }
-  F from_double(double v) const { return F{fast::from_double<F::kExpBits, F::kManBits>(v, mode_)}; }
-  F from_int(std::int64_t v) const { return F{ff::from_int(v, F::kFormat, mode_)}; }
+  F from_double(double v) const {
+    return F{fast::from_double<F::kExpBits, F::kManBits>(v, rounder_.mode)};
+  }
+  F from_int(std::int64_t v) const { return F{ff::from_int(v, F::kFormat, rounder_.mode)}; }
   double to_double(F a) const {
-    return fast::decode<F::kExpBits, F::kManBits>(a.bits, mode_.subnormals);
+    return fast::decode<F::kExpBits, F::kManBits>(a.bits, rounder_.mode.subnormals);
   }
 
-  const Mode& mode() const { return mode_; }
+  const Mode& mode() const { return rounder_.mode; }
   OpCounts* counts() const { return counts_; }
 
  private:
-  Mode mode_;
   fast::Rounder<F::kExpBits, F::kManBits> rounder_;
   OpCounts* counts_;
 };

@@ -45,6 +45,23 @@ struct Layout {
   static constexpr std::uint64_t kSpan = static_cast<std::uint64_t>(kExpMax - 1u) << 52;
   static constexpr std::uint64_t kLowBits = (std::uint64_t{1} << kShift) - 1u;
   static constexpr std::uint64_t kHalf = std::uint64_t{1} << (kShift - 1);
+
+  // The signed decode of the nearest-even add (see add_nearest): b << kTop puts the sign at bit 63;
+  // an arithmetic shift by kFill then sets the kFill binary64 exponent bits above the target's to
+  // copies of the sign, and or-ing kFillMask sets them for both signs. The binary64 exponent field
+  // becomes e + kFillBias, so the all-ones field (inf, NaN) maps exactly onto binary64 inf/NaN.
+  static constexpr int kTop = 63 - E - M;
+  static constexpr int kFill = 11 - E;
+  static constexpr std::uint64_t kFillMask = ((std::uint64_t{1} << kFill) - 1u) << (52 + E);
+  static constexpr std::uint64_t kFillBias = 2048u - (1u << E);
+  // Smallest exponent field of a sum the nearest-even add accepts: then every operand whose
+  // exponent field is 0 (read as 2^emin * 1.f by the signed decode) is below a quarter ulp of the
+  // sum and cannot change it, exactly like the zero it stands for (see add_nearest).
+  static constexpr std::uint32_t kAddLowField = M + 3;
+  static constexpr bool kAddNearest = kAddLowField < kExpMax;
+  // Exponent offset of the product of a magnitude decoded with field e (scale 2^(bias-1023)) and
+  // one decoded with field e + kFillBias: the product's binary64 field is e + kMulBias.
+  static constexpr std::uint64_t kMulBias = kFillBias + kBias - 1023u;
 };
 
 // True for normal encodings (exponent field neither 0 nor all ones): adding one to the exponent
@@ -107,26 +124,37 @@ template <int E, int M>
   return round_pack(v, dir, Layout<E, M>::kFormat, m);
 }
 
-// A Mode with the constant of the common rounding case precomputed: for a binary64 magnitude |v|
-// in the target's normal range, nearest-even gives the rounded exponent|mantissa field as
-// (bits(|v|) + add + lsb) >> (52 - M), with add = half - 1 - rebias and lsb the lowest kept bit
-// (a tie then rounds to even). Double rounding (binary64, then M+1 bits) is innocuous for +, -, x,
-// /, sqrt whenever 53 >= 2(M+1)+2 (Figueroa 1995), which holds for every supported format (M <=
-// 23), so nearest-even never needs the exact error. Truncation does: a binary64 value exactly on
-// the target grid may stand for an exact result just below it.
+// A Mode with the mode-dependent limits of the fast paths precomputed. For a binary64 magnitude
+// |v| in the target's normal range, nearest-even gives the rounded exponent|mantissa field as
+// (bits(|v|) + half - 1 - rebias + lsb) >> (52 - M), with lsb the lowest kept bit (a tie then
+// rounds to even). Double rounding (binary64, then M+1 bits) is innocuous for +, -, x, /, sqrt
+// whenever 53 >= 2(M+1)+2 (Figueroa 1995), which holds for every supported format (M <= 23), so
+// nearest-even never needs the exact error. Truncation does: a binary64 value exactly on the
+// target grid may stand for an exact result just below it.
+//
+// The spans are the widths of the ranges that the nearest-even paths accept: the whole range for
+// nearest-even, empty for truncation (which then takes its own branch), so the common path needs
+// no test of the mode. The struct is kept small (16 bytes) so that a compiler can hold a unit in
+// registers and fold a mode it knows.
 template <int E, int M>
 struct Rounder {
   using L = Layout<E, M>;
   Mode mode;
-  std::uint64_t add;
-  // Width of the range of kept bits (bits(|v|) >> (52 - M)) that the nearest-even path takes:
-  // the whole normal range for nearest-even, empty for truncation (which then takes its own
-  // branch), so the common path needs no test of the mode.
-  std::uint64_t nearest_span;
+  // round_mag: kept bits (bits(|v|) >> (52 - M)) from the smallest normal's on.
+  std::uint32_t nearest_span;
+  // add_nearest, mul_nearest: rounded exponent|mantissa fields from their lowest accepted one up
+  // to the infinity encoding.
+  std::uint32_t add_span;
+  std::uint32_t mul_span;
   constexpr explicit Rounder(const Mode& m)
       : mode(m),
-        add(L::kHalf - 1u - L::kRebias),
-        nearest_span(m.rounding == Rounding::kNearestEven ? (L::kSpan >> L::kShift) : 0u) {}
+        nearest_span(m.rounding == Rounding::kNearestEven
+                         ? static_cast<std::uint32_t>(L::kSpan >> L::kShift)
+                         : 0u),
+        add_span(m.rounding == Rounding::kNearestEven && L::kAddNearest
+                     ? ((L::kExpMax - L::kAddLowField) << M) + 1u
+                     : 0u),
+        mul_span(m.rounding == Rounding::kNearestEven ? ((L::kExpMax - 1u) << M) + 1u : 0u) {}
 };
 
 // Truncation of a magnitude exactly on the grid; d is the sign of (exact magnitude - |v|). The
@@ -156,7 +184,8 @@ inline std::uint32_t round_mag(std::uint64_t mag, std::uint32_t sign, const Roun
   if (offset < r.nearest_span) [[likely]] {
     // Nearest-even in the normal range. A carry out of the mantissa increments the exponent
     // field; a carry out of the largest finite value gives exactly the infinity encoding.
-    return sign | static_cast<std::uint32_t>((mag + r.add + (kept & 1u)) >> L::kShift);
+    constexpr std::uint64_t kAdd = L::kHalf - 1u - L::kRebias;
+    return sign | static_cast<std::uint32_t>((mag + kAdd + (kept & 1u)) >> L::kShift);
   }
   if (offset < (L::kSpan >> L::kShift) && r.mode.rounding == Rounding::kTowardZero) {
     if ((mag & L::kLowBits) != 0)
@@ -188,8 +217,10 @@ inline int sign_of(double x) {
   return (x > 0.0) - (x < 0.0);
 }
 
+// Both operands normal: the binary64 sum, rounded by round_mag (which also has truncation's
+// in-range branch); everything else on the general path.
 template <int E, int M>
-inline std::uint32_t add(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+inline std::uint32_t add_checked(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
   using L = Layout<E, M>;
   if (both_normal<E, M>(a, b)) [[likely]] {
     // |a| + (+-|b|) with b's sign relative to a's: the sum's sign flips a's sign when negative.
@@ -216,13 +247,118 @@ inline std::uint32_t add(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& 
   return slow_add<E, M>(a, b, r.mode);
 }
 
+// Exact binary64 value, scaled by 2^(kFillBias + bias - 1023), of a normal encoding; an infinity
+// or NaN becomes binary64 inf or NaN, and a zero or subnormal becomes +-2^emin * 1.f (scaled).
 template <int E, int M>
-inline std::uint32_t sub(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
-  return add<E, M>(a, b ^ Layout<E, M>::kSign, r);
+inline std::uint64_t signed_decode_bits(std::uint32_t b) {
+  using L = Layout<E, M>;
+  const auto top = static_cast<std::int64_t>(static_cast<std::uint64_t>(b) << L::kTop);
+  return static_cast<std::uint64_t>(top >> L::kFill) | L::kFillMask;
+}
+// signed_decode_bits of two operands. With GCC/Clang vector extensions on a little-endian machine
+// both go through one 128-bit register (x86-64: two loads into it, one shift per direction, one
+// or): fewer instructions than two scalar decodes and two moves into floating-point registers.
+// The arithmetic right shift works on the upper 32-bit half of each 64-bit lane, which holds the
+// whole shifted encoding as long as M <= 20 (then no bit crosses into the lower half).
+#if defined(__GNUC__)
+#define SAARCOR_FF_VECTOR_DECODE 1
+#endif
+struct DecodedPair {
+  double x, y;
+};
+template <int E, int M>
+inline DecodedPair signed_decode_pair(std::uint32_t a, std::uint32_t b) {
+  using L = Layout<E, M>;
+#if defined(SAARCOR_FF_VECTOR_DECODE)
+  if constexpr (M <= 20 && std::endian::native == std::endian::little) {
+    using U64x2 = std::uint64_t __attribute__((vector_size(16)));
+    using I32x4 = std::int32_t __attribute__((vector_size(16)));
+    U64x2 v = {a, b};
+    v <<= L::kTop;
+    v = std::bit_cast<U64x2>(std::bit_cast<I32x4>(v) >> L::kFill) | L::kFillMask;
+    return {std::bit_cast<double>(v[0]), std::bit_cast<double>(v[1])};
+  }
+#endif
+  return {std::bit_cast<double>(signed_decode_bits<E, M>(a)),
+          std::bit_cast<double>(signed_decode_bits<E, M>(b))};
+}
+
+// The encoding back from signed_decode_bits.
+template <int E, int M>
+inline std::uint32_t signed_encode(double x) {
+  using L = Layout<E, M>;
+  const auto u = std::bit_cast<std::uint64_t>(x);
+  return (static_cast<std::uint32_t>(u >> L::kShift) & L::kMag) |
+         (static_cast<std::uint32_t>(u >> L::kTop) & L::kSign);
+}
+// What the nearest-even add leaves (truncation, sums out of its range, NaN results), from its
+// decoded operands. Out of line, with the mode by value, so the common path stays short and the
+// unit does not escape.
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t add_rest(double x, double y, Mode m) {
+  return add_checked<E, M>(signed_encode<E, M>(x), signed_encode<E, M>(y), Rounder<E, M>(m));
+}
+
+// The nearest-even add without a test of its operands. Both are decoded with signed_decode and
+// added once in binary64; the sum is rounded to the target's precision by integer arithmetic on its
+// bit pattern (ties to even, a mantissa carry bumps the exponent, the largest finite value carries
+// into exactly the infinity encoding) and accepted when the rounded exponent field lies in
+// [M+3, all ones]:
+//   - normal operands: as in add_checked (double rounding is innocuous, Figueroa 1995);
+//   - an operand with exponent field 0 (zero or subnormal, in either subnormal mode) decodes as
+//     some x with |x| < 2^emin. An accepted sum is at least 2^(emin+M+2), so the other operand y
+//     is at least that large too (a sum of two operands below it stays below it) and |x| is less
+//     than a quarter ulp of y: y + x rounds to y, the same as y + 0 or y + subnormal. Both
+//     roundings see precision-(M+1) operands, so Figueroa's theorem covers the binary64 step here
+//     as well;
+//   - inf and NaN operands give binary64 inf (the infinity encoding, correct) or NaN (a rounded
+//     field above all ones: rejected);
+//   - overflow: a binary64 sum that overflows is beyond the target's overflow threshold, and its
+//     infinity rounds to the infinity encoding; smaller sums carry into it by rounding;
+//   - sums below the range, exact zeros (whose rounded field wraps around far above the range) and
+//     truncation (add_span = 0) go to add_rest.
+// kSub: a - b, as x - y on the decoded operands (the same binary64 operation as x + (-y)).
+template <int E, int M, bool kSub>
+inline std::uint32_t add_nearest(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  using L = Layout<E, M>;
+  // The sum's bit pattern doubled drops its sign. One constant adds half - 1 at the rounding
+  // position and removes the exponent offset kFillBias and the lowest accepted field, so q is the
+  // rounded exponent|mantissa field minus its lowest accepted value (wrapping around far above the
+  // range for exponents below it, exact zeros included).
+  constexpr std::uint64_t kLow = std::uint64_t{L::kAddLowField} << M;
+  constexpr std::uint64_t kRound =
+      (std::uint64_t{1} << L::kShift) - 1u - (L::kFillBias << 53) - (kLow << (L::kShift + 1));
+  const auto [x, y] = signed_decode_pair<E, M>(a, b);
+  const double s = kSub ? x - y : x + y;
+  const std::uint64_t u = std::bit_cast<std::uint64_t>(s);
+  const std::uint64_t q = (u + u + kRound + ((u >> L::kShift) & 1u)) >> (L::kShift + 1);
+  if (q < r.add_span) [[likely]]
+    return static_cast<std::uint32_t>(q + kLow + ((u >> 63) << (E + M)));
+  // The operands go out decoded (in floating-point registers, where they already are) so that the
+  // common path need not keep the encodings live.
+  return add_rest<E, M>(x, kSub ? -y : y, r.mode);
 }
 
 template <int E, int M>
-inline std::uint32_t mul(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+inline std::uint32_t add(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  if constexpr (Layout<E, M>::kAddNearest) {
+    return add_nearest<E, M, false>(a, b, r);
+  } else {
+    return add_checked<E, M>(a, b, r);
+  }
+}
+
+template <int E, int M>
+inline std::uint32_t sub(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  if constexpr (Layout<E, M>::kAddNearest) {
+    return add_nearest<E, M, true>(a, b, r);
+  } else {
+    return add_checked<E, M>(a, b ^ Layout<E, M>::kSign, r);
+  }
+}
+
+template <int E, int M>
+inline std::uint32_t mul_checked(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
   if (both_normal<E, M>(a, b)) [[likely]] {
     // Two significands of at most 24 bits: the binary64 product of the magnitudes is exact.
     const double p = std::bit_cast<double>(magnitude_bits<E, M>(a)) *
@@ -231,6 +367,43 @@ inline std::uint32_t mul(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& 
                            [] { return 0; });
   }
   return slow_mul<E, M>(a, b, r.mode);
+}
+
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t mul_rest(std::uint32_t a, std::uint32_t b, Mode m) {
+  return mul_checked<E, M>(a, b, Rounder<E, M>(m));
+}
+
+// The nearest-even mul. a must be normal and b's exponent field nonzero; a's magnitude is decoded
+// with its exponent field unchanged (scale 2^(bias-1023)), b's with the field raised by kFillBias
+// (its sign bit lands in the or-ed fill bits and vanishes; an infinity or NaN becomes binary64
+// inf/NaN, whose product rounds far above the range and is rejected). The product of two
+// significands of at most 24 bits is exact, so one rounding of its bit pattern gives the result;
+// a rounded field in [1, all ones] is accepted (all ones: the overflow to infinity).
+template <int E, int M>
+inline std::uint32_t mul(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  using L = Layout<E, M>;
+  // Rounding constant (half - 1), the product's exponent offset and the lowest accepted field (1):
+  // q is the rounded exponent|mantissa field minus 1 << M (wrapping around far above the range
+  // for products below it).
+  constexpr std::uint64_t kLow = std::uint64_t{1} << M;
+  constexpr std::uint64_t kRound = L::kHalf - 1u - (L::kMulBias << 52) - (kLow << L::kShift);
+  if (is_normal<E, M>(a) && (b & (L::kExpMax << M)) != 0) [[likely]] {
+    const std::uint32_t sign = (a ^ b) & L::kSign;
+    const double x = std::bit_cast<double>(static_cast<std::uint64_t>(a & L::kMag) << L::kShift);
+    const double y =
+        std::bit_cast<double>((static_cast<std::uint64_t>(b) << L::kShift) | L::kFillMask);
+    const std::uint64_t t = std::bit_cast<std::uint64_t>(x * y);
+    const std::uint64_t q = (t + kRound + ((t >> L::kShift) & 1u)) >> L::kShift;
+    if (q < r.mul_span) [[likely]]
+      return static_cast<std::uint32_t>(q + kLow) + sign;
+    // The operands again from their decoded magnitudes and the product's sign (the result depends
+    // on the signs only through it), so the common path need not keep the encodings live.
+    return mul_rest<E, M>(
+        static_cast<std::uint32_t>(std::bit_cast<std::uint64_t>(x) >> L::kShift) | sign,
+        static_cast<std::uint32_t>(std::bit_cast<std::uint64_t>(y) >> L::kShift) & L::kMag, r.mode);
+  }
+  return mul_rest<E, M>(a, b, r.mode);
 }
 
 template <int E, int M>
