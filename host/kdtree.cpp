@@ -568,17 +568,34 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
     }
   }
 #endif
-  // s_j by search on the grid (see above); +inf when no grid value in the box reaches bin j + 1.
+  // s_j (see above): the smallest binary32 value y with f(y) > j, found by bisection on the
+  // order-preserving integers (f can be flat over many values where x - lo absorbs x), then
+  // rounded up onto the grid: grid values >= y reach bin j + 1, smaller ones do not. Usually
+  // the even position is y already. +inf when not even the box's upper bound reaches the bin.
   auto threshold = [&](int k, int j) {
     const auto want = static_cast<float>(j + 1);
-    auto f = [&](float x) { return std::min(std::max((x - base[k]) * scale[k], 0.0f), top[k]); };
-    float x = grid_.up(std::min(static_cast<float>(box.lo[k] + d[k] * (j + 1) / nb[k]), box.hi[k]));
-    while (x < box.hi[k] && f(x) < want)
-      x = grid_succ(x);
-    if (!(f(x) >= want)) return std::numeric_limits<float>::infinity();
-    for (float below = grid_pred(x); below > box.lo[k] && f(below) >= want; below = grid_pred(x))
-      x = below;
-    return x;
+    auto reaches = [&](std::uint32_t o) {
+      return std::min(std::max((unordered(o) - base[k]) * scale[k], 0.0f), top[k]) >= want;
+    };
+    std::uint32_t below = ordered(box.lo[k]);  // f(lo) = 0
+    std::uint32_t at = ordered(box.hi[k]);
+    if (!reaches(at)) return std::numeric_limits<float>::infinity();
+    const std::uint32_t guess = ordered(
+        std::clamp(static_cast<float>(box.lo[k] + d[k] * (j + 1) / nb[k]), box.lo[k], box.hi[k]));
+    if (guess > below && guess < at) {
+      if (reaches(guess)) {
+        at = guess;
+        if (!reaches(guess - 1)) below = guess - 1;
+      } else {
+        below = guess;
+        if (reaches(guess + 1)) at = guess + 1;
+      }
+    }
+    while (at - below > 1) {
+      const std::uint32_t mid = below + (at - below) / 2;
+      (reaches(mid) ? at : below) = mid;
+    }
+    return grid_.up(unordered(at));
   };
   int bin_j = -1;  // the winner's candidate when it is a bin plane
   for (int k = 0; k < 3; ++k) {

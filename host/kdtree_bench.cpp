@@ -2,7 +2,9 @@
 // deterministic meshes of about 10K, 100K and 1M triangles: a noisy terrain heightfield (like the
 // builtin terrain scene) and a finely tessellated sphere. Prints triangles per second, the ratio
 // against the target of 1M triangles/s on one core, and, as a reference measured in the same
-// run, Embree 3's single-threaded BVH build on the same mesh.
+// run, Embree 3's single-threaded BVH build on the same mesh. BM_KdTreeBuildExact builds the 1M
+// meshes with the exact Wald-Havran sweep alone (no binned stage): the tree-quality reference
+// (SAH cost, nodes) for the default hybrid build.
 #include <benchmark/benchmark.h>
 #include <embree3/rtcore.h>
 
@@ -12,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <limits>
 #include <map>
 #include <random>
 #include <vector>
@@ -21,6 +24,7 @@
 namespace {
 
 using saarcor::host::build_kdtree;
+using saarcor::host::KdBuildParams;
 using saarcor::host::KdTree;
 
 constexpr double kTargetTrianglesPerSecond = 1e6;
@@ -169,6 +173,37 @@ void BM_KdTreeBuild(benchmark::State& state) {
   state.counters["exp_tests"] = tree.stats.expected_item_tests;
 }
 
+// The exact event sweep alone (binned stage off): the same counters, for the quality comparison.
+void BM_KdTreeBuildExact(benchmark::State& state) {
+  const Mesh& m = mesh(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  KdBuildParams params;
+  params.binned_above = std::numeric_limits<int>::max();
+  KdTree tree;
+  double total = 0.0;
+  std::int64_t builds = 0;
+  for (auto _ : state) {
+    const double t0 = thread_seconds();
+    tree = build_kdtree(m.pos, m.tris, {}, params);
+    const double t = thread_seconds() - t0;
+    state.SetIterationTime(t);
+    total += t;
+    ++builds;
+    benchmark::DoNotOptimize(tree.nodes.data());
+  }
+  const double n = static_cast<double>(m.tris.size());
+  const double rate = n * builds / total;
+  state.SetLabel(state.range(0) == 0 ? "terrain, exact sweep only" : "sphere, exact sweep only");
+  state.counters["triangles"] = n;
+  state.counters["tri_per_s"] = rate;
+  state.counters["vs_target_1M"] = rate / kTargetTrianglesPerSecond;
+  state.counters["nodes"] = tree.stats.nodes;
+  state.counters["depth"] = tree.stats.depth;
+  state.counters["items_per_leaf"] = tree.stats.items_per_leaf;
+  state.counters["sah_cost"] = tree.stats.sah_cost;
+  state.counters["exp_steps"] = tree.stats.expected_traversal_steps;
+  state.counters["exp_tests"] = tree.stats.expected_item_tests;
+}
+
 // (kind, size): terrain n x n cells (2n^2 triangles), sphere with s stacks (~4 s^2 triangles).
 BENCHMARK(BM_KdTreeBuild)
     ->Args({0, 71})
@@ -180,6 +215,12 @@ BENCHMARK(BM_KdTreeBuild)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()  // the "Time" column is this thread's CPU time per build
     ->MinTime(0.5);
+BENCHMARK(BM_KdTreeBuildExact)
+    ->Args({0, 708})
+    ->Args({1, 500})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1);
 
 }  // namespace
 
