@@ -1,0 +1,141 @@
+// `saarcor render --model cycle` (testbench/cycle_render.h): the report's keys and figures, the
+// VCD, the Table 4 printout, hit records equal to the fp24 model's, and every class of bad input.
+#include "testbench/cycle_render.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "testbench/render_cmd.h"
+
+namespace saarcor {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir() {
+  fs::path d = fs::temp_directory_path() / ("saarcor_cycle_" + std::to_string(getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+void expect_error(const RenderOptions& o, const std::string& needle) {
+  try {
+    run_render(o);
+    ADD_FAILURE() << "accepted; expected an error with '" << needle << "'";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(needle), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+TEST(CycleRender, ReportVcdAndTable) {
+  const fs::path d = temp_dir();
+  RenderOptions o;
+  o.scene = "builtin:room";
+  o.model = "cycle";
+  o.res = "32x24";
+  o.out = (d / "room").string();
+  o.report = (d / "room.json").string();
+  o.cycle.set = {"threads=16", "lat.div=12"};
+  o.cycle.interval = 2000;
+  o.cycle.vcd = (d / "room.vcd").string();
+  o.cycle.vcd_from = 100;
+  o.cycle.vcd_to = 200;
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(run_render(o), 0);
+  const std::string out = testing::internal::GetCapturedStdout();
+  EXPECT_NE(out.find("paper Scene6"), std::string::npos) << out;
+  EXPECT_NE(out.find("model builtin:room"), std::string::npos) << out;
+  const auto j = nlohmann::json::parse(read(d / "room.json"));
+  for (const char* k : {"cycles", "fps", "rays", "rays_per_s", "usage", "cache_hit",
+                        "bandwidth_mb_s", "per_ray", "simd_efficiency", "host", "time_series"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["rays"].get<int>(), 32 * 24);
+  EXPECT_GT(j["cycles"].get<double>(), 0);
+  EXPECT_NEAR(j["fps"].get<double>(), 90e6 / j["cycles"].get<double>(), 1e-6);
+  for (const char* u : {"traversal", "list", "transformation", "intersection"}) {
+    EXPECT_GT(j["usage"][u].get<double>(), 0.0) << u;
+    EXPECT_LE(j["usage"][u].get<double>(), 100.0) << u;
+  }
+  EXPECT_EQ(j["configuration"]["cycle"]["threads"]["value"].get<int>(), 16);
+  EXPECT_EQ(j["configuration"]["cycle"]["lat.div"]["value"].get<int>(), 12);
+  EXPECT_EQ(j["configuration"]["cycle"]["depth.traversal"].get<int>(), 3 + 12 + 1);
+  EXPECT_GE(j["time_series"].size(), 2u);
+  const std::string vcd = read(d / "room.vcd");
+  EXPECT_NE(vcd.find("$enddefinitions"), std::string::npos);
+  EXPECT_NE(vcd.find("path_a"), std::string::npos);
+  EXPECT_NE(vcd.find("#100"), std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST(CycleRender, HitsEqualTheFp24Model) {
+  RenderSettings s;
+  s.res = {24, 16};
+  const PreparedScene prep = prepare_scene("builtin:cube", s);
+  s.cycle.set = {"threads=3", "packet=16"};
+  const FrameResult c = render_model(parse_model("cycle"), prep, s);
+  const FrameResult f = render_model(parse_model("fp24"), prep, s);
+  EXPECT_EQ(c.hits.pixels, f.hits.pixels);
+  EXPECT_EQ(c.image.rgb, f.image.rgb);
+  EXPECT_EQ(trace_pixel(parse_model("cycle"), prep, s, {5, 7}), f.hits.pixels[7 * 24 + 5]);
+}
+
+TEST(CycleRender, BadInput) {
+  const fs::path d = temp_dir();
+  RenderOptions o;
+  o.scene = "builtin:cube";
+  o.model = "cycle";
+  o.res = "16x12";
+  o.out = (d / "x").string();
+  RenderOptions bad = o;
+  bad.cycle.set = {"threads=0"};
+  expect_error(bad, "threads");
+  bad = o;
+  bad.cycle.set = {"cache.traversal.items=12"};
+  expect_error(bad, "cache.traversal.items");
+  bad = o;
+  bad.cycle.set = {"warp=9"};
+  expect_error(bad, "unknown --set key 'warp'");
+  bad = o;
+  bad.cycle.preset = "asic";
+  expect_error(bad, "unknown --preset 'asic'");
+  bad = o;
+  bad.model = "fp24";
+  bad.cycle.set = {"threads=4"};
+  expect_error(bad, "--model cycle only");
+  bad = o;
+  bad.cycle.vcd = (d / "t.vcd").string();
+  bad.cycle.vcd_from = 50;
+  bad.cycle.vcd_to = 10;
+  expect_error(bad, "--vcd-to");
+  bad = o;
+  bad.cycle.vcd = (d / "no" / "such" / "dir" / "t.vcd").string();
+  expect_error(bad, "cannot write --vcd");
+  // A watchdog stop leaves no partial VCD.
+  bad = o;
+  bad.cycle.vcd = (d / "w.vcd").string();
+  bad.cycle.set = {"watchdog=5", "mem.latency=300"};
+  try {
+    run_render(bad);
+    ADD_FAILURE() << "the watchdog did not fire";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("watchdog"), std::string::npos);
+  }
+  EXPECT_FALSE(fs::exists(d / "w.vcd"));
+  fs::remove_all(d);
+}
+
+}  // namespace
+}  // namespace saarcor
