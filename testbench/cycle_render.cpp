@@ -123,6 +123,8 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
   conf["depth.transformation"] = c.params.transformation_depth();
   conf["depth.intersection"] = c.params.intersection_depth();
   j["configuration"] = conf;
+  // The hw/ statistics registry in full: per unit, cache, path and memory client.
+  j["stats"] = nlohmann::json::parse(c.stats_json);
   if (!c.series.empty()) {
     nlohmann::json s = nlohmann::json::array();
     for (const units::CycleFigures& f : c.series) {

@@ -73,6 +73,9 @@ TEST(CycleRender, ReportVcdAndTable) {
   EXPECT_EQ(j["configuration"]["cycle"]["lat.div"]["value"].get<int>(), 12);
   EXPECT_EQ(j["configuration"]["cycle"]["depth.traversal"].get<int>(), 3 + 12 + 1);
   EXPECT_GE(j["time_series"].size(), 2u);
+  EXPECT_EQ(j["stats"]["dynrtp0.transformation.issue_cycles"]["value"].get<double>(),
+            j["units"]["transformation"]["issue_cycles"].get<double>());
+  EXPECT_TRUE(j["stats"].contains("dynrtp0.node_cache.hit_rate_with_merges"));
   const std::string vcd = read(d / "room.vcd");
   EXPECT_NE(vcd.find("$enddefinitions"), std::string::npos);
   EXPECT_NE(vcd.find("path_a"), std::string::npos);
