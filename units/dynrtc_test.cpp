@@ -193,6 +193,19 @@ TEST(DynRtc, ParametersPresetsAndBadSettings) {
   EXPECT_THROW(check_cycle_params(r), std::runtime_error);
 }
 
+// A stack too small for the trees stops the run with the thread program's one-line error (D26).
+TEST(DynRtc, StackOverflowIsAnError) {
+  const host::BuiltImage b = build("builtin:room", 16, 12);
+  CycleParams p = prototype_params();
+  p.stack = 2;
+  try {
+    run_cycle(b.image, p);
+    ADD_FAILURE() << "a 2-entry stack was enough";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("stack overflow"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DynRtc, OnlyTheFp24ImageRuns) {
   const host::Scene scene = host::load_scene("builtin:cube");
   host::ImageParams ip;
