@@ -99,7 +99,7 @@ TEST(DynRtc, ThreadScalingOnTheRoom) {
 // The prototype configuration on the room (the paper's Scene6 stand-in) beside Table 4's Scene6
 // row (1024x768 there; usage, hit rates and cycles per packet do not depend on the resolution).
 TEST(DynRtc, PrototypeOnTheRoomBesideTable4) {
-  const host::BuiltImage b = build("builtin:room", 128, 96);
+  const host::BuiltImage b = build("builtin:room", 256, 192);
   const CycleFrame c = run_cycle(b.image, prototype_params());
   const auto& f = c.figures;
   const double per_packet = static_cast<double>(c.cycles) / static_cast<double>(c.packets);
@@ -111,7 +111,7 @@ TEST(DynRtc, PrototypeOnTheRoomBesideTable4) {
                             static_cast<double>(c.per_ray_sum.intersections);
   const double tri_per_packet =
       static_cast<double>(u.intersection_packets) / static_cast<double>(c.packets);
-  std::printf("builtin:room 128x96, prototype configuration, against Table 4 Scene6\n");
+  std::printf("builtin:room 256x192, prototype configuration, against Table 4 Scene6\n");
   std::printf(
       "                 usage %% trav list xfrm  int | hit %% trav list xfrm | cycles/packet\n");
   std::printf("model room             %4.0f %4.0f %4.0f %4.0f |       %4.0f %4.0f %4.0f | %6.1f\n",
@@ -127,12 +127,14 @@ TEST(DynRtc, PrototypeOnTheRoomBesideTable4) {
     EXPECT_GT(f.cache_hit[static_cast<std::size_t>(k)], 90.0) << cache_unit_name(CacheUnit(k));
   // Usage is the work the thread program asks for, spread over the frame: P intersection cycles
   // per triangle test and n+1 transformation steps per matrix (D30, D31). The ratio follows from
-  // the scene's triangle tests per packet (docs/cycle-model.md explains the room's 0.7x).
+  // the scene's triangle tests per packet.
   const double predicted =
       static_cast<double>(u.intersection_packets * 4) / static_cast<double>(u.transformation_steps);
   EXPECT_NEAR(ratio, predicted, 0.01);
+  // The issue's band (paper: 0.41-0.65 over its scenes). The room sits near the top: its tree
+  // gives about 12 triangle tests per packet against Scene6's ~3 (docs/cycle-model.md).
   EXPECT_GT(ratio, 0.4);
-  EXPECT_LT(ratio, 0.8);
+  EXPECT_LT(ratio, 0.7);
   EXPECT_EQ(c.issue_cycles[2], u.transformation_steps);
   EXPECT_EQ(c.issue_cycles[3], u.intersection_packets * 4);
   EXPECT_EQ(c.issue_cycles[1], u.list_steps);
