@@ -281,6 +281,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;
+  kc.idle_skip = opt.idle_skip;
   hw::Kernel k(kc);
   DynRtp dyn(k, image, p, threads);
   if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);

@@ -30,6 +30,7 @@ struct CycleRunOptions {
   std::ostream* vcd = nullptr;  // VCD trace of cycles [vcd_from, vcd_to]
   std::uint64_t vcd_from = 0, vcd_to = 0;
   std::uint64_t shuffle_seed = 0;  // != 0: random module evaluation order (figures must not move)
+  bool idle_skip = true;           // false: evaluate every cycle (figures must not move)
   std::uint64_t max_cycles = 0;    // != 0: stop with an error after this many cycles
   std::function<void(std::uint64_t cycles, int packets_done, int packets)> progress;
 };
