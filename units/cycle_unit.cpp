@@ -1,6 +1,7 @@
 // The shared stages of the DynRTP units (docs/cycle-model.md "Units").
 #include "units/cycle_unit.h"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
