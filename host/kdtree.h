@@ -44,8 +44,9 @@ struct KdBuildParams {
   // value gives the pure event builder.
   int binned_above = 0;
   int bins = 128;  // 2..256
-  // Split planes are rounded (nearest even) into this format before items are classified, so the
-  // tree is exact for the plane the hardware stores (DESIGN.md section 4: split position in fp24).
+  // Item bounds are rounded outward onto this format's values before any plane is chosen, so
+  // every split is exactly representable and the tree is exact for the plane the hardware stores
+  // (DESIGN.md section 4: split position in fp24).
   ff::Format split_format = ff::kFp24;
 };
 
