@@ -3,22 +3,28 @@
 // path every special case falls back to.
 //
 // Method (the same idea as format.cpp, with bit manipulation instead of frexp/ldexp/floor):
-//   1. decode: a normal encoding becomes its exact binary64 magnitude by moving the exponent and
-//      mantissa fields into binary64 position and re-biasing the exponent (one shift, one add);
-//      signs are handled on the encodings (mul/div: sign xor; add: b's sign relative to a's);
+//   1. decode: an encoding becomes an exact, power-of-two-scaled binary64 value by moving its
+//      exponent and mantissa fields into binary64 position and setting (or keeping) the binary64
+//      exponent bits above them, so that the all-ones field lands on binary64 inf/NaN where that
+//      helps (signed_decode for add/sub, the fill bits for mul/div);
 //   2. the op runs once in binary64 (+, -, x, /, sqrt: correctly rounded to 53 bits; a product of
 //      two significands of at most 24 bits is exact);
-//   3. round: when the binary64 result lies in the target's normal exponent range, its 52-bit
-//      fraction is cut to M bits with integer arithmetic on the bit pattern. A carry out of the
-//      mantissa increments the exponent field, and a carry out of the largest finite value gives
-//      exactly the infinity encoding. Nearest-even rounds the binary64 value with ties to even:
-//      double rounding is innocuous because 53 >= 2(M+1)+2 for every supported format (Figueroa
-//      1995; DESIGN.md section 3). Truncation needs the sign of the exact error only when the
-//      binary64 value lies exactly on the target grid; only then is it computed (TwoSum for add,
-//      a fused remainder for div and sqrt).
-// Zeros, subnormals, inf, NaN and results outside the normal range take the general path in
-// format.cpp (binary64 value + exact error sign, round_pack). The MPFR tests
-// (fixedfloat/*_test.cpp) check the whole arrangement bit for bit.
+//   3. round: the binary64 bit pattern is rounded to M fraction bits with integer arithmetic (one
+//      constant adds half - 1 and removes the exponent offset and the lowest accepted field, plus
+//      the lowest kept bit for ties to even). A carry out of the mantissa increments the exponent
+//      field, and a carry out of the largest finite value gives exactly the infinity encoding.
+//      Double rounding is innocuous because 53 >= 2(M+1)+2 for every supported format (Figueroa
+//      1995; DESIGN.md section 3). One unsigned compare of the rounded field against a span from
+//      the Rounder accepts the result: the span is empty for truncation, so the nearest-even
+//      path needs no test of the mode.
+// Nearest-even add/sub test no operand at all (see add_nearest for why zeros, subnormals, inf and
+// NaN cannot pass wrongly); mul/div test the exponent fields (one or two instructions each).
+// Truncation needs the sign of the exact error only when the binary64 value lies exactly on the
+// target grid; only then is it computed (TwoSum for add, a fused remainder for div and sqrt), in
+// the *_checked paths. Whatever the fast paths do not accept goes out of line to the *_rest
+// functions and from there, for zeros, subnormals, inf, NaN and results outside the normal range,
+// to the general path in format.cpp (binary64 value + exact error sign, round_pack). The MPFR
+// tests (fixedfloat/*_test.cpp) check the whole arrangement bit for bit.
 #pragma once
 
 #include <bit>
@@ -46,10 +52,12 @@ struct Layout {
   static constexpr std::uint64_t kLowBits = (std::uint64_t{1} << kShift) - 1u;
   static constexpr std::uint64_t kHalf = std::uint64_t{1} << (kShift - 1);
 
-  // The signed decode of the nearest-even add (see add_nearest): b << kTop puts the sign at bit 63;
-  // an arithmetic shift by kFill then sets the kFill binary64 exponent bits above the target's to
-  // copies of the sign, and or-ing kFillMask sets them for both signs. The binary64 exponent field
-  // becomes e + kFillBias, so the all-ones field (inf, NaN) maps exactly onto binary64 inf/NaN.
+  // The fill bits: the kFill binary64 exponent bits above the target's E. Setting them makes the
+  // binary64 exponent field e + kFillBias, so the all-ones field (inf, NaN) maps exactly onto
+  // binary64 inf/NaN. The signed decode of the nearest-even add (signed_decode_bits): b << kTop
+  // puts the sign at bit 63, an arithmetic shift by kFill copies it into the fill bits, and
+  // or-ing kFillMask sets them for both signs. mul/div shift by kShift, which moves the sign
+  // into the fill bits, where the or erases it.
   static constexpr int kTop = 63 - E - M;
   static constexpr int kFill = 11 - E;
   static constexpr std::uint64_t kFillMask = ((std::uint64_t{1} << kFill) - 1u) << (52 + E);
@@ -60,8 +68,19 @@ struct Layout {
   static constexpr std::uint32_t kAddLowField = M + 3;
   static constexpr bool kAddNearest = kAddLowField < kExpMax;
   // Exponent offset of the product of a magnitude decoded with field e (scale 2^(bias-1023)) and
-  // one decoded with field e + kFillBias: the product's binary64 field is e + kMulBias.
+  // one decoded with field e + kFillBias: the product's binary64 field is e + kMulBias (e: the
+  // product's biased exponent in the target format).
   static constexpr std::uint64_t kMulBias = kFillBias + kBias - 1023u;
+
+  // Decodes for mul/div written so that their constants are small (x86-64 immediates instead of
+  // 64-bit constants held in registers): the fill bits set before the shift (the sign bit is one
+  // of them), the magnitude as a 32-bit shift that drops the sign followed by a 64-bit one.
+  static std::uint64_t filled_bits(std::uint32_t b) {
+    return (static_cast<std::uint64_t>(b) | (kFillMask >> kShift)) << kShift;
+  }
+  static std::uint64_t magnitude_bits_unbiased(std::uint32_t b) {
+    return static_cast<std::uint64_t>(b << (32 - E - M)) << (kShift - (32 - E - M));
+  }
 };
 
 // True for normal encodings (exponent field neither 0 nor all ones): adding one to the exponent
@@ -142,10 +161,10 @@ struct Rounder {
   Mode mode;
   // round_mag: kept bits (bits(|v|) >> (52 - M)) from the smallest normal's on.
   std::uint32_t nearest_span;
-  // add_nearest, mul_nearest: rounded exponent|mantissa fields from their lowest accepted one up
-  // to the infinity encoding.
+  // Rounded exponent|mantissa fields from the lowest accepted one up to the infinity encoding:
+  // add_nearest (from field kAddLowField), mul and div (from field 1).
   std::uint32_t add_span;
-  std::uint32_t mul_span;
+  std::uint32_t rounded_span;
   constexpr explicit Rounder(const Mode& m)
       : mode(m),
         nearest_span(m.rounding == Rounding::kNearestEven
@@ -154,7 +173,7 @@ struct Rounder {
         add_span(m.rounding == Rounding::kNearestEven && L::kAddNearest
                      ? ((L::kExpMax - L::kAddLowField) << M) + 1u
                      : 0u),
-        mul_span(m.rounding == Rounding::kNearestEven ? ((L::kExpMax - 1u) << M) + 1u : 0u) {}
+        rounded_span(m.rounding == Rounding::kNearestEven ? ((L::kExpMax - 1u) << M) + 1u : 0u) {}
 };
 
 // Truncation of a magnitude exactly on the grid; d is the sign of (exact magnitude - |v|). The
@@ -299,10 +318,10 @@ template <int E, int M>
   return add_checked<E, M>(signed_encode<E, M>(x), signed_encode<E, M>(y), Rounder<E, M>(m));
 }
 
-// The nearest-even add without a test of its operands. Both are decoded with signed_decode and
-// added once in binary64; the sum is rounded to the target's precision by integer arithmetic on its
-// bit pattern (ties to even, a mantissa carry bumps the exponent, the largest finite value carries
-// into exactly the infinity encoding) and accepted when the rounded exponent field lies in
+// The nearest-even add without a test of its operands. Both are decoded with signed_decode_bits
+// and added once in binary64; the sum is rounded to the target's precision by integer arithmetic on
+// its bit pattern (ties to even, a mantissa carry bumps the exponent, the largest finite value
+// carries into exactly the infinity encoding) and accepted when the rounded exponent field lies in
 // [M+3, all ones]:
 //   - normal operands: as in add_checked (double rounding is innocuous, Figueroa 1995);
 //   - an operand with exponent field 0 (zero or subnormal, in either subnormal mode) decodes as
@@ -390,12 +409,11 @@ inline std::uint32_t mul(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& 
   constexpr std::uint64_t kRound = L::kHalf - 1u - (L::kMulBias << 52) - (kLow << L::kShift);
   if (is_normal<E, M>(a) && (b & (L::kExpMax << M)) != 0) [[likely]] {
     const std::uint32_t sign = (a ^ b) & L::kSign;
-    const double x = std::bit_cast<double>(static_cast<std::uint64_t>(a & L::kMag) << L::kShift);
-    const double y =
-        std::bit_cast<double>((static_cast<std::uint64_t>(b) << L::kShift) | L::kFillMask);
+    const double x = std::bit_cast<double>(L::magnitude_bits_unbiased(a));
+    const double y = std::bit_cast<double>(L::filled_bits(b));
     const std::uint64_t t = std::bit_cast<std::uint64_t>(x * y);
     const std::uint64_t q = (t + kRound + ((t >> L::kShift) & 1u)) >> L::kShift;
-    if (q < r.mul_span) [[likely]]
+    if (q < r.rounded_span) [[likely]]
       return static_cast<std::uint32_t>(q + kLow) + sign;
     // The operands again from their decoded magnitudes and the product's sign (the result depends
     // on the signs only through it), so the common path need not keep the encodings live.
@@ -407,7 +425,7 @@ inline std::uint32_t mul(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& 
 }
 
 template <int E, int M>
-inline std::uint32_t div(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+inline std::uint32_t div_checked(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
   if (both_normal<E, M>(a, b)) [[likely]] {
     const double x = std::bit_cast<double>(magnitude_bits<E, M>(a));
     const double y = std::bit_cast<double>(magnitude_bits<E, M>(b));
@@ -417,6 +435,38 @@ inline std::uint32_t div(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& 
                            [&] { return sign_of(std::fma(-q, y, x)); });
   }
   return slow_div<E, M>(a, b, r.mode);
+}
+
+template <int E, int M>
+[[gnu::noinline]] std::uint32_t div_rest(std::uint32_t a, std::uint32_t b, Mode m) {
+  return div_checked<E, M>(a, b, Rounder<E, M>(m));
+}
+
+// The nearest-even div. Both exponent fields must be nonzero; both magnitudes are decoded with the
+// field raised by kFillBias (sign bits vanish in the fill bits, inf/NaN become binary64 inf/NaN),
+// so the binary64 quotient is unscaled. It is rounded once more like the product in mul (double
+// rounding is innocuous for division too); an infinite, NaN or zero quotient (from inf or NaN
+// operands) rounds far outside the accepted range [1, all ones].
+template <int E, int M>
+inline std::uint32_t div(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& r) {
+  using L = Layout<E, M>;
+  constexpr std::uint64_t kLow = std::uint64_t{1} << M;
+  constexpr std::uint64_t kDivBias = 1023u - L::kBias;
+  constexpr std::uint64_t kRound = L::kHalf - 1u - (kDivBias << 52) - (kLow << L::kShift);
+  constexpr std::uint32_t kExpField = L::kExpMax << M;
+  if ((a & kExpField) != 0 && (b & kExpField) != 0) [[likely]] {
+    const std::uint32_t sign = (a ^ b) & L::kSign;
+    const double x = std::bit_cast<double>(L::filled_bits(a));
+    const double y = std::bit_cast<double>(L::filled_bits(b));
+    const std::uint64_t t = std::bit_cast<std::uint64_t>(x / y);
+    const std::uint64_t q = (t + kRound + ((t >> L::kShift) & 1u)) >> L::kShift;
+    if (q < r.rounded_span) [[likely]]
+      return static_cast<std::uint32_t>(q + kLow) + sign;
+    return div_rest<E, M>(
+        (static_cast<std::uint32_t>(std::bit_cast<std::uint64_t>(x) >> L::kShift) & L::kMag) | sign,
+        static_cast<std::uint32_t>(std::bit_cast<std::uint64_t>(y) >> L::kShift) & L::kMag, r.mode);
+  }
+  return div_rest<E, M>(a, b, r.mode);
 }
 
 template <int E, int M>
