@@ -61,34 +61,11 @@ class Threads final : public ThreadTable {
 
 template <class F>
 void collect(FunctionalFrame& frame, Threads<F>& threads) {
-  const PipelineUnits<F>& u = threads.units();
-  FrameSink& sink = threads.sink();
-  UnitStats& s = frame.units;
-  s.traversal_ops = u.traversal_ops;
-  s.transformation_ops = u.transformation_ops;
-  s.intersection_ops = u.intersection_ops;
-  s.rgs_ops = u.rgs_ops;
-  s.traversal_steps = u.traversal_steps;
-  s.inner_steps = u.inner_steps;
-  s.clip_steps = u.clip_steps;
-  s.list_steps = u.list_steps;
-  s.transformation_steps = u.transformation_steps;
-  s.shading_transformation_steps = u.shading_transformation_steps;
-  s.intersection_packets = u.intersection_packets;
-  s.sub_packets = u.sub_packets;
   frame.format = F::kFormat;
-  frame.width = sink.width;
-  frame.height = sink.height;
+  frame.width = threads.sink().width;
+  frame.height = threads.sink().height;
   frame.params = threads.params();
-  frame.by_kind = sink.by_kind;
-  frame.rays_issued = sink.rays_issued;
-  frame.rays_returned = sink.rays_returned;
-  frame.rgb.resize(sink.pixels.size() * 3u);
-  for (std::size_t i = 0; i < sink.pixels.size(); ++i)
-    for (std::size_t k = 0; k < 3; ++k)
-      frame.rgb[3u * i + k] = static_cast<std::uint8_t>(
-          std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
-  frame.pixels = sink.pixels;
+  collect_frame(frame, threads.units(), threads.sink());
 }
 
 memif::CacheConfig cache_config(const CycleParams& p, CacheUnit c) {

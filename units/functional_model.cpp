@@ -53,32 +53,6 @@ void check_image(const memif::MemoryImage& image) {
                              " (1..16384 per side)");
 }
 
-template <class F>
-void collect(FunctionalFrame& frame, const PipelineUnits<F>& u, FrameSink& sink) {
-  UnitStats& s = frame.units;
-  s.traversal_ops = u.traversal_ops;
-  s.transformation_ops = u.transformation_ops;
-  s.intersection_ops = u.intersection_ops;
-  s.rgs_ops = u.rgs_ops;
-  s.traversal_steps = u.traversal_steps;
-  s.inner_steps = u.inner_steps;
-  s.clip_steps = u.clip_steps;
-  s.list_steps = u.list_steps;
-  s.transformation_steps = u.transformation_steps;
-  s.shading_transformation_steps = u.shading_transformation_steps;
-  s.intersection_packets = u.intersection_packets;
-  s.sub_packets = u.sub_packets;
-  frame.by_kind = sink.by_kind;
-  frame.rays_issued = sink.rays_issued;
-  frame.rays_returned = sink.rays_returned;
-  frame.rgb.resize(sink.pixels.size() * 3u);
-  for (std::size_t i = 0; i < sink.pixels.size(); ++i)
-    for (std::size_t k = 0; k < 3; ++k)
-      frame.rgb[3u * i + k] = static_cast<std::uint8_t>(
-          std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
-  frame.pixels = std::move(sink.pixels);
-}
-
 // Calls fn(Float<E,M>{}) for the image's format.
 template <class Fn>
 decltype(auto) with_format(const ff::Format& f, Fn&& fn) {
@@ -148,7 +122,7 @@ FunctionalFrame run_functional(const memif::MemoryImage& image, const Functional
   }
   frame.units.packets = static_cast<std::uint64_t>(total);
   const std::uint64_t requests = frame.units.requests;
-  collect(frame, units, sink);
+  collect_frame(frame, units, sink);
   frame.units.requests = requests;
   frame.units.packets = static_cast<std::uint64_t>(total);
   frame.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -5,6 +5,7 @@
 // drives the same thread program with timing and must match this model bit for bit.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -88,5 +89,33 @@ struct PixelTrace {
 };
 PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& params, int x,
                        int y);
+
+// Gathers a frame's results from the units' counters and the hit sink (moving the pixels out of
+// the sink); the functional and the cycle model share it so both report alike.
+template <class F>
+void collect_frame(FunctionalFrame& frame, const PipelineUnits<F>& u, FrameSink& sink) {
+  UnitStats& s = frame.units;
+  s.traversal_ops = u.traversal_ops;
+  s.transformation_ops = u.transformation_ops;
+  s.intersection_ops = u.intersection_ops;
+  s.rgs_ops = u.rgs_ops;
+  s.traversal_steps = u.traversal_steps;
+  s.inner_steps = u.inner_steps;
+  s.clip_steps = u.clip_steps;
+  s.list_steps = u.list_steps;
+  s.transformation_steps = u.transformation_steps;
+  s.shading_transformation_steps = u.shading_transformation_steps;
+  s.intersection_packets = u.intersection_packets;
+  s.sub_packets = u.sub_packets;
+  frame.by_kind = sink.by_kind;
+  frame.rays_issued = sink.rays_issued;
+  frame.rays_returned = sink.rays_returned;
+  frame.rgb.resize(sink.pixels.size() * 3u);
+  for (std::size_t i = 0; i < sink.pixels.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k)
+      frame.rgb[3u * i + k] = static_cast<std::uint8_t>(
+          std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
+  frame.pixels = std::move(sink.pixels);
+}
 
 }  // namespace saarcor::units
