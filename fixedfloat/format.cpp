@@ -9,7 +9,9 @@
 namespace saarcor::ff {
 namespace {
 
-int sign_of(double x) { return (x > 0.0) - (x < 0.0); }
+int sign_of(double x) {
+  return (x > 0.0) - (x < 0.0);
+}
 
 }  // namespace
 
@@ -224,9 +226,11 @@ std::string bit_groups(std::uint32_t bits, const Format& f) {
   std::string s;
   s += (bits & f.sign_mask()) ? '1' : '0';
   s += '.';
-  for (int i = f.exp_bits - 1; i >= 0; --i) s += ((bits >> (f.man_bits + i)) & 1u) ? '1' : '0';
+  for (int i = f.exp_bits - 1; i >= 0; --i)
+    s += ((bits >> (f.man_bits + i)) & 1u) ? '1' : '0';
   s += '.';
-  for (int i = f.man_bits - 1; i >= 0; --i) s += ((bits >> i) & 1u) ? '1' : '0';
+  for (int i = f.man_bits - 1; i >= 0; --i)
+    s += ((bits >> i) & 1u) ? '1' : '0';
   return s;
 }
 

@@ -160,7 +160,8 @@ inline constexpr int kShadingRecordWords = 4;
 inline constexpr int kTexcoordFracBits = 12;
 inline std::array<std::uint32_t, 4> encode_shading(const ShadingRecord& s) {
   std::array<std::uint32_t, 4> w{s.material & 0xFFFFu, 0, 0, 0};
-  for (int i = 0; i < 3; ++i) w[1 + i] = s.tex_u[i] | (std::uint32_t{s.tex_v[i]} << 16);
+  for (int i = 0; i < 3; ++i)
+    w[1 + i] = s.tex_u[i] | (std::uint32_t{s.tex_v[i]} << 16);
   return w;
 }
 inline ShadingRecord decode_shading(const std::uint32_t* w) {
@@ -191,9 +192,9 @@ struct FrameRegisters {
   std::array<std::uint32_t, 3> scene_max{};
   std::uint32_t instance_row_base = 0;  // row index of instance record 0
   std::uint32_t instance_count = 0;
-  std::uint32_t material_base = 0;  // shading-bank word address of material record 0
+  std::uint32_t material_base = 0;        // shading-bank word address of material record 0
   std::uint32_t shading_record_base = 0;  // shading-bank word address of shading record 0
-  std::uint32_t light_base = 0;     // shading-bank word address of light record 0
+  std::uint32_t light_base = 0;           // shading-bank word address of light record 0
   std::uint32_t light_count = 0;
   std::uint32_t ambient_rgb = 0x202020u;  // RGB8
   std::uint32_t background_rgb = 0;       // RGB8
@@ -220,7 +221,8 @@ class MemoryImage {
   MemoryImage() = default;
   MemoryImage(ff::Format format, std::uint32_t bank_words)
       : format_(format), bank_words_(bank_words) {
-    for (auto& b : banks_) b.assign(bank_words, 0u);
+    for (auto& b : banks_)
+      b.assign(bank_words, 0u);
   }
 
   const ff::Format& format() const { return format_; }
@@ -262,7 +264,8 @@ class MemoryImage {
   // Four float encodings of one matrix row.
   std::array<std::uint32_t, 4> row(std::uint32_t index) const {
     std::array<std::uint32_t, 4> w{};
-    for (int i = 0; i < item_words(ItemType::kRow); ++i) w[i] = item_word(ItemType::kRow, index, i);
+    for (int i = 0; i < item_words(ItemType::kRow); ++i)
+      w[i] = item_word(ItemType::kRow, index, i);
     return ff::unpack_row(w.data(), format_);
   }
   // The header row of an instance record read as three raw words.

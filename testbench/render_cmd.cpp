@@ -435,9 +435,9 @@ PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prep,
       // The cycle model runs whole frames: the pixel's record from the frame (bit-identical to
       // the fp24 model's replay by construction).
       const FrameResult f = render_model(model, prep, settings);
-      return f.hits.pixels[static_cast<std::size_t>(pixel.y) *
-                               static_cast<std::size_t>(f.hits.width) +
-                           static_cast<std::size_t>(pixel.x)];
+      return f.hits
+          .pixels[static_cast<std::size_t>(pixel.y) * static_cast<std::size_t>(f.hits.width) +
+                  static_cast<std::size_t>(pixel.x)];
     }
   }
   throw std::runtime_error("model '" + model.name + "' is not available yet");
@@ -495,7 +495,8 @@ int run_render(const RenderOptions& opts) {
     throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
   }
 
-  const ff::Format format = model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
+  const ff::Format format =
+      model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
   const PreparedScene prep = prepare_scene(opts.scene, settings, format);
 
   if (pixel) {

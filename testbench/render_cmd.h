@@ -43,10 +43,10 @@ inline constexpr int kMaxMantissa = 23;
 
 struct RenderSettings {
   Resolution res;
-  double time = 0.0;     // seconds into the scene's animation
-  bool shadows = false;  // shadow rays (docs/shading.md section 6)
-  int depth = 0;         // secondary rays (reflection, transparency) up to this depth; 0 = none
-  double bank_mb = 4.0;  // SRAM bank size of the memory image (the prototype: 4 MB)
+  double time = 0.0;         // seconds into the scene's animation
+  bool shadows = false;      // shadow rays (docs/shading.md section 6)
+  int depth = 0;             // secondary rays (reflection, transparency) up to this depth; 0 = none
+  double bank_mb = 4.0;      // SRAM bank size of the memory image (the prototype: 4 MB)
   CycleRenderOptions cycle;  // --model cycle: preset, --set overrides, --interval, --vcd
 };
 

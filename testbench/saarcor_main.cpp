@@ -8,11 +8,11 @@
 
 #include "testbench/version.h"
 // [subcommand headers]
-#include "testbench/scene_cmd.h"
-#include "testbench/float_tools.h"
 #include "testbench/compare.h"
+#include "testbench/float_tools.h"
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
+#include "testbench/scene_cmd.h"
 
 int main(int argc, char** argv) {
   CLI::App app{

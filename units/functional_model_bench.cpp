@@ -85,15 +85,16 @@ void BM_TransformStep(benchmark::State& state) {
   units::UnitFp<F> fp;
   units::Mat34<F> m{};
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) m[r][c] = F::from_double(0.3 + 0.17 * r - 0.11 * c);
+    for (int c = 0; c < 4; ++c)
+      m[r][c] = F::from_double(0.3 + 0.17 * r - 0.11 * c);
   units::Vec3<F> v{F::from_double(1.25), F::from_double(-0.75), F::from_double(2.5)};
   for (auto _ : state) {
     benchmark::DoNotOptimize(v);
     units::Vec3<F> o = units::transform_step(fp, m, v, true);
     benchmark::DoNotOptimize(o);
   }
-  state.counters["ops_per_s"] =
-      benchmark::Counter(18.0 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["ops_per_s"] = benchmark::Counter(18.0 * static_cast<double>(state.iterations()),
+                                                   benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_TransformStep);
 
