@@ -233,6 +233,19 @@ class Builder {
 
  private:
   static const KdBuildParams& checked(const KdBuildParams& p);
+  // Turns `node` into an inner node splitting axis k at `split` and appends its two (adjacent)
+  // children; returns the index of the left one. Both build stages end a split here.
+  std::uint32_t make_inner(std::uint32_t node, int k, float split) {
+    const auto child = static_cast<std::uint32_t>(tree_.nodes.size());
+    KdTreeNode& nd = tree_.nodes[node];
+    nd.leaf = false;
+    nd.axis = static_cast<std::uint8_t>(k);
+    nd.split = split;
+    nd.child = child;
+    tree_.nodes.emplace_back();
+    tree_.nodes.emplace_back();
+    return child;
+  }
   void check_coordinate(float v, const char* what, std::size_t index) const;
   void start(std::size_t items);
   void add_item(std::uint32_t id, const float lo[3], const float hi[3]);
@@ -752,16 +765,7 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
     }
   }
 
-  const auto child = static_cast<std::uint32_t>(tree_.nodes.size());
-  {
-    KdTreeNode& nd = tree_.nodes[node];
-    nd.leaf = false;
-    nd.axis = static_cast<std::uint8_t>(k);
-    nd.split = split;
-    nd.child = child;
-  }
-  tree_.nodes.emplace_back();
-  tree_.nodes.emplace_back();
+  const std::uint32_t child = make_inner(node, k, split);
   const std::size_t top = rb + nr;
   items_.top_ = top;
   bin_node(child, depth + 1, lbox, lb, nl);
@@ -1134,16 +1138,7 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
     }
   }
 
-  const auto child = static_cast<std::uint32_t>(tree_.nodes.size());
-  {
-    KdTreeNode& nd = tree_.nodes[node];
-    nd.leaf = false;
-    nd.axis = static_cast<std::uint8_t>(k);
-    nd.split = split;
-    nd.child = child;
-  }
-  tree_.nodes.emplace_back();
-  tree_.nodes.emplace_back();
+  const std::uint32_t child = make_inner(node, k, split);
 
   const auto leaf_size = static_cast<std::uint32_t>(p_.leaf_size);
   if (last_level || (n_left <= leaf_size && n_right <= leaf_size)) {
