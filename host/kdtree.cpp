@@ -179,6 +179,11 @@ struct Box {
   float lo[3];
   float hi[3];
 };
+double box_half_area(const Box& b) {
+  const double d[3] = {static_cast<double>(b.hi[0]) - b.lo[0], static_cast<double>(b.hi[1]) - b.lo[1],
+                       static_cast<double>(b.hi[2]) - b.lo[2]};
+  return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+}
 
 // Item side after classification. kBoth items are dropped from the old lists (they get new
 // events from their clipped bounds); the values make the split pass branch-free.
@@ -205,11 +210,24 @@ inline float float_up(double d) {
   return static_cast<double>(f) < d ? float_next_up(f) : f;
 }
 
+// The width of a face slab (Builder::face_slabs) as a share of the root box's extent.
+constexpr double kFaceSlabShare = 1.0 / 1024.0;
+// A face slab may cost this much more than the leaf: peeling one face of a box whose other faces
+// carry planars too pays off only once those are peeled as well (a greedy SAH never sees that).
+constexpr double kFaceSlabSlack = 1.5;
+// A node whose surface area is below this share of the root's is a leaf: one ray in 2^20 enters
+// it, so splitting it gains nothing, yet without this bound the builder subdivides the cells
+// around shared vertices (whose triangles' bounds, rounded outward onto the split grid, overlap by
+// a grid step) down to single grid steps at the depth limit.
+constexpr double kMinAreaShare = 1.0 / (1 << 20);
+
+
 struct Split {
   double cost = std::numeric_limits<double>::infinity();
   int axis = -1;
   std::uint32_t pos = 0;  // ordered position
   bool planar_left = true;
+  bool face_slab = false;  // a plane of Builder::face_slabs
 };
 
 struct BinnedSplit {
@@ -276,6 +294,8 @@ class Builder {
   void emit_leaf(std::uint32_t node, std::vector<std::uint32_t>& ids);
   Split find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
                    std::uint32_t n) const;
+  void face_slabs(const Box& box, int k, std::size_t b, std::size_t e, std::uint32_t n,
+                  double inv_area, Split& best) const;
   int clip_split(std::uint32_t id, const Box& box, int axis, float split, float llo[3],
                  float lhi[3], float rlo[3], float rhi[3]) const;
   void add_clipped(std::uint32_t id, const float lo[3], const float hi[3], std::vector<Key>* out);
@@ -303,6 +323,7 @@ class Builder {
   std::vector<std::uint32_t> both_right_;
   std::uint32_t item_count_ = 0;
   Box root_{};
+  double min_half_area_ = 0.0;  // nodes below it are leaves (kMinAreaShare of the root's)
 };
 
 const KdBuildParams& Builder::checked(const KdBuildParams& p) {
@@ -432,6 +453,7 @@ void Builder::run() {
   tree_.bounds.lo = glm::vec3(root_.lo[0], root_.lo[1], root_.lo[2]);
   tree_.bounds.hi = glm::vec3(root_.hi[0], root_.hi[1], root_.hi[2]);
   const std::size_t n = items_.top_;
+  min_half_area_ = box_half_area(root_) * kMinAreaShare;
   bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n));
 }
 
@@ -691,7 +713,8 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
     exact_subtree(node, depth, box, b, n);
     return;
   }
-  if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth) {
+  if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth ||
+      box_half_area(box) < min_half_area_) {
     leaf_scratch_.clear();
     for (std::uint32_t i = 0; i < n; ++i)
       leaf_scratch_.push_back(items_.data()[b + i].id);
@@ -786,6 +809,7 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
   const double kt = p_.traversal_cost;
   const double ki = p_.intersection_cost;
   const double bonus = p_.empty_bonus;
+  Split face;  // the best face slab (Builder::face_slabs)
   for (int k = 0; k < 3; ++k) {
     if (!(d[k] > 0.0)) continue;
     const double sum = d[(k + 1) % 3] + d[(k + 2) % 3];
@@ -843,8 +867,73 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
       pending = 0;
       np = 0;
     }
+    face_slabs(box, k, b[k], e[k], n, inv_area, face);
   }
+  // A face slab wins when it is cheaper, and also when no other plane beats the leaf but the slab
+  // lies within the slack (build_node applies the slack to it).
+  const double leaf_cost = ki * n;
+  if (face.cost < best.cost || (!(best.cost < leaf_cost) && face.cost < leaf_cost * kFaceSlabSlack))
+    return face;
   return best;
+}
+
+// Items lying in a face of the node's box (a room's walls, floor and ceiling) are in every leaf
+// along that face, and no event plane can separate them: their events sit on the box bound.
+// Every ray crossing such a leaf then tests them (no triangle mailbox, paper 3.1). A plane a
+// slab's width inside the face does: the thin slab holds the face's items and is entered only by
+// rays near the face. The width is a fixed share of the root extent so that the traversal's
+// rounded plane distances (about 2^-15 of the distance, fp24) cannot skip the slab.
+void Builder::face_slabs(const Box& box, int k, std::size_t b, std::size_t e, std::uint32_t n,
+                         double inv_area, Split& best) const {
+  const double width = (static_cast<double>(root_.hi[k]) - root_.lo[k]) * kFaceSlabShare;
+  const float lo = box.lo[k];
+  const float hi = box.hi[k];
+  if (!(static_cast<double>(hi) - lo > 4.0 * width) || !(width > 0.0)) return;
+  const int j = (k + 1) % 3;
+  const int l = (k + 2) % 3;
+  const double dj = static_cast<double>(box.hi[j]) - box.lo[j];
+  const double dl = static_cast<double>(box.hi[l]) - box.lo[l];
+  const double sum = dj + dl;
+  const double prod = dj * dl;
+  const Key* ev = ev_[k].data();
+  auto evaluate = [&](float x, std::uint32_t nl, std::uint32_t nr) {
+    const double al = (static_cast<double>(x) - lo) * sum + prod;
+    const double ar = (static_cast<double>(hi) - x) * sum + prod;
+    // The interior side is empty where every item lies in the face.
+    const double cost = (nl == 0 || nr == 0 ? p_.empty_bonus : 1.0) *
+                        (p_.traversal_cost + p_.intersection_cost * inv_area * (al * nl + ar * nr));
+    if (cost < best.cost) best = Split{cost, k, ordered(x), true, true};
+  };
+  // Near the low face: left = items with lo < x, right = items with hi > x.
+  const float x_lo = grid_.up(static_cast<float>(lo + width));
+  // Planars at x go left (planar_left), so they count left and not right.
+  // A slab thinner than a grid step rounds onto the face itself: no plane.
+  if (e > b && x_lo > lo && x_lo < hi && key_pos(ev[b]) == ordered(lo) &&
+      key_type(ev[b]) == kPlanar) {
+    std::uint32_t nl = 0;
+    std::uint32_t ended = 0;
+    const std::uint32_t xo = ordered(x_lo);
+    for (std::size_t i = b; i < e && key_pos(ev[i]) <= xo; ++i) {
+      const std::uint32_t t = key_type(ev[i]);
+      nl += t == kPlanar || (t == kStart && key_pos(ev[i]) < xo);
+      ended += t != kStart;
+    }
+    evaluate(x_lo, nl, n - ended);
+  }
+  // Near the high face: left = items with lo < x, right = items with hi > x.
+  const float x_hi = grid_.down(static_cast<float>(hi - width));
+  if (e > b && x_hi < hi && x_hi > lo && key_pos(ev[e - 1]) == ordered(hi) &&
+      key_type(ev[e - 1]) == kPlanar) {
+    std::uint32_t started = 0;  // items with lo >= x
+    std::uint32_t nr = 0;
+    const std::uint32_t xo = ordered(x_hi);
+    for (std::size_t i = e; i-- > b && key_pos(ev[i]) >= xo;) {
+      const std::uint32_t t = key_type(ev[i]);
+      started += t == kStart || (t == kPlanar && key_pos(ev[i]) > xo);
+      nr += t != kStart && key_pos(ev[i]) > xo;
+    }
+    evaluate(x_hi, n - started, nr);
+  }
 }
 
 void Builder::make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0) {
@@ -1048,12 +1137,14 @@ std::size_t split_events(const Key* ev, std::size_t n, const std::uint8_t* side,
 
 void Builder::build_node(std::uint32_t node, int depth, const Box& box, const std::size_t b[3],
                          const std::size_t e[3], std::uint32_t n) {
-  if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth) {
+  if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth ||
+      box_half_area(box) < min_half_area_) {
     make_leaf(node, b[0], e[0]);
     return;
   }
   const Split best = find_split(box, b, e, n);
-  if (best.axis < 0 || !(best.cost < static_cast<double>(p_.intersection_cost) * n)) {
+  const double leaf_cost = static_cast<double>(p_.intersection_cost) * n;
+  if (best.axis < 0 || !(best.cost < leaf_cost * (best.face_slab ? kFaceSlabSlack : 1.0))) {
     make_leaf(node, b[0], e[0]);
     return;
   }

@@ -37,7 +37,7 @@ struct KdBuildParams {
   float intersection_cost = 20.0f;
   float empty_bonus = 0.8f;  // cost factor for a split that cuts off empty space
   int max_depth = 24;        // per level; top + bottom must fit the 64-entry traversal stack
-  int leaf_size = 2;         // never split a node with this many items or fewer
+  int leaf_size = 0;         // never split a node with this many items or fewer (0: SAH decides)
   // Hybrid build (docs/kdtree.md): a node with more than `binned_above` items is split by binned
   // SAH over its items' clipped bounds (`bins` bins per axis, plus the two empty-space planes at
   // the items' bounds); a subtree at or below it by Wald & Havran's exact event sweep. A huge

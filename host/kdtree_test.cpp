@@ -603,6 +603,62 @@ TEST(KdTree, SphereTerrainAndCube) {
   }
 }
 
+// Items in a face of the node box (a room's walls) have their only event on the box bound, where
+// no plane may lie; face slabs (docs/kdtree.md) peel them off, so that a ray through the interior
+// tests none of them. Without them the cube's interior leaves held the walls.
+TEST(KdTree, FaceSlabsKeepWallsOutOfTheInterior) {
+  Mesh m = cube();  // triangles 0..11 lie in the root box's faces
+  append(m, sphere(6, 8, glm::vec3(0.0f, 1.5f, 0.0f), 0.1f));
+  const KdBuildParams params;
+  const KdTree tree = build_kdtree(m.pos, m.tris, {}, params);
+  check_triangle_tree(tree, m);
+  check_rays(tree, m, 2000 / kScale, 21);
+  int interior_leaves = 0;
+  for (const Leaf& leaf : walk(tree, params)) {
+    // Leaves reaching into the cube's interior (the box shrunk by a tenth of its extent on each
+    // side), which a ray crosses without being near a wall: no wall may be listed there.
+    bool interior = true;
+    for (int k = 0; k < 3; ++k) {
+      const double margin = 0.1 * (double{tree.bounds.hi[k]} - tree.bounds.lo[k]);
+      interior = interior && leaf.box.hi[k] > tree.bounds.lo[k] + margin &&
+                 leaf.box.lo[k] < tree.bounds.hi[k] - margin;
+    }
+    if (!interior) continue;
+    ++interior_leaves;
+    const KdTreeNode& nd = tree.nodes[leaf.node];
+    for (std::uint32_t i = 0; i < nd.count; ++i)
+      EXPECT_GE(tree.items[nd.first + i], 12u) << "a wall in interior leaf " << leaf.node;
+  }
+  EXPECT_GT(interior_leaves, 0);
+}
+
+// Triangles meeting at shared vertices: their bounds, rounded outward onto the split grid, overlap
+// by a grid step, and without the area bound the cells around the vertices were split down to a
+// few grid steps, 8% of all leaves at the depth limit (under 1% with it).
+TEST(KdTree, CellsAroundSharedVerticesStopAtTheAreaBound) {
+  Mesh m = planar_grid(12, 12);
+  // A shallow pyramid: vertex heights off the grid, the root box not flat.
+  for (auto& p : m.pos)
+    p.z = 0.05f * (std::fabs(p.x - 3.0f) + std::fabs(p.y - 1.5f));
+  const KdBuildParams params;
+  const KdTree tree = build_kdtree(m.pos, m.tris, {}, params);
+  check_triangle_tree(tree, m);
+  check_rays(tree, m, 2000 / kScale, 22);
+  std::vector<int> depth(tree.nodes.size(), 0);
+  int leaves = 0;
+  int at_limit = 0;
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+    const KdTreeNode& nd = tree.nodes[i];
+    if (nd.leaf) {
+      ++leaves;
+      at_limit += depth[i] >= params.max_depth;
+      continue;
+    }
+    depth[nd.child] = depth[nd.child + 1] = depth[i] + 1;
+  }
+  EXPECT_LT(at_limit * 50, leaves) << at_limit << " of " << leaves << " leaves at the depth limit";
+}
+
 TEST(KdTree, StanfordBunny) {
   Mesh m;
   ASSERT_TRUE(load_bunny(&m)) << "cannot read the shared bunny";

@@ -89,9 +89,11 @@ TEST(DynRtc, IdleSkipChangesNothing) {
 
 // Thread scaling (paper section 5: nearly linear up to 32 threads, about +10% from 32 to 64).
 TEST(DynRtc, ThreadScalingOnTheRoom) {
-  const host::BuiltImage b = build("builtin:room", 64, 48);
+  // 128x96 (3,072 packets): at 64x48 the 64 threads share 768 packets and the frame's tail, when
+  // fewer packets than threads remain, is a visible part of it.
+  const host::BuiltImage b = build("builtin:room", 128, 96);
   std::map<int, std::uint64_t> cycles;
-  std::printf("thread scaling, builtin:room 64x48, prototype otherwise\n");
+  std::printf("thread scaling, builtin:room 128x96, prototype otherwise\n");
   std::printf("threads   cycles  cycles/packet  speed-up  trav  list  xfrm   int (usage %%)\n");
   for (int t : {1, 2, 4, 8, 16, 32, 64}) {
     CycleParams p = prototype_params();
@@ -107,7 +109,7 @@ TEST(DynRtc, ThreadScalingOnTheRoom) {
   EXPECT_GE(static_cast<double>(cycles[1]) / static_cast<double>(cycles[32]), 8.0);
   const double gain = static_cast<double>(cycles[32]) / static_cast<double>(cycles[64]) - 1.0;
   std::printf("64 threads against 32: %+.1f%% (paper: about +10%%)\n", 100.0 * gain);
-  EXPECT_GE(gain, -0.01);  // more threads never cost more than noise of the arrival order
+  EXPECT_GE(gain, 0.0);
   EXPECT_LE(gain, 0.25);
   for (int t : {2, 4, 8, 16, 32})
     EXPECT_LE(cycles[t], cycles[t / 2]) << t << " threads";
