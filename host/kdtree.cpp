@@ -180,7 +180,8 @@ struct Box {
   float hi[3];
 };
 double box_half_area(const Box& b) {
-  const double d[3] = {static_cast<double>(b.hi[0]) - b.lo[0], static_cast<double>(b.hi[1]) - b.lo[1],
+  const double d[3] = {static_cast<double>(b.hi[0]) - b.lo[0],
+                       static_cast<double>(b.hi[1]) - b.lo[1],
                        static_cast<double>(b.hi[2]) - b.lo[2]};
   return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
 }
@@ -220,7 +221,6 @@ constexpr double kFaceSlabSlack = 1.5;
 // around shared vertices (whose triangles' bounds, rounded outward onto the split grid, overlap by
 // a grid step) down to single grid steps at the depth limit.
 constexpr double kMinAreaShare = 1.0 / (1 << 20);
-
 
 struct Split {
   double cost = std::numeric_limits<double>::infinity();
