@@ -1,11 +1,15 @@
 // Issue 4 acceptance: the functional fp24 model against the float reference (DESIGN.md section 9)
-// on every glTF model in the shared scenes and every built-in scene, at 64x48: the same closest
-// triangle for at least 99 % of the primary rays and a shaded image within 35 dB PSNR. Every
-// scene prints its figures, so the test output is the precision report.
+// on every glTF model in the shared scenes and every built-in scene, at the issue's 512x384: the
+// same closest triangle for at least 99 % of the primary rays and a shaded image within 35 dB
+// PSNR. Every scene prints its figures, so the test output is the precision report. The
+// resolution matters for PSNR: rays that graze an edge (ties the two models break differently)
+// grow with the width, pixels with its square; at 64x48 one flipped full-contrast pixel alone
+// costs 10 log10(3072) = 34.9 dB, and the single-triangle scenes, whose default camera centres on
+// the hypotenuse, scored 27.9 dB there (37.3 dB at 512x384).
 //
 // Known deviations (measured, explained in docs/compare.md "fp24 acceptance"): scenes listed in
 // kKnown miss an issue threshold for a reason that is a property of the fp24 format or of the
-// metric at 64x48, not a model error. For them the test asserts the measured figure as a floor
+// metric, not a model error. For them the test asserts the measured figure as a floor
 // (a regression guard) and prints the reason; every other scene must meet the issue's thresholds.
 #include <gtest/gtest.h>
 
@@ -37,18 +41,9 @@ struct KnownDeviation {
 };
 
 constexpr KnownDeviation kKnown[] = {
-    // The default camera looks at the centre of the hypotenuse: 5 pixel rays pass through that
-    // edge (u ~ 7e-6): edge ties that flip a full-contrast pixel, and one such pixel at 64x48
-    // alone costs 10 log10(3072) = 34.9 dB.
-    {"Triangle/Triangle.gltf", kSameTrianglePct, 27.8,
-     "5 edge ties on the hypotenuse flip full-contrast pixels (PSNR metric at 64x48)"},
-    {"TriangleWithoutIndices/TriangleWithoutIndices.gltf", kSameTrianglePct, 27.8,
-     "5 edge ties on the hypotenuse flip full-contrast pixels (PSNR metric at 64x48)"},
-    {"AnimatedTriangle/AnimatedTriangle.gltf", kSameTrianglePct, 27.8,
-     "5 edge ties on the hypotenuse flip full-contrast pixels (PSNR metric at 64x48)"},
     // 33K-triangle objects of ~1 unit seen from ~50 units: in unit-triangle space |O'| ~ 5e3,
     // where the fp24 ulp is 1/16, so u = O'x + t*D'x cancels to an absolute error ~0.1.
-    {"builtin:suncor", 98.9, kPsnrDb,
+    {"builtin:suncor", 98.6, 33.7,
      "cancellation in u = O'x + t*D'x: tiny triangles far away, |O'| ~ 5e3, fp24 ulp 1/16"},
 };
 
@@ -103,7 +98,7 @@ TEST_P(Fp24Acceptance, SameTriangleAndPsnrAgainstFloatReference) {
   }
 #endif
   RenderSettings settings;
-  settings.res = {64, 48};
+  settings.res = {512, 384};  // the issue's default (render's default too)
   // A scene whose image exceeds the banks (the kd-trees move with the builder's parameters) is
   // retried with banks twice as large: bank size is a parameter, precision is what is tested.
   settings.bank_mb = bank_mb_for(spec);
@@ -149,7 +144,8 @@ TEST_P(Fp24Acceptance, SameTriangleAndPsnrAgainstFloatReference) {
   const double psnr_floor = k ? k->psnr_floor : kPsnrDb;
   EXPECT_GE(hits.same_triangle_pct, same_floor)
       << short_name(spec) << ": replay the first mismatch with `saarcor render " << spec
-      << " --model fp24 --res 64x48 --bank-mb " << settings.bank_mb << " --pixel " << first.x << ","
+      << " --model fp24 --res " << settings.res.width << "x" << settings.res.height
+      << " --bank-mb " << settings.bank_mb << " --pixel " << first.x << ","
       << first.y << "` (and --model float)";
   EXPECT_GE(psnr, psnr_floor) << short_name(spec) << ": largest difference at --pixel "
                               << img.worst_pixel.x << "," << img.worst_pixel.y;
