@@ -58,7 +58,10 @@ struct FloatTraceStats {
 
 // The float reference's copy of one instance, one object and the trees, all in binary32.
 struct FloatInstance {
-  Affine32 world_to_object;  // rounded once from binary64
+  // The ray's world -> object step runs in binary64 and rounds the object-space ray once
+  // (docs/float-reference.md: instances scaled ~40 and translated ~600, as in VC, lose ~1e-5 of t
+  // to a binary32 step).
+  Affine64 world_to_object;
   std::uint32_t object = 0;
   std::uint32_t id = 0;  // glTF node index (built-ins: instance index), what hit records report
 };

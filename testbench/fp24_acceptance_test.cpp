@@ -144,9 +144,8 @@ TEST_P(Fp24Acceptance, SameTriangleAndPsnrAgainstFloatReference) {
   const double psnr_floor = k ? k->psnr_floor : kPsnrDb;
   EXPECT_GE(hits.same_triangle_pct, same_floor)
       << short_name(spec) << ": replay the first mismatch with `saarcor render " << spec
-      << " --model fp24 --res " << settings.res.width << "x" << settings.res.height
-      << " --bank-mb " << settings.bank_mb << " --pixel " << first.x << ","
-      << first.y << "` (and --model float)";
+      << " --model fp24 --res " << settings.res.width << "x" << settings.res.height << " --bank-mb "
+      << settings.bank_mb << " --pixel " << first.x << "," << first.y << "` (and --model float)";
   EXPECT_GE(psnr, psnr_floor) << short_name(spec) << ": largest difference at --pixel "
                               << img.worst_pixel.x << "," << img.worst_pixel.y;
   // Same triangle, same ray: the relative t error stays within a few fp24 ulps of the
