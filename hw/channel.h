@@ -27,6 +27,7 @@
 namespace saarcor::hw {
 
 class Kernel;
+class Module;
 struct Counter;
 
 inline constexpr std::uint64_t kNever = std::numeric_limits<std::uint64_t>::max();
@@ -56,8 +57,12 @@ class ChannelBase {
     return pops_ < count_ && pops_ < width_ && ready_at_[slot(pops_)] <= *now_;
   }
 
-  // Applies this cycle's pushes and pops; returns how many there were. Kernel only.
+  // Applies this cycle's pushes and pops (waking the declared consumer when pushed items become
+  // visible and the declared producer when a pop frees room); returns how many there were.
+  // Kernel only.
   int commit();
+  Module* producer() const { return producer_; }
+  Module* consumer() const { return consumer_; }
   std::uint64_t total_pushes() const;
 
  protected:
@@ -101,6 +106,8 @@ class ChannelBase {
   std::vector<std::uint64_t> ready_at_;
   int head_ = 0, count_ = 0, pushes_ = 0, pops_ = 0;
   bool dirty_ = false;
+  Module* producer_ = nullptr;  // declared ends (Module::produces/consumes); null: not declared
+  Module* consumer_ = nullptr;
   // Statistics (owned by the kernel's registry).
   Counter* pushes_stat_ = nullptr;
   Counter* max_occupancy_stat_ = nullptr;
@@ -109,6 +116,7 @@ class ChannelBase {
   std::uint64_t last_change_ = 0;
 
   friend class Kernel;
+  friend class Module;
 };
 
 template <class T>

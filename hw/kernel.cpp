@@ -46,6 +46,13 @@ int ChannelBase::commit() {
   count_ += pushes_ - pops_;
   *pushes_stat_ += static_cast<std::uint64_t>(pushes_);
   max_occupancy_stat_->set_max(static_cast<std::uint64_t>(count_));
+  // Event scheduling: the items pushed now become visible after the latency; the slots popped now
+  // are free for the producer next cycle.
+  if (pushes_ != 0 && consumer_ != nullptr)
+    consumer_->wake_at_ =
+        std::min(consumer_->wake_at_, *now_ + static_cast<std::uint64_t>(latency_));
+  if (pops_ != 0 && producer_ != nullptr)
+    producer_->wake_at_ = std::min(producer_->wake_at_, *now_ + 1);
   pushes_ = pops_ = 0;
   dirty_ = false;
   return moved;
@@ -66,6 +73,22 @@ Stats& Module::stats() const {
   return kernel_->stats();
 }
 
+void Module::consumes(ChannelBase& c) {
+  if (c.consumer_ != nullptr && c.consumer_ != this)
+    throw std::logic_error("channel '" + c.name() + "': consumed by both '" + c.consumer_->name() +
+                           "' and '" + name_ + "'");
+  if (c.consumer_ == this) return;
+  c.consumer_ = this;
+  inputs_.push_back(&c);
+}
+
+void Module::produces(ChannelBase& c) {
+  if (c.producer_ != nullptr && c.producer_ != this)
+    throw std::logic_error("channel '" + c.name() + "': produced by both '" + c.producer_->name() +
+                           "' and '" + name_ + "'");
+  c.producer_ = this;
+}
+
 // ---- Kernel -------------------------------------------------------------------------------------
 
 Kernel::Kernel(KernelConfig config) : config_(config), rng_(config.shuffle_seed) {}
@@ -78,8 +101,11 @@ void Kernel::add_module(Module* m) {
                                   "cycles in which the module made progress");
   m->stall_stat_ = &stats_.counter(m->name() + ".stall_cycles", "cycles",
                                    "cycles in which the module had work but was blocked");
+  m->accounted_ = cycle_;
+  m->wake_at_ = cycle_;
   modules_.push_back(m);
   order_.push_back(m);
+  awake_.resize(modules_.size());
 }
 
 void Kernel::add_channel(ChannelBase* c) {
@@ -97,34 +123,87 @@ void Kernel::add_channel(ChannelBase* c) {
 }
 
 int Kernel::step() {
+  wake_all();
+  const int total = step_cycle();
+  account_all();
+  return total;
+}
+
+void Kernel::wake_all() {
+  for (Module* m : modules_)
+    m->wake_at_ = std::min(m->wake_at_, cycle_);
+}
+
+// Counts the cycles a module was not evaluated in (asleep, or jumped over by the idle skip) as
+// repeats of its last evaluated cycle: no progress, the same stall.
+void Kernel::account(Module* m) {
+  const std::uint64_t n = cycle_ - m->accounted_;
+  if (n == 0) return;
+  if (m->stalled_) m->stall_stat_->value += n;
+  m->skipped(n);
+  m->accounted_ = cycle_;
+}
+
+void Kernel::account_all() {
+  for (Module* m : modules_)
+    account(m);
+}
+
+int Kernel::step_cycle() {
   if (config_.shuffle_seed != 0) std::shuffle(order_.begin(), order_.end(), rng_);
+  // Without idle skipping every module is due every cycle (the reference for the figures).
+  const std::uint64_t due = config_.idle_skip ? cycle_ : kNever;
   int progress = 0;
+  Module** const evaluated = awake_.data();
+  std::size_t n = 0;
   for (Module* m : order_) {
+    if (m->wake_at_ > due) continue;  // asleep: this cycle would repeat its last one
+    if (m->accounted_ != cycle_) account(m);
     m->stalled_ = false;
     const int p = m->evaluate();
     m->last_progress_ = p;
+    m->accounted_ = cycle_ + 1;
     progress += p;
+    evaluated[n++] = m;
   }
-  evaluations_ += order_.size();
+  evaluations_ += n;
   ++evaluated_;
   if (tracer_) tracer_->sample(cycle_, modules_, channels_);
-  for (Module* m : modules_) {
-    m->commit();
-    m->busy_stat_->value += m->last_progress_ > 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    Module* m = evaluated[i];
+    if (m->last_progress_ > 0) {
+      m->commit();  // an idle module staged nothing (module.h: progress 0 = nothing changed)
+      ++m->busy_stat_->value;
+      m->wake_at_ = cycle_ + 1;
+    } else {
+      m->wake_at_ = m->sleeps_ ? idle_wakeup(*m) : cycle_ + 1;
+    }
     m->stall_stat_->value += m->stalled_;
   }
   int activity = 0;
   for (ChannelBase* c : dirty_)
-    activity += c->commit();
+    activity += c->commit();  // wakes the declared ends of the channels that moved
   dirty_.clear();
   const int total = progress + activity;
   ++cycle_;
   if (total > 0) progress_mark_ = cycle_;
   if (config_.time_series_period != 0 && cycle_ % config_.time_series_period == 0) {
+    account_all();
     stats_.set_time_series_period(config_.time_series_period);
     stats_.sample(cycle_);
   }
   return total;
+}
+
+// A sleeping module's next evaluation after an idle cycle: its own timers, or the first item on
+// one of its inputs that becomes visible later (pushes and pops after now wake it themselves).
+std::uint64_t Kernel::idle_wakeup(const Module& m) const {
+  std::uint64_t t = m.next_wakeup(cycle_);
+  for (const ChannelBase* c : m.inputs_) {
+    const std::uint64_t r = c->front_ready_cycle();
+    if (r > cycle_ && r < t) t = r;
+  }
+  return std::max(t, cycle_ + 1);
 }
 
 std::uint64_t Kernel::next_event() const {
@@ -140,37 +219,45 @@ std::uint64_t Kernel::next_event() const {
 }
 
 void Kernel::skip_to(std::uint64_t target) {
-  const std::uint64_t n = target - cycle_;
-  for (Module* m : modules_) {
-    if (m->stalled_) m->stall_stat_->value += n;
-    m->skipped(n);
-  }
-  skipped_ += n;
+  // The jumped-over cycles are counted lazily (account) like a sleeping module's.
+  skipped_ += target - cycle_;
   cycle_ = target;
   if (config_.time_series_period != 0 && cycle_ % config_.time_series_period == 0) {
+    account_all();
     stats_.set_time_series_period(config_.time_series_period);
     stats_.sample(cycle_);
   }
 }
 
 RunResult Kernel::run(const std::function<bool()>& done, std::uint64_t max_cycles) {
+  RunResult r = run_cycles(done, max_cycles);
+  account_all();
+  return r;
+}
+
+RunResult Kernel::run_cycles(const std::function<bool()>& done, std::uint64_t max_cycles) {
   const std::uint64_t limit = max_cycles > kNever - cycle_ ? kNever : cycle_ + max_cycles;
   progress_mark_ = cycle_;
   const std::uint64_t wd = config_.watchdog_cycles;
+  wake_all();  // the caller may have changed module state between runs
   for (;;) {
     if (done()) return {RunResult::Status::kDone, cycle_, {}};
     if (cycle_ >= limit) return {RunResult::Status::kCycleLimit, cycle_, {}};
     if (wd != 0 && cycle_ - progress_mark_ >= wd) {
+      account_all();
       return {RunResult::Status::kWatchdog, cycle_, state_report()};
     }
-    if (step() != 0 || !config_.idle_skip) continue;
+    if (step_cycle() != 0 || !config_.idle_skip) continue;
     // Idle cycle: jump to the earliest cycle where anything (or anything we report) can change.
     std::uint64_t target = std::min(next_event(), limit);
+    for (const Module* m : modules_)  // a sleeper's pending wake (next_event covers the rest)
+      if (m->sleeps_) target = std::min(target, std::max(m->wake_at_, cycle_));
     if (wd != 0) target = std::min(target, progress_mark_ + wd);
     const std::uint64_t period = config_.time_series_period;
     if (period != 0) target = std::min(target, (cycle_ / period + 1) * period);
     if (tracer_ && cycle_ < trace_from_) target = std::min(target, trace_from_);
     if (target == kNever) {  // no watchdog, no limit, and nothing can ever happen again
+      account_all();
       return {RunResult::Status::kWatchdog, cycle_,
               "nothing can change any more (no pending event)\n" + state_report()};
     }

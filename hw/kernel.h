@@ -4,9 +4,11 @@
 //
 // A cycle c, as a script:
 //   1. evaluate every module (registration order, or a fresh random order per cycle when
-//      shuffle_seed != 0: the figures must not change);
+//      shuffle_seed != 0: the figures must not change), except modules that sleep (opt-in,
+//      Module::sleep_when_idle) and have no event due: their cycle would repeat their last one;
 //   2. trace (VCD, start-of-cycle channel state + this cycle's busy/stall);
-//   3. commit every module, then every channel touched in the cycle;
+//   3. commit every module that made progress, then every channel touched in the cycle (which
+//      wakes the channel's declared consumer / producer);
 //   4. busy/stall statistics, time-series sample, clock advances to c+1;
 //   5. if nothing happened (no progress, no channel activity) and idle skipping is on, jump to the
 //      earliest cycle at which something can happen (a channel item's latency elapses, a module's
@@ -110,6 +112,12 @@ class Kernel {
   void add_channel(ChannelBase* c);
   std::uint64_t next_event() const;
   void skip_to(std::uint64_t target);
+  int step_cycle();
+  RunResult run_cycles(const std::function<bool()>& done, std::uint64_t max_cycles);
+  void wake_all();
+  void account(Module* m);
+  void account_all();
+  std::uint64_t idle_wakeup(const Module& m) const;
 
   KernelConfig config_;
   std::uint64_t cycle_ = 0;
@@ -119,6 +127,7 @@ class Kernel {
   Stats stats_;
   std::vector<Module*> modules_;
   std::vector<Module*> order_;
+  std::vector<Module*> awake_;  // the modules evaluated in the current cycle
   std::vector<ChannelBase*> channels_;
   std::vector<ChannelBase*> dirty_;
   std::mt19937_64 rng_;

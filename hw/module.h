@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "hw/channel.h"
 #include "hw/stats.h"
@@ -51,8 +52,24 @@ class Module {
   // Kernel-kept per-module statistics: <name>.busy_cycles, <name>.stall_cycles.
   bool busy() const { return last_progress_ > 0; }
   bool stalled() const { return stalled_; }
+  // Whether the module sleeps between events (see sleep_when_idle).
+  bool sleeps() const { return sleeps_; }
 
  protected:
+  // Opt-in event scheduling: the module promises that its evaluate() depends only on its own
+  // state, on time through next_wakeup(), and on the channels it declared with consumes() and
+  // produces() (each of its channels, every end it touches). The kernel then evaluates it only in
+  // cycles where something it depends on may have changed: the cycle after it made progress, an
+  // item pushed to one of its inputs becoming visible, a pop freeing room in one of its outputs,
+  // its next_wakeup(), and the first cycle of every run()/step(). Skipped cycles would have
+  // repeated its last idle cycle exactly, so every figure is the same as evaluating every cycle
+  // (KernelConfig::idle_skip = false evaluates every module every cycle: the reference).
+  void sleep_when_idle() { sleeps_ = true; }
+  // This module pops from `c` (its one consumer) / pushes into `c` (its one producer). Throws
+  // std::logic_error if another module already holds that end.
+  void consumes(ChannelBase& c);
+  void produces(ChannelBase& c);
+
   // Marks this cycle as a stall: the module has work but is blocked (full output, no credit).
   void stall() { stalled_ = true; }
   Kernel& kernel() const { return *kernel_; }
@@ -61,11 +78,18 @@ class Module {
 
  private:
   friend class Kernel;
+  friend class ChannelBase;
   std::string name_;
   Kernel* kernel_;
   const std::uint64_t* now_;
   int last_progress_ = 0;
   bool stalled_ = false;
+  bool sleeps_ = false;
+  // Event scheduling: evaluated in cycle c only if wake_at_ <= c; cycles before accounted_ have
+  // their busy/stall statistics and skipped() counted (the rest are counted lazily on waking).
+  std::uint64_t wake_at_ = 0;
+  std::uint64_t accounted_ = 0;
+  std::vector<ChannelBase*> inputs_;  // consumed channels: their front items wake the module
   Counter* busy_stat_ = nullptr;
   Counter* stall_stat_ = nullptr;
 };

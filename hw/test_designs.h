@@ -1,6 +1,8 @@
 // Small designs shared by the hw/ tests (DESIGN.md section 8): a pipeline of stages that share
 // state only through registers and channels, and a bursty design with long idle gaps, internal
-// timers and back-pressure stalls (what idle skipping must handle). Test-only header.
+// timers and back-pressure stalls (what idle skipping must handle). With `sleep`, every module
+// that may (all but the doubler, which reads another module's register) opts into event
+// scheduling (Module::sleep_when_idle) and declares its channels. Test-only header.
 #pragma once
 
 #include <cstdint>
@@ -17,8 +19,13 @@ namespace saarcor::hw::testing {
 
 class Source : public Module {
  public:
-  Source(Kernel& k, Channel<std::uint32_t>& out, std::uint32_t items)
-      : Module(k, "a.source"), out_(out), items_(items) {}
+  Source(Kernel& k, Channel<std::uint32_t>& out, std::uint32_t items, bool sleep = false)
+      : Module(k, "a.source"), out_(out), items_(items) {
+    if (sleep) {
+      sleep_when_idle();
+      produces(out);
+    }
+  }
   int evaluate() override {
     const std::uint32_t n = count_.get();
     if (n == items_) return 0;
@@ -70,8 +77,15 @@ class Doubler : public Module {
 class Splitter : public Module {
  public:
   Splitter(Kernel& k, Channel<std::uint32_t>& in, Channel<std::uint32_t>& c,
-           Channel<std::uint32_t>& d)
-      : Module(k, "a.splitter"), in_(in), c_(c), d_(d) {}
+           Channel<std::uint32_t>& d, bool sleep = false)
+      : Module(k, "a.splitter"), in_(in), c_(c), d_(d) {
+    if (sleep) {
+      sleep_when_idle();
+      consumes(in);
+      produces(c);
+      produces(d);
+    }
+  }
   int evaluate() override {
     if (!in_.can_pop()) return 0;
     Channel<std::uint32_t>& out = toggle_.get() ? d_ : c_;
@@ -94,8 +108,17 @@ class Splitter : public Module {
 class Joiner : public Module {
  public:
   Joiner(Kernel& k, Channel<std::uint32_t>& c, Channel<std::uint32_t>& d,
-         Channel<std::uint32_t>& out)
-      : Module(k, "a.joiner"), c_(c), d_(d), out_(out), pipe_(k, "a.joiner.pipe", 5) {}
+         Channel<std::uint32_t>& out, bool sleep = false)
+      : Module(k, "a.joiner"), c_(c), d_(d), out_(out), pipe_(k, "a.joiner.pipe", 5) {
+    if (sleep) {  // the internal pipeline too: its results becoming visible wake the joiner
+      sleep_when_idle();
+      consumes(c);
+      consumes(d);
+      produces(out);
+      consumes(pipe_);
+      produces(pipe_);
+    }
+  }
   int evaluate() override {
     int p = 0;
     // Retire from the internal pipeline into the output.
@@ -124,7 +147,12 @@ class Joiner : public Module {
 
 class Sink : public Module {
  public:
-  Sink(Kernel& k, Channel<std::uint32_t>& in) : Module(k, "a.sink"), in_(in) {}
+  Sink(Kernel& k, Channel<std::uint32_t>& in, bool sleep = false) : Module(k, "a.sink"), in_(in) {
+    if (sleep) {
+      sleep_when_idle();
+      consumes(in);
+    }
+  }
   int evaluate() override {
     // Slow consumer: every third cycle only, so back-pressure reaches the source.
     if (now() % 3 != 0 || !in_.can_pop()) return 0;
@@ -141,16 +169,16 @@ class Sink : public Module {
 };
 
 struct DesignA {
-  explicit DesignA(Kernel& k, std::uint32_t items = 200)
+  explicit DesignA(Kernel& k, std::uint32_t items = 200, bool sleep = false)
       : a(k, "a.ch_a", 3, 2),
         b(k, "a.ch_b", 2, 1),
         c(k, "a.ch_c", 2, 1),
         d(k, "a.ch_d", 5, 4),
         e(k, "a.ch_e", 4, 3),
-        sink(k, e),
-        joiner(k, c, d, e),
-        source(k, a, items),
-        splitter(k, b, c, d),
+        sink(k, e, sleep),
+        joiner(k, c, d, e, sleep),
+        source(k, a, items, sleep),
+        splitter(k, b, c, d, sleep),
         doubler(k, a, b, source),
         items_(items) {}
   bool done() const { return sink.log.size() == items_; }
@@ -167,8 +195,13 @@ struct DesignA {
 
 class BurstSource : public Module {
  public:
-  BurstSource(Kernel& k, Channel<std::uint32_t>& out, int bursts)
-      : Module(k, "b.source"), out_(out), bursts_(bursts) {}
+  BurstSource(Kernel& k, Channel<std::uint32_t>& out, int bursts, bool sleep = false)
+      : Module(k, "b.source"), out_(out), bursts_(bursts) {
+    if (sleep) {
+      sleep_when_idle();
+      produces(out);
+    }
+  }
   int evaluate() override {
     if (burst_.get() == bursts_) return 0;
     const std::uint64_t start = static_cast<std::uint64_t>(burst_.get()) * 700u + 10u;
@@ -209,8 +242,13 @@ class BurstSource : public Module {
 // Accepts one request at a time and answers 37 cycles later (an internal timer, not a channel).
 class SlowMemory : public Module {
  public:
-  SlowMemory(Kernel& k, Channel<std::uint32_t>& in, Channel<std::uint32_t>& out)
+  SlowMemory(Kernel& k, Channel<std::uint32_t>& in, Channel<std::uint32_t>& out, bool sleep = false)
       : Module(k, "b.memory"), in_(in), out_(out) {
+    if (sleep) {
+      sleep_when_idle();
+      consumes(in);
+      produces(out);
+    }
     waiting_ = &stats().counter("b.memory.wait_cycles", "cycles",
                                 "cycles with a request in service (counted per cycle)");
   }
@@ -253,7 +291,12 @@ class SlowMemory : public Module {
 
 class TimedSink : public Module {
  public:
-  TimedSink(Kernel& k, Channel<std::uint32_t>& in) : Module(k, "b.sink"), in_(in) {
+  TimedSink(Kernel& k, Channel<std::uint32_t>& in, bool sleep = false)
+      : Module(k, "b.sink"), in_(in) {
+    if (sleep) {
+      sleep_when_idle();
+      consumes(in);
+    }
     latency_ = &stats().histogram("b.sink.gap", "cycles", "cycles between arrivals", 0, 50, 20);
   }
   int evaluate() override {
@@ -275,12 +318,12 @@ class TimedSink : public Module {
 };
 
 struct DesignB {
-  explicit DesignB(Kernel& k, int bursts = 5)
+  explicit DesignB(Kernel& k, int bursts = 5, bool sleep = false)
       : req(k, "b.req", 2, 50),
         resp(k, "b.resp", 3, 20),
-        source(k, req, bursts),
-        memory(k, req, resp),
-        sink(k, resp),
+        source(k, req, bursts, sleep),
+        memory(k, req, resp, sleep),
+        sink(k, resp, sleep),
         bursts_(bursts) {}
   bool done() const { return log_size() == static_cast<std::size_t>(bursts_) * 6; }
   std::size_t log_size() const { return sink.log.size(); }

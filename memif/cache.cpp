@@ -48,6 +48,15 @@ Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryIm
     responses_.push_back(std::make_unique<hw::Channel<CacheResponse>>(
         kernel, this->name() + ".resp" + suffix, config.hit_latency + 2, config.hit_latency - 1));
   }
+  // Event scheduling: the cache depends only on its channels (it has no timers).
+  sleep_when_idle();
+  for (int p = 0; p < config.ports; ++p) {
+    consumes(*requests_[static_cast<std::size_t>(p)]);
+    produces(*responses_[static_cast<std::size_t>(p)]);
+  }
+  produces(mem_requests_);
+  consumes(fills_);
+  if ((sets_ & (sets_ - 1)) == 0) set_mask_ = static_cast<std::uint32_t>(sets_ - 1);
   lines_.resize(static_cast<std::size_t>(config.items));
   mshrs_.resize(static_cast<std::size_t>(config.max_misses));
   hw::Stats& s = stats();
@@ -123,11 +132,15 @@ int Cache::deliver() {
 int Cache::lookup(bool port_free) {
   const int ports = static_cast<int>(requests_.size());
   int port = -1;
-  for (int k = 0; k < ports; ++k) {
-    const int p = (next_port_ + k) % ports;
-    if (requests_[static_cast<std::size_t>(p)]->can_pop()) {
-      port = p;
-      break;
+  if (ports == 1) {  // the DynRTP's caches: one unit each
+    if (requests_[0]->can_pop()) port = 0;
+  } else {
+    for (int k = 0; k < ports; ++k) {
+      const int p = (next_port_ + k) % ports;
+      if (requests_[static_cast<std::size_t>(p)]->can_pop()) {
+        port = p;
+        break;
+      }
     }
   }
   if (port < 0) return 0;
@@ -137,10 +150,12 @@ int Cache::lookup(bool port_free) {
   auto accepted = [&] {
     if (accept_log_) accept_log_->push_back(req.index);
     ++*requests_stat_;
-    next_port_ = (port + 1) % ports;
+    next_port_ = port + 1 == ports ? 0 : port + 1;
     in.pop();  // last: `req` refers to the channel's slot
   };
-  const std::size_t set = req.index % static_cast<std::uint32_t>(sets_);
+  const std::size_t set = set_mask_ != 0 || sets_ == 1
+                              ? req.index & set_mask_
+                              : req.index % static_cast<std::uint32_t>(sets_);
   const std::size_t first = set * static_cast<std::size_t>(config_.ways);
   int way = -1;
   for (int w = 0; w < config_.ways; ++w) {

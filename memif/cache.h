@@ -129,6 +129,7 @@ class Cache : public hw::Module {
   CacheConfig config_;
   int words_;
   int sets_;
+  std::uint32_t set_mask_ = 0;  // sets - 1 when sets is a power of two (else 0 and a modulo)
   std::vector<std::unique_ptr<hw::Channel<CacheRequest>>> requests_;
   std::vector<std::unique_ptr<hw::Channel<CacheResponse>>> responses_;
   hw::Channel<MemRequest> mem_requests_;

@@ -30,6 +30,8 @@ HostBus::HostBus(hw::Kernel& kernel, std::string name, MemoryController& control
   bytes_per_second_ = static_cast<std::uint64_t>(std::llround(config.mb_per_s * 1048576.0));
   if (bytes_per_second_ == 0) bytes_per_second_ = 1;
   clock_ = static_cast<std::uint64_t>(std::llround(config.clock_hz));
+  sleep_when_idle();  // upload() comes between runs, and every run starts by waking all modules
+  produces(port_.requests);
   sent_ =
       &stats().counter(this->name() + ".bytes_uploaded", "bytes", "bytes sent over the host bus");
 }

@@ -36,6 +36,7 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
       config_(std::move(config)),
       banks_(kNumBanks),
       inflight_limit_(config_.latency + 2) {
+  sleep_when_idle();  // its timers are in next_wakeup, its inputs are its ports
   hw::Stats& s = stats();
   const std::string& n = this->name();
   for (int b = 0; b < kNumBanks; ++b) {
@@ -58,6 +59,8 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
 
 MemoryController::Port& MemoryController::add_port(const std::string& name) {
   ports_.push_back(std::make_unique<Port>(kernel(), name, config_.port_capacity));
+  consumes(ports_.back()->requests);
+  produces(ports_.back()->responses);
   return *ports_.back();
 }
 

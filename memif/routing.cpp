@@ -18,6 +18,9 @@ SimpleRouting::SimpleRouting(hw::Kernel& kernel, std::string name, MemoryControl
     : hw::Module(kernel, check(std::move(name), responses_per_cycle)),
       port_(port),
       responses_per_cycle_(responses_per_cycle) {
+  sleep_when_idle();  // depends only on its channels and its register
+  produces(port.requests);
+  consumes(port.responses);
   forwarded_ = &stats().counter(this->name() + ".requests", "requests",
                                 "requests forwarded to the memory controller");
 }
@@ -29,6 +32,8 @@ void SimpleRouting::add_client(std::uint16_t client, hw::Channel<MemRequest>& re
     throw std::runtime_error("routing '" + name() + "': client " + std::to_string(client) +
                              " added twice");
   }
+  consumes(requests);
+  produces(fills);
   by_id_[client] = static_cast<int>(clients_.size());
   clients_.push_back({client, &requests, &fills});
 }

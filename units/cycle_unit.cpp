@@ -14,7 +14,15 @@ CycleUnit::CycleUnit(hw::Kernel& kernel, std::string name, UnitId id, ThreadTabl
       id_(id),
       depth_(depth),
       cache_(cache),
-      waiting_(static_cast<std::size_t>(threads.size()), 0) {
+      waiting_(static_cast<std::size_t>(threads.size()), 0),
+      ready_(threads.size()),
+      pipeline_(threads.size()) {
+  // Event scheduling: a unit depends on its paths, its cache's channels and its pipeline timer.
+  sleep_when_idle();
+  if (cache_ != nullptr) {
+    produces(cache_->requests());
+    consumes(cache_->responses());
+  }
   issued_ = &stats().counter(this->name() + ".issue_cycles", "cycles",
                              "cycles in which the unit issued a step (its usage)");
   served_ =
@@ -35,7 +43,7 @@ int CycleUnit::deliver() {
   int moved = 0;
   while (!pipeline_.empty() && pipeline_.front().done_at <= now()) {
     const ThreadToken t = pipeline_.front().thread;
-    const Request next = threads_.request(t);
+    const Request& next = threads_.request(t);
     if (next.unit == UnitId::kNone) {
       pipeline_.pop_front();
       --inside_;
@@ -70,11 +78,11 @@ int CycleUnit::issue() {
     } else {
       return 0;
     }
-    const Request r = threads_.request(t);
+    const Request r = threads_.request(t);  // a copy: execute() replaces the table's entry
     threads_.execute(t);
     ++*served_;
     steps_left_ = r.steps < 1 ? 1 : r.steps;
-    const Request next = threads_.request(t);
+    const Request& next = threads_.request(t);
     if (next.unit == id_ && chains(r, next)) {
       chained_ = true;
       chain_thread_ = t;
@@ -151,7 +159,7 @@ std::string CycleUnit::dump_state() const {
       << pipeline_.front().done_at;
   for (std::size_t t = 0; t < waiting_.size(); ++t)
     if (waiting_[t] > 0) {
-      const Request r = threads_.request(static_cast<ThreadToken>(t));
+      const Request& r = threads_.request(static_cast<ThreadToken>(t));
       s << "\n  thread " << t << " waits for " << waiting_[t] << " item(s) for "
         << phase_name(r.phase) << " item " << r.item;
     }

@@ -12,7 +12,6 @@
 
 #include <array>
 #include <cstdint>
-#include <deque>
 #include <string>
 #include <vector>
 
@@ -28,16 +27,46 @@ inline int unit_index(UnitId u) {
 }
 
 // The threads of one DynRTP as the units see them (the thread program behind an interface, so the
-// units are independent of the float format).
+// units are independent of the float format). A thread's request changes only when it executes
+// or starts a packet, so the table keeps each thread's current request (the units read it several
+// times per step: a plain array read, not a call).
 class ThreadTable {
  public:
   virtual ~ThreadTable() = default;
-  virtual int size() const = 0;
-  virtual Request request(std::uint32_t thread) const = 0;
+  int size() const { return static_cast<int>(requests_.size()); }
+  const Request& request(std::uint32_t thread) const { return requests_[thread]; }
+  // Runs the thread's current request and stores its next one.
   virtual void execute(std::uint32_t thread) = 0;
   // The RGC hands thread `thread` primary packet `packet` (path a starts from here).
   virtual void start_primary(std::uint32_t thread, int packet) = 0;
   virtual int packets() const = 0;
+
+ protected:
+  std::vector<Request> requests_;  // one per thread
+};
+
+// A FIFO of at most `capacity` items in a power-of-two ring (the units' ready queue, pipeline and
+// free list hold thread ids, at most one entry per thread, so the capacity is the thread count).
+template <class T>
+class Ring {
+ public:
+  explicit Ring(int capacity) {
+    std::size_t n = 1;
+    while (n < static_cast<std::size_t>(capacity))
+      n *= 2;
+    items_.resize(n);
+    mask_ = n - 1;
+  }
+  bool empty() const { return head_ == tail_; }
+  std::size_t size() const { return tail_ - head_; }
+  const T& front() const { return items_[head_ & mask_]; }
+  const T& operator[](std::size_t k) const { return items_[(head_ + k) & mask_]; }
+  void push_back(const T& v) { items_[tail_++ & mask_] = v; }
+  void pop_front() { ++head_; }
+
+ private:
+  std::vector<T> items_;
+  std::size_t mask_ = 0, head_ = 0, tail_ = 0;
 };
 
 // A thread id on a path between units.
@@ -51,9 +80,15 @@ class CycleUnit : public hw::Module {
             memif::Cache* cache);
 
   // Inputs in priority order (the first non-empty path is served, D25).
-  void add_input(ThreadPath* path) { inputs_.push_back(path); }
+  void add_input(ThreadPath* path) {
+    consumes(*path);
+    inputs_.push_back(path);
+  }
   // The path towards unit `to` (also a path back into this unit: the unit's own loop).
-  void set_output(UnitId to, ThreadPath* path) { outputs_[unit_index(to)] = path; }
+  void set_output(UnitId to, ThreadPath* path) {
+    produces(*path);
+    outputs_[unit_index(to)] = path;
+  }
 
   UnitId id() const { return id_; }
   int depth() const { return depth_; }
@@ -108,12 +143,12 @@ class CycleUnit : public hw::Module {
   int fetch_left_ = 0;
   std::vector<int> waiting_;  // per thread: cache responses still expected
   int waiting_threads_ = 0;
-  std::deque<ThreadToken> ready_;
+  Ring<ThreadToken> ready_;
   // Issue slot.
   int steps_left_ = 0;
   bool chained_ = false;
   ThreadToken chain_thread_ = 0;
-  std::deque<InFlight> pipeline_;
+  Ring<InFlight> pipeline_;
   hw::Counter* issued_;
   hw::Counter* served_;
 };

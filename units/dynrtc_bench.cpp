@@ -70,6 +70,8 @@ void BM_CycleModelFrame(benchmark::State& state) {
   state.counters["host_s_per_frame"] = per_frame;
   state.counters["sim_cycles_per_s"] = rate;
   state.counters["cycles"] = static_cast<double>(last.cycles);
+  state.counters["evaluations_per_cycle"] =
+      static_cast<double>(last.module_evaluations) / static_cast<double>(last.cycles);
   std::printf(
       "cycle model, %d threads: %.3f host s per 512x384 frame, %llu cycles (%.1f fps at %.0f "
       "MHz), %.2f M simulated cycles/s (target >= 5: ratio %.2f), %.1fx the functional fp24 "

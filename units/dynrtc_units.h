@@ -5,7 +5,6 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <string>
 
 #include "units/cycle_unit.h"
@@ -73,7 +72,7 @@ class RaySource : public CycleUnit {
   std::uint64_t extra_wakeup(std::uint64_t now) const override;
 
  private:
-  std::deque<ThreadToken> free_list_;
+  Ring<ThreadToken> free_list_;
   int free_;
   int next_packet_ = 0;
   hw::Counter* retired_;

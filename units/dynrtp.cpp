@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 
@@ -32,16 +33,16 @@ class Threads final : public ThreadTable {
       requests_.push_back(programs_.back()->request());
     }
   }
-  int size() const override { return static_cast<int>(programs_.size()); }
-  // A thread's request changes only when it executes or starts a packet: kept, not recomputed.
-  Request request(std::uint32_t t) const override { return requests_[t]; }
   void execute(std::uint32_t t) override {
-    programs_[t]->execute();
-    requests_[t] = programs_[t]->request();
+    ThreadProgram<F>& p = *programs_[t];
+    p.execute();
+    // Returned straight into the table (guaranteed elision): a copy of the returned temporary
+    // would reload a struct the callee has just written field by field (a store-forward stall).
+    ::new (static_cast<void*>(&requests_[t])) Request(p.request());
   }
   void start_primary(std::uint32_t t, int packet) override {
     programs_[t]->start_primary(packet_pixels(tiling_, w_, h_, packet));
-    requests_[t] = programs_[t]->request();
+    ::new (static_cast<void*>(&requests_[t])) Request(programs_[t]->request());
   }
   int packets() const override { return tiling_.count(); }
 
@@ -56,7 +57,6 @@ class Threads final : public ThreadTable {
   PacketTiling tiling_;
   int w_ = 0, h_ = 0;
   std::vector<std::unique_ptr<ThreadProgram<F>>> programs_;
-  std::vector<Request> requests_;
 };
 
 template <class F>
@@ -330,6 +330,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
                                          static_cast<double>(steps) / p.packet;
   out.packets_retired = dyn.rgs().packets_retired();
   out.skipped_cycles = k.skipped_cycles();
+  out.module_evaluations = k.module_evaluations();
   out.stats_json = k.stats().json();
   out.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.frame.seconds = out.host_seconds;

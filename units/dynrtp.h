@@ -60,8 +60,9 @@ struct CycleFrame {
   std::uint64_t packets = 0, packets_retired = 0;
   double host_seconds = 0, sim_cycles_per_s = 0;
   std::uint64_t skipped_cycles = 0;
-  std::vector<CycleFigures> series;  // with interval != 0: the figures of each interval
-  std::string stats_json;            // the hw/ statistics registry
+  std::uint64_t module_evaluations = 0;  // host work: evaluate() calls (sleeping modules skip)
+  std::vector<CycleFigures> series;      // with interval != 0: the figures of each interval
+  std::string stats_json;                // the hw/ statistics registry
 };
 
 // Renders the image's frame. Throws std::runtime_error for a bad configuration or image, and when
