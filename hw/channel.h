@@ -53,9 +53,8 @@ class ChannelBase {
   std::uint64_t front_ready_cycle() const { return count_ > 0 ? ready_at_[head_] : kNever; }
 
   bool can_push() const { return count_ + pushes_ < capacity_ && pushes_ < width_; }
-  bool can_pop() const {
-    return pops_ < count_ && pops_ < width_ && ready_at_[slot(pops_)] <= *now_;
-  }
+  // (The hottest test of a model: one compare against a cached cycle, see pop_ready_.)
+  bool can_pop() const { return pop_ready_ <= *now_; }
 
   // Applies this cycle's pushes and pops (waking the declared consumer when pushed items become
   // visible and the declared producer when a pop frees room); returns how many there were.
@@ -66,10 +65,7 @@ class ChannelBase {
   std::uint64_t total_pushes() const;
 
  protected:
-  int slot(int k) const {
-    const int s = head_ + k;
-    return s >= capacity_ ? s - capacity_ : s;
-  }
+  int slot(int k) const { return (head_ + k) & mask_; }
   // Checks and books a push, returns its slot.
   int reserve_push() {
     if (!can_push()) misuse("push while !can_push() (full, or port width used up)");
@@ -84,6 +80,9 @@ class ChannelBase {
     if (!can_pop()) misuse("pop while !can_pop() (empty, not yet visible, or width used up)");
     const int s = slot(pops_);
     ++pops_;
+    // The next item, if committed and visible; a slot past the committed items is empty (kNever)
+    // or holds an item pushed in this cycle (visible later), so no count test is needed.
+    pop_ready_ = pops_ < width_ ? ready_at_[static_cast<std::size_t>(slot(pops_))] : kNever;
     mark_dirty();
     return s;
   }
@@ -98,16 +97,27 @@ class ChannelBase {
     }
   }
   [[noreturn, gnu::cold, gnu::noinline]] void misuse(const char* what) const;
+  inline int commit_now();  // commit(), inlined into the kernel's cycle (defined in kernel.cpp)
 
   std::string name_;
   int capacity_, latency_, width_;
   const std::uint64_t* now_;
   std::vector<ChannelBase*>* dirty_list_;
+  // Per slot: the cycle its item becomes poppable; kNever for an empty slot. Slots are a power of
+  // two (>= capacity, which alone limits the occupancy) so that a slot is an index mask.
   std::vector<std::uint64_t> ready_at_;
+  int mask_ = 0;
   int head_ = 0, count_ = 0, pushes_ = 0, pops_ = 0;
+  // The cycle from which can_pop() holds: the next item's ready cycle, kNever when there is none
+  // or the port width is used up. Kept on pop and commit.
+  std::uint64_t pop_ready_ = kNever;
   bool dirty_ = false;
   Module* producer_ = nullptr;  // declared ends (Module::produces/consumes); null: not declared
   Module* consumer_ = nullptr;
+  // Where commit() posts wake-ups: the kernel's per-module wake cycles, at the declared ends'
+  // slots (slot 0 is a sink for undeclared ends).
+  std::vector<std::uint64_t>* wakes_;
+  std::size_t producer_slot_ = 0, consumer_slot_ = 0;
   // Statistics (owned by the kernel's registry).
   Counter* pushes_stat_ = nullptr;
   Counter* max_occupancy_stat_ = nullptr;
@@ -125,7 +135,7 @@ class Channel : public ChannelBase {
   // capacity >= 1, latency >= 1, width >= 1, else std::logic_error.
   Channel(Kernel& kernel, std::string name, int capacity, int latency = 1, int width = 1)
       : ChannelBase(kernel, std::move(name), capacity, latency, width),
-        items_(static_cast<std::size_t>(capacity)) {}
+        items_(static_cast<std::size_t>(mask_) + 1) {}
 
   void push(T item) { items_[static_cast<std::size_t>(reserve_push())] = std::move(item); }
   const T& peek() const { return items_[static_cast<std::size_t>(front_slot())]; }

@@ -3,6 +3,7 @@
 #include "hw/kernel.h"
 
 #include <algorithm>
+#include <bit>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -19,14 +20,19 @@ ChannelBase::ChannelBase(Kernel& kernel, std::string name, int capacity, int lat
       latency_(latency),
       width_(width),
       now_(&kernel.cycle_),
-      dirty_list_(&kernel.dirty_) {
+      dirty_list_(&kernel.dirty_),
+      wakes_(&kernel.wake_) {
   if (capacity < 1 || latency < 1 || width < 1) {
     throw std::logic_error("channel '" + name_ +
                            "': capacity, latency and width must be >= 1 (got " +
                            std::to_string(capacity) + ", " + std::to_string(latency) + ", " +
                            std::to_string(width) + ")");
   }
-  ready_at_.assign(static_cast<std::size_t>(capacity), 0);
+  std::size_t slots = 1;
+  while (slots < static_cast<std::size_t>(capacity))
+    slots *= 2;
+  ready_at_.assign(slots, kNever);
+  mask_ = static_cast<int>(slots - 1);
   last_change_ = kernel.cycle_;
   kernel.add_channel(this);
 }
@@ -35,27 +41,43 @@ void ChannelBase::misuse(const char* what) const {
   throw std::logic_error("channel '" + name_ + "' at cycle " + std::to_string(*now_) + ": " + what);
 }
 
-int ChannelBase::commit() {
-  const int moved = pushes_ + pops_;
-  if (pushes_ != pops_) {
-    // The old occupancy held from last_change_ through this cycle.
-    occupancy_area_ += static_cast<std::uint64_t>(count_) * (*now_ + 1 - last_change_);
-    last_change_ = *now_ + 1;
+// Straight-line on purpose (every moving channel commits every cycle it moves), and inlined into
+// the kernel's cycle.
+[[gnu::always_inline]] inline int ChannelBase::commit_now() {
+  const int pushes = pushes_, pops = pops_;
+  const std::uint64_t now = *now_;
+  // The old occupancy held from last_change_ through this cycle (also when it does not change:
+  // the integral is the same either way, and no branch is taken).
+  occupancy_area_ += static_cast<std::uint64_t>(count_) * (now + 1 - last_change_);
+  last_change_ = now + 1;
+  // An empty slot is never poppable (the popped ones kept their cycle until now for valid()).
+  if (width_ == 1) {
+    std::uint64_t& front = ready_at_[static_cast<std::size_t>(head_)];
+    front = pops != 0 ? kNever : front;
+  } else {
+    for (int k = 0; k < pops; ++k)
+      ready_at_[static_cast<std::size_t>(slot(k))] = kNever;
   }
-  head_ = slot(pops_);
-  count_ += pushes_ - pops_;
-  *pushes_stat_ += static_cast<std::uint64_t>(pushes_);
+  head_ = slot(pops);
+  count_ += pushes - pops;
+  pop_ready_ = ready_at_[static_cast<std::size_t>(head_)];  // kNever when empty
+  pushes_stat_->value += static_cast<std::uint64_t>(pushes);
   max_occupancy_stat_->set_max(static_cast<std::uint64_t>(count_));
   // Event scheduling: the items pushed now become visible after the latency; the slots popped now
   // are free for the producer next cycle.
-  if (pushes_ != 0 && consumer_ != nullptr)
-    consumer_->wake_at_ =
-        std::min(consumer_->wake_at_, *now_ + static_cast<std::uint64_t>(latency_));
-  if (pops_ != 0 && producer_ != nullptr)
-    producer_->wake_at_ = std::min(producer_->wake_at_, *now_ + 1);
+  std::uint64_t* wake = wakes_->data();
+  const std::uint64_t consumer_at =
+      pushes != 0 ? now + static_cast<std::uint64_t>(latency_) : kNever;
+  const std::uint64_t producer_at = pops != 0 ? now + 1 : kNever;
+  wake[consumer_slot_] = std::min(wake[consumer_slot_], consumer_at);
+  wake[producer_slot_] = std::min(wake[producer_slot_], producer_at);
   pushes_ = pops_ = 0;
   dirty_ = false;
-  return moved;
+  return pushes + pops;
+}
+
+int ChannelBase::commit() {
+  return commit_now();
 }
 
 std::uint64_t ChannelBase::total_pushes() const {
@@ -79,6 +101,7 @@ void Module::consumes(ChannelBase& c) {
                            "' and '" + name_ + "'");
   if (c.consumer_ == this) return;
   c.consumer_ = this;
+  c.consumer_slot_ = slot_;
   inputs_.push_back(&c);
 }
 
@@ -87,6 +110,7 @@ void Module::produces(ChannelBase& c) {
     throw std::logic_error("channel '" + c.name() + "': produced by both '" + c.producer_->name() +
                            "' and '" + name_ + "'");
   c.producer_ = this;
+  c.producer_slot_ = slot_;
 }
 
 // ---- Kernel -------------------------------------------------------------------------------------
@@ -102,7 +126,8 @@ void Kernel::add_module(Module* m) {
   m->stall_stat_ = &stats_.counter(m->name() + ".stall_cycles", "cycles",
                                    "cycles in which the module had work but was blocked");
   m->accounted_ = cycle_;
-  m->wake_at_ = cycle_;
+  m->slot_ = wake_.size();
+  wake_.push_back(cycle_);
   modules_.push_back(m);
   order_.push_back(m);
   awake_.resize(modules_.size());
@@ -130,8 +155,8 @@ int Kernel::step() {
 }
 
 void Kernel::wake_all() {
-  for (Module* m : modules_)
-    m->wake_at_ = std::min(m->wake_at_, cycle_);
+  for (std::uint64_t& w : wake_)
+    w = std::min(w, cycle_);
 }
 
 // Counts the cycles a module was not evaluated in (asleep, or jumped over by the idle skip) as
@@ -153,36 +178,59 @@ int Kernel::step_cycle() {
   if (config_.shuffle_seed != 0) std::shuffle(order_.begin(), order_.end(), rng_);
   // Without idle skipping every module is due every cycle (the reference for the figures).
   const std::uint64_t due = config_.idle_skip ? cycle_ : kNever;
+  const std::uint64_t next = cycle_ + 1;
+  std::uint64_t* const wake = wake_.data();
   int progress = 0;
-  Module** const evaluated = awake_.data();
-  std::size_t n = 0;
-  for (Module* m : order_) {
-    if (m->wake_at_ > due) continue;  // asleep: this cycle would repeat its last one
+  Module** const busy = awake_.data();  // the modules to commit: those that made progress
+  std::size_t busy_count = 0, evaluated = 0;
+  // Evaluates one module and settles its cycle at once: statistics, and its next wake cycle (an
+  // idle module's state and committed inputs are final for this cycle: it staged nothing, and
+  // other modules' pushes are not visible before their commit, which may only lower the wake).
+  auto evaluate = [&](Module* m) {
     if (m->accounted_ != cycle_) account(m);
     m->stalled_ = false;
     const int p = m->evaluate();
     m->last_progress_ = p;
-    m->accounted_ = cycle_ + 1;
+    m->accounted_ = next;
+    m->stall_stat_->value += m->stalled_;
     progress += p;
-    evaluated[n++] = m;
+    ++evaluated;
+    if (p > 0) {
+      ++m->busy_stat_->value;
+      wake[m->slot_] = next;
+      busy[busy_count++] = m;
+    } else {
+      wake[m->slot_] = m->sleeps_ ? idle_wakeup(*m) : next;
+    }
+  };
+  if (config_.shuffle_seed != 0) {
+    for (Module* m : order_)
+      if (wake[m->slot_] <= due) evaluate(m);  // else asleep: it would repeat its last cycle
+  } else {
+    // Registration order: the due modules of each group of 64 as a bit mask, taken before any of
+    // them is evaluated (no branch per sleeping module).
+    const std::size_t count = modules_.size();
+    for (std::size_t base = 0; base < count; base += 64) {
+      const std::size_t end = std::min(count, base + 64);
+      std::uint64_t mask = 0;
+      for (std::size_t i = base; i < end; ++i)
+        mask |= static_cast<std::uint64_t>(wake[i + 1] <= due) << (i - base);
+      while (mask != 0) {
+        evaluate(modules_[base + static_cast<std::size_t>(std::countr_zero(mask))]);
+        mask &= mask - 1;
+      }
+    }
   }
-  evaluations_ += n;
+  evaluations_ += evaluated;
   ++evaluated_;
   if (tracer_) tracer_->sample(cycle_, modules_, channels_);
-  for (std::size_t i = 0; i < n; ++i) {
-    Module* m = evaluated[i];
-    if (m->last_progress_ > 0) {
-      m->commit();  // an idle module staged nothing (module.h: progress 0 = nothing changed)
-      ++m->busy_stat_->value;
-      m->wake_at_ = cycle_ + 1;
-    } else {
-      m->wake_at_ = m->sleeps_ ? idle_wakeup(*m) : cycle_ + 1;
-    }
-    m->stall_stat_->value += m->stalled_;
-  }
+  // An idle module staged nothing (module.h: progress 0 = nothing changed): only the others
+  // commit, after every evaluation (a module may read another's committed register).
+  for (std::size_t i = 0; i < busy_count; ++i)
+    busy[i]->commit();
   int activity = 0;
   for (ChannelBase* c : dirty_)
-    activity += c->commit();  // wakes the declared ends of the channels that moved
+    activity += c->commit_now();  // wakes the declared ends of the channels that moved
   dirty_.clear();
   const int total = progress + activity;
   ++cycle_;
@@ -251,7 +299,7 @@ RunResult Kernel::run_cycles(const std::function<bool()>& done, std::uint64_t ma
     // Idle cycle: jump to the earliest cycle where anything (or anything we report) can change.
     std::uint64_t target = std::min(next_event(), limit);
     for (const Module* m : modules_)  // a sleeper's pending wake (next_event covers the rest)
-      if (m->sleeps_) target = std::min(target, std::max(m->wake_at_, cycle_));
+      if (m->sleeps_) target = std::min(target, std::max(wake_[m->slot_], cycle_));
     if (wd != 0) target = std::min(target, progress_mark_ + wd);
     const std::uint64_t period = config_.time_series_period;
     if (period != 0) target = std::min(target, (cycle_ / period + 1) * period);

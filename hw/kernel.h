@@ -128,6 +128,9 @@ class Kernel {
   std::vector<Module*> modules_;
   std::vector<Module*> order_;
   std::vector<Module*> awake_;  // the modules evaluated in the current cycle
+  // Per module (at Module::slot_, from 1; slot 0 takes the wake-ups of undeclared channel ends):
+  // the earliest cycle it must be evaluated in. Lowered by channel commits, set after evaluation.
+  std::vector<std::uint64_t> wake_{kNever};
   std::vector<ChannelBase*> channels_;
   std::vector<ChannelBase*> dirty_;
   std::mt19937_64 rng_;

@@ -85,9 +85,10 @@ class Module {
   int last_progress_ = 0;
   bool stalled_ = false;
   bool sleeps_ = false;
-  // Event scheduling: evaluated in cycle c only if wake_at_ <= c; cycles before accounted_ have
-  // their busy/stall statistics and skipped() counted (the rest are counted lazily on waking).
-  std::uint64_t wake_at_ = 0;
+  // Event scheduling: evaluated in cycle c only if the kernel's wake cycle at slot_ is <= c;
+  // cycles before accounted_ have their busy/stall statistics and skipped() counted (the rest are
+  // counted lazily on waking).
+  std::size_t slot_ = 0;
   std::uint64_t accounted_ = 0;
   std::vector<ChannelBase*> inputs_;  // consumed channels: their front items wake the module
   Counter* busy_stat_ = nullptr;

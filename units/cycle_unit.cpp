@@ -20,8 +20,10 @@ CycleUnit::CycleUnit(hw::Kernel& kernel, std::string name, UnitId id, ThreadTabl
   // Event scheduling: a unit depends on its paths, its cache's channels and its pipeline timer.
   sleep_when_idle();
   if (cache_ != nullptr) {
-    produces(cache_->requests());
-    consumes(cache_->responses());
+    cache_requests_ = &cache_->requests();
+    cache_responses_ = &cache_->responses();
+    produces(*cache_requests_);
+    consumes(*cache_responses_);
   }
   issued_ = &stats().counter(this->name() + ".issue_cycles", "cycles",
                              "cycles in which the unit issued a step (its usage)");
@@ -29,12 +31,15 @@ CycleUnit::CycleUnit(hw::Kernel& kernel, std::string name, UnitId id, ThreadTabl
       &stats().counter(this->name() + ".requests", "requests", "thread-program requests served");
 }
 
+// Each step is called only when it has something to do (the tests are what the step would test
+// first), in the script's order.
 int CycleUnit::evaluate() {
-  int progress = deliver();
-  progress += issue();
-  progress += receive();
-  progress += accept();
-  progress += extra();
+  int progress = 0;
+  if (deliver_at_ <= now()) progress += deliver();
+  if (steps_left_ != 0 || chained_ || !ready_.empty()) progress += issue();
+  if (cache_responses_ != nullptr && cache_responses_->can_pop()) progress += receive();
+  if (fetching_ || input_waiting()) progress += accept();
+  if (has_extra_) progress += extra();
   if (progress == 0 && inside_ > 0) stall();  // threads inside, all waiting for memory
   return progress;
 }
@@ -63,6 +68,7 @@ int CycleUnit::deliver() {
     --inside_;
     ++moved;
   }
+  deliver_at_ = pipeline_.empty() ? hw::kNever : pipeline_.front().done_at;
   return moved;
 }
 
@@ -87,7 +93,9 @@ int CycleUnit::issue() {
       chained_ = true;
       chain_thread_ = t;
     } else {
-      pipeline_.push_back({now() + static_cast<std::uint64_t>(steps_left_ - 1 + depth_), t});
+      const std::uint64_t done_at = now() + static_cast<std::uint64_t>(steps_left_ - 1 + depth_);
+      if (pipeline_.empty()) deliver_at_ = done_at;  // later entries are due no earlier
+      pipeline_.push_back({done_at, t});
     }
   }
   --steps_left_;
@@ -96,8 +104,8 @@ int CycleUnit::issue() {
 }
 
 int CycleUnit::receive() {
-  if (cache_ == nullptr || !cache_->responses().can_pop()) return 0;
-  const memif::CacheResponse r = cache_->responses().pop();
+  if (cache_responses_ == nullptr || !cache_responses_->can_pop()) return 0;
+  const memif::CacheResponse r = cache_responses_->pop();
   const ThreadToken t = r.label.tag;
   if (--waiting_[t] == 0) {
     --waiting_threads_;
@@ -130,11 +138,11 @@ int CycleUnit::accept() {
     ++waiting_threads_;
   }
   // One cache request per cycle (a matrix's rows go out over consecutive cycles, D32).
-  if (!cache_->requests().can_push()) {
+  if (!cache_requests_->can_push()) {
     stall();
     return 0;
   }
-  cache_->requests().push(
+  cache_requests_->push(
       {fetch_next_, {static_cast<std::uint16_t>(unit_index(id_)), fetch_thread_}});
   ++fetch_next_;
   if (--fetch_left_ == 0) fetching_ = false;
@@ -144,8 +152,8 @@ int CycleUnit::accept() {
 std::uint64_t CycleUnit::next_wakeup(std::uint64_t now) const {
   if (steps_left_ > 0 || chained_ || !ready_.empty() || fetching_) return now + 1;
   std::uint64_t t = hw::kNever;
-  if (!pipeline_.empty()) t = std::max(now + 1, pipeline_.front().done_at);
-  t = std::min(t, extra_wakeup(now));
+  if (!pipeline_.empty()) t = std::max(now + 1, deliver_at_);
+  if (has_extra_) t = std::min(t, extra_wakeup(now));
   return t;
 }
 

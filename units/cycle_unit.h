@@ -113,7 +113,8 @@ class CycleUnit : public hw::Module {
   virtual bool chains(const Request& /*done*/, const Request& /*next*/) const { return false; }
   // Called when a thread's request is `kDone` after this unit (only the RGS frees threads).
   virtual void retire(ThreadToken /*thread*/) {}
-  // Extra work of the cycle after the shared steps (the RGS admits packets here).
+  // Extra work of the cycle after the shared steps (the RGS admits packets here; a unit that
+  // overrides it sets has_extra_).
   virtual int extra() { return 0; }
   virtual std::uint64_t extra_wakeup(std::uint64_t /*now*/) const { return hw::kNever; }
 
@@ -126,15 +127,25 @@ class CycleUnit : public hw::Module {
   ThreadTable& threads_;
   std::array<ThreadPath*, kUnitCount> outputs_{};
   int inside_ = 0;
+  bool has_extra_ = false;
 
  private:
   struct InFlight {
     std::uint64_t done_at;
     ThreadToken thread;
   };
+  // Whether a thread waits on an input path (accept() has one to take).
+  bool input_waiting() const {
+    for (const ThreadPath* p : inputs_)
+      if (p->can_pop()) return true;
+    return false;
+  }
+
   UnitId id_;
   int depth_;
   memif::Cache* cache_;
+  hw::Channel<memif::CacheRequest>* cache_requests_ = nullptr;
+  hw::Channel<memif::CacheResponse>* cache_responses_ = nullptr;
   std::vector<ThreadPath*> inputs_;
   // Fetch stage: the thread whose cache requests are being sent.
   bool fetching_ = false;
@@ -149,6 +160,7 @@ class CycleUnit : public hw::Module {
   bool chained_ = false;
   ThreadToken chain_thread_ = 0;
   Ring<InFlight> pipeline_;
+  std::uint64_t deliver_at_ = hw::kNever;  // the pipeline's front done_at, kNever when empty
   hw::Counter* issued_;
   hw::Counter* served_;
 };

@@ -9,6 +9,7 @@ RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth)
     : CycleUnit(k, std::move(name), UnitId::kRgs, t, depth, nullptr),
       free_list_(t.size()),
       free_(t.size()) {
+  has_extra_ = true;
   for (int i = 0; i < t.size(); ++i)
     free_list_.push_back(static_cast<ThreadToken>(i));
   retired_ = &stats().counter(this->name() + ".packets_retired", "packets",
