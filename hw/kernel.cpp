@@ -126,8 +126,11 @@ void Kernel::add_module(Module* m) {
   m->stall_stat_ = &stats_.counter(m->name() + ".stall_cycles", "cycles",
                                    "cycles in which the module had work but was blocked");
   m->accounted_ = cycle_;
-  m->slot_ = wake_.size();
-  wake_.push_back(cycle_);
+  // Slots 1.. in registration order, padded with kNever to a multiple of 8 (the due scan).
+  m->slot_ = modules_.size() + 1;
+  const std::size_t padded = 1 + (m->slot_ + 7) / 8 * 8;
+  if (wake_.size() < padded) wake_.resize(padded, kNever);
+  wake_[m->slot_] = cycle_;
   modules_.push_back(m);
   order_.push_back(m);
   awake_.resize(modules_.size());
@@ -155,8 +158,8 @@ int Kernel::step() {
 }
 
 void Kernel::wake_all() {
-  for (std::uint64_t& w : wake_)
-    w = std::min(w, cycle_);
+  for (const Module* m : modules_)
+    wake_[m->slot_] = std::min(wake_[m->slot_], cycle_);
 }
 
 // Counts the cycles a module was not evaluated in (asleep, or jumped over by the idle skip) as
@@ -165,7 +168,7 @@ void Kernel::account(Module* m) {
   const std::uint64_t n = cycle_ - m->accounted_;
   if (n == 0) return;
   if (m->stalled_) m->stall_stat_->value += n;
-  m->skipped(n);
+  if (!m->skipped_is_noop_) m->skipped(n);
   m->accounted_ = cycle_;
 }
 
@@ -213,8 +216,14 @@ int Kernel::step_cycle() {
     for (std::size_t base = 0; base < count; base += 64) {
       const std::size_t end = std::min(count, base + 64);
       std::uint64_t mask = 0;
-      for (std::size_t i = base; i < end; ++i)
-        mask |= static_cast<std::uint64_t>(wake[i + 1] <= due) << (i - base);
+      for (std::size_t i = base; i < end; i += 8) {  // 8 at a time over the kNever padding
+        const std::uint64_t* w = wake + 1 + i;
+        std::uint64_t m8 = 0;
+        for (std::size_t j = 0; j < 8; ++j)
+          m8 |= static_cast<std::uint64_t>(w[j] <= due) << j;
+        mask |= m8 << (i - base);
+      }
+      if (end - base < 64) mask &= (std::uint64_t{1} << (end - base)) - 1;  // not the padding
       while (mask != 0) {
         evaluate(modules_[base + static_cast<std::size_t>(std::countr_zero(mask))]);
         mask &= mask - 1;

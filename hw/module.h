@@ -47,7 +47,8 @@ class Module {
   // cycles would each have repeated the last one exactly (progress 0). A module that counts
   // something per cycle in evaluate() adds it here, so statistics do not depend on skipping.
   // busy/stall cycles are kept by the kernel already.
-  virtual void skipped(std::uint64_t /*cycles*/) {}
+  // (The default does nothing and tells the kernel so: it is then not called again.)
+  virtual void skipped(std::uint64_t /*cycles*/) { skipped_is_noop_ = true; }
 
   // Kernel-kept per-module statistics: <name>.busy_cycles, <name>.stall_cycles.
   bool busy() const { return last_progress_ > 0; }
@@ -85,6 +86,7 @@ class Module {
   int last_progress_ = 0;
   bool stalled_ = false;
   bool sleeps_ = false;
+  bool skipped_is_noop_ = false;  // set by the default skipped(): the kernel stops calling it
   // Event scheduling: evaluated in cycle c only if the kernel's wake cycle at slot_ is <= c;
   // cycles before accounted_ have their busy/stall statistics and skipped() counted (the rest are
   // counted lazily on waking).

@@ -99,10 +99,11 @@ bool Cache::idle() const {
 int Cache::evaluate() {
   // A fill is written into its line and may answer its first waiting request in the same cycle
   // (bypass); that delivery takes the response port, so a hit waits a cycle.
-  int progress = accept_fill();
-  const int delivered = deliver();
+  // (Each stage is entered only when it has something to do.)
+  int progress = fills_.can_pop() ? accept_fill() : 0;
+  const int delivered = filled_.empty() ? 0 : deliver();
   progress += delivered;
-  progress += lookup(delivered == 0);
+  if (requests_.size() != 1 || requests_[0]->can_pop()) progress += lookup(delivered == 0);
   return progress;
 }
 

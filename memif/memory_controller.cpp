@@ -126,6 +126,7 @@ int MemoryController::evaluate() {
 
 // Completed reads leave towards their port, oldest due first; one per port and cycle.
 int MemoryController::retire_responses() {
+  if (inflight_ == 0) return 0;
   int moved = 0;
   for (;;) {
     int best = -1;
@@ -145,6 +146,7 @@ int MemoryController::retire_responses() {
     ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.push(
         bank.inflight.front().resp);
     bank.inflight.pop_front();
+    --inflight_;
     ++moved;
   }
   for (const Bank& bank : banks_) {
@@ -157,6 +159,7 @@ void MemoryController::start(int b, std::uint64_t when) {
   Bank& bank = banks_[static_cast<std::size_t>(b)];
   const Queued q = bank.queue.front();
   bank.queue.pop_front();
+  --queued_;
   const MemRequest& r = q.req;
   bank.free_at = when + r.words;
   *bank.words += r.words;
@@ -178,9 +181,11 @@ void MemoryController::start(int b, std::uint64_t when) {
   for (int i = 0; i < r.words; ++i)
     f.resp.words[static_cast<std::size_t>(i)] = mem[r.offset + static_cast<std::uint32_t>(i)];
   bank.inflight.push_back(f);
+  ++inflight_;
 }
 
 int MemoryController::issue() {
+  if (queued_ == 0) return 0;
   int started = 0;
   for (Path& path : paths_) {
     if (path.banks.empty() || path.free_at > now()) continue;
@@ -259,6 +264,7 @@ int MemoryController::accept_requests() {
       continue;
     }
     bank.queue.push_back({in.pop(), static_cast<int>(p), seq_++});
+    ++queued_;
     bank.max_queue->set_max(bank.queue.size());
     ++accepted;
   }

@@ -127,6 +127,7 @@ class MemoryController : public hw::Module {
   std::vector<Path> paths_;
   std::vector<Client> clients_;
   std::uint64_t seq_ = 0;
+  int queued_ = 0, inflight_ = 0;  // over all banks: the stages skip their loops when 0
   int inflight_limit_;
 };
 

@@ -60,7 +60,8 @@ class RaySource : public CycleUnit {
  public:
   RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth);
 
-  bool finished() const { return next_packet_ == threads_.packets() && free_ == threads_.size(); }
+  // (Checked before every cycle: no call.)
+  bool finished() const { return next_packet_ == packets_ && free_ == threads_.size(); }
   int packets_started() const { return next_packet_; }
   std::uint64_t packets_retired() const { return retired_->value; }
 
@@ -74,6 +75,7 @@ class RaySource : public CycleUnit {
  private:
   Ring<ThreadToken> free_list_;
   int free_;
+  int packets_;
   int next_packet_ = 0;
   hw::Counter* retired_;
   hw::Counter* admitted_;

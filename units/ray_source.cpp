@@ -8,7 +8,8 @@ namespace saarcor::units {
 RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth)
     : CycleUnit(k, std::move(name), UnitId::kRgs, t, depth, nullptr),
       free_list_(t.size()),
-      free_(t.size()) {
+      free_(t.size()),
+      packets_(t.packets()) {
   has_extra_ = true;
   for (int i = 0; i < t.size(); ++i)
     free_list_.push_back(static_cast<ThreadToken>(i));
@@ -34,7 +35,7 @@ void RaySource::retire(ThreadToken thread) {
 
 // Admission: the next primary packet goes to the oldest free thread, on path a.
 int RaySource::extra() {
-  if (free_list_.empty() || next_packet_ >= threads_.packets()) return 0;
+  if (free_list_.empty() || next_packet_ >= packets_) return 0;
   ThreadPath* a = outputs_[unit_index(UnitId::kTransformation)];
   if (!a->can_push()) return 0;
   const ThreadToken t = free_list_.front();
@@ -47,7 +48,7 @@ int RaySource::extra() {
 }
 
 std::uint64_t RaySource::extra_wakeup(std::uint64_t now) const {
-  return free_list_.empty() || next_packet_ >= threads_.packets() ? hw::kNever : now + 1;
+  return free_list_.empty() || next_packet_ >= packets_ ? hw::kNever : now + 1;
 }
 
 }  // namespace saarcor::units
