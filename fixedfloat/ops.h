@@ -469,6 +469,40 @@ inline std::uint32_t div(std::uint32_t a, std::uint32_t b, const Rounder<E, M>& 
   return div_rest<E, M>(a, b, r.mode);
 }
 
+// Division by a divisor whose binary64 reciprocal inv_b = 1 / |b| is known (b normal; computed once
+// for many dividends, as the traversal unit's d = (split - O) / D with D fixed per level): the
+// quotient's magnitude as the binary64 product |a| * inv_b, rounded as in div. For nearest-even
+// this is the correctly rounded quotient whenever it is accepted: with A, B the integer
+// significands (M+1 bits) the exact quotient A/B is a nonzero integer over B * 2^(M+1) (or 2^(M+2))
+// away from every rounding midpoint (a midpoint has M+2 significant bits ending in 1, and A * 2^k =
+// B * odd is impossible for B < 2^(M+1)), i.e. more than 2^-(2M+3) relative, while |a| * inv_b is
+// within 2^-52 (two binary64 roundings) of A/B. 2^-52 < 2^-49 = 2^-(2*23+3), so for every supported
+// format the product lies on the same side of every midpoint as the exact quotient and rounds to
+// the same encoding (the range limits, overflow to infinity and the flush threshold included,
+// since they are decided by the rounded value). Truncation (rounded_span = 0), operands that are
+// not normal and quotients outside the range take the exact div_rest. Tested against op_div in
+// fixedfloat/div_reciprocal_test.cpp.
+template <int E, int M>
+inline double reciprocal(std::uint32_t b) {
+  return 1.0 / std::bit_cast<double>(magnitude_bits<E, M>(b));
+}
+template <int E, int M>
+inline std::uint32_t div_reciprocal(std::uint32_t a, std::uint32_t b, double inv_b,
+                                    const Rounder<E, M>& r) {
+  using L = Layout<E, M>;
+  constexpr std::uint64_t kLow = std::uint64_t{1} << M;
+  constexpr std::uint64_t kRound = L::kHalf - 1u - L::kRebias - (kLow << L::kShift);
+  if (both_normal<E, M>(a, b)) [[likely]] {
+    const std::uint32_t sign = (a ^ b) & L::kSign;
+    const double x = std::bit_cast<double>(magnitude_bits<E, M>(a));
+    const std::uint64_t t = std::bit_cast<std::uint64_t>(x * inv_b);
+    const std::uint64_t q = (t + kRound + ((t >> L::kShift) & 1u)) >> L::kShift;
+    if (q < r.rounded_span) [[likely]]
+      return static_cast<std::uint32_t>(q + kLow) + sign;
+  }
+  return div_rest<E, M>(a, b, r.mode);
+}
+
 template <int E, int M>
 inline std::uint32_t sqrt(std::uint32_t a, const Rounder<E, M>& r) {
   if (is_normal<E, M>(a) && !(a & Layout<E, M>::kSign)) [[likely]] {
@@ -480,17 +514,36 @@ inline std::uint32_t sqrt(std::uint32_t a, const Rounder<E, M>& r) {
   return slow_sqrt<E, M>(a, r.mode);
 }
 
+// Compares on the encodings, without decoding: the magnitude bits order like the magnitude (for
+// every non-NaN encoding), so sign ? -magnitude : magnitude orders like the value, with -0 and +0
+// both 0. In flush mode a subnormal magnitude reads as 0 first. NaN compares false.
+template <int E, int M>
+inline std::int32_t order_key(std::uint32_t b, Subnormals s) {
+  using L = Layout<E, M>;
+  std::uint32_t mag = b & L::kMag;
+  if (s == Subnormals::kFlush && mag < (1u << M)) mag = 0;
+  const auto k = static_cast<std::int32_t>(mag);
+  return (b & L::kSign) != 0 ? -k : k;
+}
+template <int E, int M>
+inline bool no_nan(std::uint32_t a, std::uint32_t b) {
+  using L = Layout<E, M>;
+  constexpr std::uint32_t kInf = L::kExpMax << M;
+  return ((a & L::kMag) <= kInf) & ((b & L::kMag) <= kInf);
+}
 template <int E, int M>
 inline bool lt(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  return decode<E, M>(a, m.subnormals) < decode<E, M>(b, m.subnormals);
+  return no_nan<E, M>(a, b) & (order_key<E, M>(a, m.subnormals) < order_key<E, M>(b, m.subnormals));
 }
 template <int E, int M>
 inline bool le(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  return decode<E, M>(a, m.subnormals) <= decode<E, M>(b, m.subnormals);
+  return no_nan<E, M>(a, b) &
+         (order_key<E, M>(a, m.subnormals) <= order_key<E, M>(b, m.subnormals));
 }
 template <int E, int M>
 inline bool eq(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  return decode<E, M>(a, m.subnormals) == decode<E, M>(b, m.subnormals);
+  return no_nan<E, M>(a, b) &
+         (order_key<E, M>(a, m.subnormals) == order_key<E, M>(b, m.subnormals));
 }
 
 // The value a comparator/mux passes on: in flush mode a subnormal operand leaves as signed zero.

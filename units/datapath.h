@@ -4,7 +4,8 @@
 // docs/shading.md section 3), and the slab clip of D29. Each takes the float unit (UnitFp) of the
 // hardware unit that owns the operators, so ops are counted per unit. The functional model and the
 // cycle model call these same functions; nothing here keeps state, so results cannot depend on
-// timing.
+// timing. `fp` is a UnitFp (counts every op) or a RawFp (the thread program, which counts each
+// step's ops in bulk).
 #pragma once
 
 #include <array>
@@ -68,9 +69,9 @@ inline std::uint32_t magnitude_key(F x) {
 // ---- transformation unit (paper 2.3, DESIGN.md 5: 9 mul, 9 add per step) -----------------------
 // One step: per output component r, (m_r0*x + m_r1*y) + (m_r2*z + t_r). A direction step feeds
 // zero as the translation (the adder still runs: -0 + +0 = +0, a real datapath effect).
-template <class F>
-[[gnu::flatten]] inline Vec3<F> transform_step(const UnitFp<F>& fp, const Mat34<F>& m,
-                                               const Vec3<F>& v, bool translate) {
+template <class F, class Fp>
+[[gnu::flatten]] inline Vec3<F> transform_step(const Fp& fp, const Mat34<F>& m, const Vec3<F>& v,
+                                               bool translate) {
   Vec3<F> out;
   for (int r = 0; r < 3; ++r) {
     const F t = translate ? m[r][3] : F::zero();
@@ -81,8 +82,8 @@ template <class F>
 }
 
 // The dot product as one row of a zero-translation step: (a.x*b.x + a.y*b.y) + (a.z*b.z + 0).
-template <class F>
-[[gnu::flatten]] inline F dot_step(const UnitFp<F>& fp, const Vec3<F>& a, const Vec3<F>& b) {
+template <class F, class Fp>
+[[gnu::flatten]] inline F dot_step(const Fp& fp, const Vec3<F>& a, const Vec3<F>& b) {
   return fp.add(fp.add(fp.mul(a[0], b[0]), fp.mul(a[1], b[1])),
                 fp.add(fp.mul(a[2], b[2]), F::zero()));
 }
@@ -102,9 +103,10 @@ struct TraversalLane {
   F far_tn{};   // far child's interval start (end stays tf)
 };
 
-template <class F>
-[[gnu::flatten]] inline TraversalLane<F> traversal_lane(const UnitFp<F>& fp, F split, F o_axis,
-                                                        F d_axis, F tn, F tf) {
+// d_axis: the direction component, or its Divisor (the same quotient, see units/unit_fp.h).
+template <class F, class Fp, class Den>
+[[gnu::flatten]] inline TraversalLane<F> traversal_lane(const Fp& fp, F split, F o_axis, Den d_axis,
+                                                        F tn, F tf) {
   const F d = fp.div(fp.sub(split, o_axis), d_axis);
   const bool before = fp.lt(d, tn);  // plane before the segment: far side only
   const bool after = fp.lt(tf, d);   // plane beyond the segment: near side only
@@ -119,8 +121,8 @@ template <class F>
 
 // Early termination at node entry (1 cmp): a ray leaves a node whose segment starts beyond its
 // closest hit. Equal values stay (a later triangle may tie in t, docs/shading.md section 3).
-template <class F>
-inline bool terminated(const UnitFp<F>& fp, F t_best, F tn) {
+template <class F, class Fp>
+inline bool terminated(const Fp& fp, F t_best, F tn) {
   return fp.lt(t_best, tn);
 }
 
@@ -129,8 +131,8 @@ inline bool terminated(const UnitFp<F>& fp, F t_best, F tn) {
 // The face is the entry face when the direction's sign bit is clear for `lo`, set for `hi`. The
 // comparator-multiplexer max/min keep the old bound on NaN (origin on a parallel face).
 // 1 add, 1 div, 1 cmp.
-template <class F>
-[[gnu::flatten]] inline void clip_face(const UnitFp<F>& fp, F plane, F o_axis, F d_axis, bool entry,
+template <class F, class Fp, class Den>
+[[gnu::flatten]] inline void clip_face(const Fp& fp, F plane, F o_axis, Den d_axis, bool entry,
                                        F& tn, F& tf) {
   const F t = fp.div(fp.sub(plane, o_axis), d_axis);
   if (entry)
@@ -147,8 +149,8 @@ struct Candidate {
 };
 
 // t = -O'z / D'z, u = O'x + t*D'x, v = O'y + t*D'y; u + v is the third adder.
-template <class F>
-[[gnu::flatten]] inline Candidate<F> intersect_unit_triangle(const UnitFp<F>& fp, const Ray<F>& r) {
+template <class F, class Fp>
+[[gnu::flatten]] inline Candidate<F> intersect_unit_triangle(const Fp& fp, const Ray<F>& r) {
   Candidate<F> c;
   c.c = r.d[2];
   c.t = fp.div(r.o[2].neg(), r.d[2]);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -143,17 +144,22 @@ class PipelineUnits {
       : traversal(mode, &traversal_ops),
         transformation(mode, &transformation_ops),
         intersection(mode, &intersection_ops),
-        rgs(mode, &rgs_ops) {}
+        rgs(mode, &rgs_ops),
+        raw(mode),
+        direct(mode) {}
   PipelineUnits(const PipelineUnits&) = delete;
   PipelineUnits& operator=(const PipelineUnits&) = delete;
 
   ff::OpCounts traversal_ops, transformation_ops, intersection_ops, rgs_ops;
   UnitFp<F> traversal, transformation, intersection, rgs;
+  // The same operators without counters, for the datapath steps the thread program counts in
+  // bulk: every step's op count is fixed by the datapath whatever the mask (D30: a masked lane
+  // fires and its result is discarded), so the counts are added where the step is issued.
+  RawFp<F> raw;
+  RawFp<F, false> direct;  // without the zero shortcuts: the traversal unit's few zeros
 
-  // The ops of a masked lane: the hardware lane fires and its result is discarded (D30), so it
-  // is counted without being computed.
-  static void count_idle(ff::OpCounts& c, std::uint64_t add, std::uint64_t mul, std::uint64_t div,
-                         std::uint64_t cmp) {
+  static void count(ff::OpCounts& c, std::uint64_t add, std::uint64_t mul, std::uint64_t div,
+                    std::uint64_t cmp) {
     c.add += add;
     c.mul += mul;
     c.div += div;
@@ -381,6 +387,9 @@ class ThreadProgram {
     std::uint32_t pixel = memif::kNone;
     std::uint32_t weight = 0;
     Ray<F> world, current, tri;
+    // 1/|D| of the world and the current direction per axis (Divisor): the traversal unit's
+    // divisions by D during a level use them.
+    std::array<double, 3> world_inv{}, inv{};
     F tn{}, tf{};            // segment of the node being visited
     F clip_tn{}, clip_tf{};  // the level's clipped segment (restart of a sign group)
     HitRecord<F> hit;        // hit.t = t_best (starts at the ray's t_max)
@@ -418,7 +427,20 @@ class ThreadProgram {
     return m;
   }
   int transform_steps() const { return shared_origin_ ? p_ + 1 : 2 * p_; }
+  // One ray transformation of the packet: 9 mul and 9 add per step (n+1 or 2n steps, D30/D31).
+  void count_transform() {
+    const auto steps = static_cast<std::uint64_t>(transform_steps());
+    u_.transformation_steps += steps;
+    PipelineUnits<F>::count(u_.transformation_ops, 9 * steps, 9 * steps, 0, 0);
+  }
   Lane& lane(int i) { return lanes_[static_cast<std::size_t>(i)]; }
+  static void set_inverses(std::array<double, 3>& inv, const Vec3<F>& d) {
+    for (int k = 0; k < 3; ++k)
+      inv[static_cast<std::size_t>(k)] = RawFp<F>::divisor(d[k]).inv;
+  }
+  static Divisor<F> divisor(const Lane& l, int axis) {
+    return {l.current.d[axis], l.inv[static_cast<std::size_t>(axis)]};
+  }
   static bool has(std::uint64_t m, int i) { return ((m >> i) & 1u) != 0; }
 
   // ---- packet start (path a) ------------------------------------------------------------------
@@ -440,8 +462,8 @@ class ThreadProgram {
   }
 
   void do_generate() {
-    const auto& fp = u_.transformation;
-    u_.transformation_steps += static_cast<std::uint64_t>(transform_steps());
+    const auto& fp = u_.raw;
+    count_transform();
     const auto& g0 = gen_.lanes[0];
     Vec3<F> shared{};
     if (shared_origin_) shared = transform_step(fp, g0.t, g0.ro, true);
@@ -450,13 +472,13 @@ class ThreadProgram {
       const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
       if (!l.valid) {
         l.world.o = shared;
-        PipelineUnits<F>::count_idle(u_.transformation_ops, shared_origin_ ? 9 : 18,
-                                     shared_origin_ ? 9 : 18, 0, 0);
       } else {
         l.world.o = shared_origin_ ? shared : transform_step(fp, g.t, g.ro, true);
         l.world.d = transform_step(fp, g.t, g.rd, false);
       }
       l.current = l.world;
+      set_inverses(l.world_inv, l.world.d);
+      l.inv = l.world_inv;
       l.hit = HitRecord<F>{};
       if (kind_ == RayKind::kShadow) l.hit.t = shadow_t_max_;
       if (l.valid) ++l.counters.transformations;
@@ -478,12 +500,23 @@ class ThreadProgram {
   void start_level(Level level) {
     level_ = level;
     clip_face_ = 0;
+    // The box the six clip steps read: the scene box, or rows 4-5 of the instance record.
+    if (level == Level::kTop) {
+      box_lo_ = scene_lo_;
+      box_hi_ = scene_hi_;
+    } else {
+      const auto rlo = read_row<F>(image_, instance_row_ + 4);
+      const auto rhi = read_row<F>(image_, instance_row_ + 5);
+      box_lo_ = {rlo[0], rlo[1], rlo[2]};
+      box_hi_ = {rhi[0], rhi[1], rhi[2]};
+    }
     if (level == Level::kTop) {
       clip_mask_ = 0;
       for (int i = 0; i < p_; ++i)
         if (lane(i).valid && !lane(i).done) clip_mask_ |= std::uint64_t{1} << i;
       for (int i = 0; i < p_; ++i) {
         lane(i).current = lane(i).world;
+        lane(i).inv = lane(i).world_inv;
         lane(i).clip_tn = F::zero();
         lane(i).clip_tf = lane(i).hit.t;
       }
@@ -499,32 +532,24 @@ class ThreadProgram {
   }
 
   void do_clip() {
-    const auto& fp = u_.traversal;
+    const auto& fp = u_.direct;
     ++u_.clip_steps;
+    const auto lanes = static_cast<std::uint64_t>(p_);
+    // Per lane 1 add, 1 div, 1 cmp; the last face 1 more cmp (the empty-segment test).
+    PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, clip_face_ == 5 ? 2 * lanes : lanes);
     const int axis = clip_face_ / 2;
     const bool exit_face = (clip_face_ % 2) == 1;
-    std::array<F, 3> lo, hi;
-    if (level_ == Level::kTop) {
-      lo = scene_lo_;
-      hi = scene_hi_;
-    } else {
-      const auto rlo = read_row<F>(image_, instance_row_ + 4);
-      const auto rhi = read_row<F>(image_, instance_row_ + 5);
-      lo = {rlo[0], rlo[1], rlo[2]};
-      hi = {rhi[0], rhi[1], rhi[2]};
-    }
+    const F lo = box_lo_[static_cast<std::size_t>(axis)];
+    const F hi = box_hi_[static_cast<std::size_t>(axis)];
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
-      if (!has(clip_mask_, i)) {
-        PipelineUnits<F>::count_idle(u_.traversal_ops, 1, 0, 1, 1);
-        continue;
-      }
+      if (!has(clip_mask_, i)) continue;
       const bool neg = l.current.d[axis].sign();
       const bool entry = !exit_face;
       // Entry face: lo for a positive direction, hi for a negative one; exit face the other.
-      const F plane = (entry != neg) ? lo[axis] : hi[axis];
+      const F plane = (entry != neg) ? lo : hi;
       F tn = l.clip_tn, tf = l.clip_tf;
-      clip_face(fp, plane, l.current.o[axis], l.current.d[axis], entry, tn, tf);
+      clip_face(fp, plane, l.current.o[axis], divisor(l, axis), entry, tn, tf);
       l.clip_tn = tn;
       l.clip_tf = tf;
     }
@@ -533,10 +558,7 @@ class ThreadProgram {
     std::uint64_t inside = 0;
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
-      if (!has(clip_mask_, i)) {
-        PipelineUnits<F>::count_idle(u_.traversal_ops, 0, 0, 0, 1);
-        continue;
-      }
+      if (!has(clip_mask_, i)) continue;
       if (!fp.lt(l.clip_tf, l.clip_tn)) inside |= std::uint64_t{1} << i;
     }
     // Sign groups: rays with equal direction signs share one front-to-back order (D27). Groups
@@ -577,21 +599,19 @@ class ThreadProgram {
 
   // ---- traversal unit (paths b, f) -----------------------------------------------------------
   void do_traverse() {
-    const auto& fp = u_.traversal;
+    const auto& fp = u_.direct;
     ++u_.traversal_steps;
+    const auto lanes = static_cast<std::uint64_t>(p_);
+    PipelineUnits<F>::count(u_.traversal_ops, 0, 0, 0, lanes);  // termination, 1 cmp per lane
     const memif::KdNode node = image_.node(node_);
     // Early termination at node entry (1 cmp per lane).
     std::uint64_t active = 0;
     for (int i = 0; i < p_; ++i) {
-      const Lane& l = lane(i);
-      if (!has(mask_, i) || l.done) {
-        PipelineUnits<F>::count_idle(u_.traversal_ops, 0, 0, 0, 1);
-        continue;
-      }
-      if (!terminated(fp, l.hit.t, l.tn)) active |= std::uint64_t{1} << i;
+      Lane& l = lane(i);
+      if (!has(mask_, i) || l.done || terminated(fp, l.hit.t, l.tn)) continue;
+      active |= std::uint64_t{1} << i;
+      ++l.counters.traversal_steps;
     }
-    for (int i = 0; i < p_; ++i)
-      if (has(active, i)) ++lane(i).counters.traversal_steps;
     if (active == 0) return pop();
     if (node.leaf) {
       if (node.count == 0) return pop();
@@ -603,29 +623,26 @@ class ThreadProgram {
       return;
     }
     ++u_.inner_steps;
+    PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, 2 * lanes);  // traversal_lane
     const int axis = static_cast<int>(node.axis);
     const F split = F::from_bits(node.split);
     // The group's shared direction sign on this axis picks the near child.
-    bool neg = false;
-    for (int i = 0; i < p_; ++i)
-      if (has(active, i)) {
-        neg = lane(i).current.d[axis].sign();
-        break;
-      }
+    const bool neg = lane(std::countr_zero(active)).current.d[axis].sign();
     std::uint64_t near_mask = 0, far_mask = 0;
-    std::array<F, kMaxPacket> near_tf{}, far_tn{};
+    std::array<F, kMaxPacket> near_tf, far_tn;  // lanes 0..P-1 set below
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
+      const auto k = static_cast<std::size_t>(i);
       if (!has(active, i)) {
-        PipelineUnits<F>::count_idle(u_.traversal_ops, 1, 0, 1, 2);
+        near_tf[k] = far_tn[k] = F::zero();
         continue;
       }
       const TraversalLane<F> r =
-          traversal_lane(fp, split, l.current.o[axis], l.current.d[axis], l.tn, l.tf);
-      if (r.go_near) near_mask |= std::uint64_t{1} << i;
-      if (r.go_far) far_mask |= std::uint64_t{1} << i;
-      near_tf[static_cast<std::size_t>(i)] = r.near_tf;
-      far_tn[static_cast<std::size_t>(i)] = r.far_tn;
+          traversal_lane(fp, split, l.current.o[axis], divisor(l, axis), l.tn, l.tf);
+      near_mask |= std::uint64_t{r.go_near} << i;
+      far_mask |= std::uint64_t{r.go_far} << i;
+      near_tf[k] = r.near_tf;
+      far_tn[k] = r.far_tn;
     }
     const std::uint32_t near_child = neg ? node.child_pair + 1 : node.child_pair;
     const std::uint32_t far_child = neg ? node.child_pair : node.child_pair + 1;
@@ -701,8 +718,10 @@ class ThreadProgram {
       n_groups_ = top_n_groups_;
       group_ = top_group_;
       stack_base_ = top_stack_base_;
-      for (int i = 0; i < p_; ++i)
+      for (int i = 0; i < p_; ++i) {
         lane(i).current = lane(i).world;
+        lane(i).inv = lane(i).world_inv;
+      }
       return list_continue();
     }
     phase_ = kind_ == RayKind::kShadow ? Phase::kShadeShadow : Phase::kShadeSurface;
@@ -748,16 +767,14 @@ class ThreadProgram {
   // ---- transformation unit (path d) -----------------------------------------------------------
   // Transforms `in` of every lane with m (n+1 or 2n steps whatever the mask, D30).
   void transform_lanes(const Mat34<F>& m, Ray<F> Lane::*in, Ray<F> Lane::*out) {
-    const auto& fp = u_.transformation;
-    u_.transformation_steps += static_cast<std::uint64_t>(transform_steps());
+    const auto& fp = u_.raw;
+    count_transform();
     Vec3<F> shared{};
     if (shared_origin_) shared = transform_step(fp, m, (lanes_[0].*in).o, true);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       if (!has(entry_mask_, i)) {
         (l.*out).o = shared;
-        PipelineUnits<F>::count_idle(u_.transformation_ops, shared_origin_ ? 9 : 18,
-                                     shared_origin_ ? 9 : 18, 0, 0);
         continue;
       }
       const Ray<F> src = l.*in;
@@ -770,6 +787,8 @@ class ThreadProgram {
   void do_transform_object() {
     instance_row_ = image_.registers().instance_row_base + memif::kInstanceRows * instance_;
     transform_lanes(read_matrix<F>(image_, instance_row_), &Lane::world, &Lane::current);
+    for (int i = 0; i < p_; ++i)
+      if (has(entry_mask_, i)) set_inverses(lane(i).inv, lane(i).current.d);
     header_ = image_.instance_header(instance_);
     // Enter the bottom level: save the top level's groups and stack base (the top-level stack
     // entries stay below; the bottom level pushes above them, D26).
@@ -790,14 +809,13 @@ class ThreadProgram {
 
   // ---- intersection unit (paths e, f) --------------------------------------------------------
   void do_intersect() {
-    const auto& fp = u_.intersection;
+    const auto& fp = u_.raw;
     ++u_.intersection_packets;
+    const auto lanes = static_cast<std::uint64_t>(p_);
+    PipelineUnits<F>::count(u_.intersection_ops, 3 * lanes, 2 * lanes, lanes, 0);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
-      if (!has(entry_mask_, i)) {
-        PipelineUnits<F>::count_idle(u_.intersection_ops, 3, 2, 1, 0);
-        continue;
-      }
+      if (!has(entry_mask_, i)) continue;
       const Candidate<F> c = intersect_unit_triangle(fp, l.tri);
       ++l.counters.intersections;
       if (!accepts(c, instance_, triangle_, l.hit)) continue;
@@ -1083,6 +1101,7 @@ class ThreadProgram {
   std::uint32_t max_depth_ = 3;
   Mat34<F> cam_{};
   std::array<F, 3> scene_lo_{}, scene_hi_{};
+  std::array<F, 3> box_lo_{}, box_hi_{};  // the current level's box (clip steps)
   F epsilon_{}, shadow_t_max_{};
 
   Phase phase_ = Phase::kDone;
