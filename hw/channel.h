@@ -118,9 +118,13 @@ class ChannelBase {
   // slots (slot 0 is a sink for undeclared ends).
   std::vector<std::uint64_t>* wakes_;
   std::size_t producer_slot_ = 0, consumer_slot_ = 0;
-  // Statistics (owned by the kernel's registry).
+  // Statistics (owned by the kernel's registry; the counts since the last flush_stats() are kept
+  // here, in the line commit() touches anyway).
+  void flush_stats();
   Counter* pushes_stat_ = nullptr;
   Counter* max_occupancy_stat_ = nullptr;
+  std::uint64_t pending_pushes_ = 0;
+  int max_count_ = 0;
   // Occupancy integrated over time, updated lazily on change (idle cycles cost nothing).
   std::uint64_t occupancy_area_ = 0;
   std::uint64_t last_change_ = 0;

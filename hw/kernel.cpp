@@ -61,8 +61,10 @@ void ChannelBase::misuse(const char* what) const {
   head_ = slot(pops);
   count_ += pushes - pops;
   pop_ready_ = ready_at_[static_cast<std::size_t>(head_)];  // kNever when empty
-  pushes_stat_->value += static_cast<std::uint64_t>(pushes);
-  max_occupancy_stat_->set_max(static_cast<std::uint64_t>(count_));
+  // The statistics are kept here and handed to the registry when the kernel brings the
+  // statistics up to date (Kernel::account_all).
+  pending_pushes_ += static_cast<std::uint64_t>(pushes);
+  max_count_ = std::max(max_count_, count_);
   // Event scheduling: the items pushed now become visible after the latency; the slots popped now
   // are free for the producer next cycle.
   std::uint64_t* wake = wakes_->data();
@@ -81,7 +83,13 @@ int ChannelBase::commit() {
 }
 
 std::uint64_t ChannelBase::total_pushes() const {
-  return pushes_stat_->value;
+  return pushes_stat_->value + pending_pushes_;
+}
+
+void ChannelBase::flush_stats() {
+  pushes_stat_->value += pending_pushes_;
+  pending_pushes_ = 0;
+  max_occupancy_stat_->set_max(static_cast<std::uint64_t>(max_count_));
 }
 
 // ---- Module -------------------------------------------------------------------------------------
@@ -175,6 +183,8 @@ void Kernel::account(Module* m) {
 void Kernel::account_all() {
   for (Module* m : modules_)
     account(m);
+  for (ChannelBase* c : channels_)
+    c->flush_stats();
 }
 
 int Kernel::step_cycle() {
@@ -236,7 +246,7 @@ int Kernel::step_cycle() {
   // An idle module staged nothing (module.h: progress 0 = nothing changed): only the others
   // commit, after every evaluation (a module may read another's committed register).
   for (std::size_t i = 0; i < busy_count; ++i)
-    busy[i]->commit();
+    if (!busy[i]->commit_is_noop_) busy[i]->commit();
   int activity = 0;
   for (ChannelBase* c : dirty_)
     activity += c->commit_now();  // wakes the declared ends of the channels that moved

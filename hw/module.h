@@ -35,8 +35,11 @@ class Module {
   // (item moved, register staged with a new value, counter advanced). 0 means "this cycle changed
   // nothing"; the kernel's idle skip and watchdog rely on it being truthful.
   virtual int evaluate() = 0;
-  // Makes staged register writes visible. Called for every module after all evaluate()s.
-  virtual void commit() {}
+  // Makes staged register writes visible. Called after all evaluate()s for every module that
+  // made progress (one that made none staged nothing). (The default does nothing and tells the
+  // kernel so: it is then not called again. The same holds for skipped(); an override must not
+  // call the base version.)
+  virtual void commit() { commit_is_noop_ = true; }
   // One or more lines for the watchdog report: what the module holds and what it waits for.
   virtual std::string dump_state() const { return {}; }
   // Earliest cycle > now at which evaluate() could make progress if no channel changes, given
@@ -47,7 +50,6 @@ class Module {
   // cycles would each have repeated the last one exactly (progress 0). A module that counts
   // something per cycle in evaluate() adds it here, so statistics do not depend on skipping.
   // busy/stall cycles are kept by the kernel already.
-  // (The default does nothing and tells the kernel so: it is then not called again.)
   virtual void skipped(std::uint64_t /*cycles*/) { skipped_is_noop_ = true; }
 
   // Kernel-kept per-module statistics: <name>.busy_cycles, <name>.stall_cycles.
@@ -87,6 +89,7 @@ class Module {
   bool stalled_ = false;
   bool sleeps_ = false;
   bool skipped_is_noop_ = false;  // set by the default skipped(): the kernel stops calling it
+  bool commit_is_noop_ = false;   // set by the default commit(): the kernel stops calling it
   // Event scheduling: evaluated in cycle c only if the kernel's wake cycle at slot_ is <= c;
   // cycles before accounted_ have their busy/stall statistics and skipped() counted (the rest are
   // counted lazily on waking).
