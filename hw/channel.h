@@ -99,35 +99,37 @@ class ChannelBase {
   [[noreturn, gnu::cold, gnu::noinline]] void misuse(const char* what) const;
   inline int commit_now();  // commit(), inlined into the kernel's cycle (defined in kernel.cpp)
 
-  std::string name_;
-  int capacity_, latency_, width_;
+  // Hot fields first (what push, pop and commit touch share the first two cache lines).
+  // The cycle from which can_pop() holds: the next item's ready cycle, kNever when there is none
+  // or the port width is used up. Kept on pop and commit.
+  std::uint64_t pop_ready_ = kNever;
   const std::uint64_t* now_;
-  std::vector<ChannelBase*>* dirty_list_;
   // Per slot: the cycle its item becomes poppable; kNever for an empty slot. Slots are a power of
   // two (>= capacity, which alone limits the occupancy) so that a slot is an index mask.
   std::vector<std::uint64_t> ready_at_;
   int mask_ = 0;
   int head_ = 0, count_ = 0, pushes_ = 0, pops_ = 0;
-  // The cycle from which can_pop() holds: the next item's ready cycle, kNever when there is none
-  // or the port width is used up. Kept on pop and commit.
-  std::uint64_t pop_ready_ = kNever;
+  int capacity_, latency_, width_;
   bool dirty_ = false;
-  Module* producer_ = nullptr;  // declared ends (Module::produces/consumes); null: not declared
-  Module* consumer_ = nullptr;
+  std::vector<ChannelBase*>* dirty_list_;
   // Where commit() posts wake-ups: the kernel's per-module wake cycles, at the declared ends'
   // slots (slot 0 is a sink for undeclared ends).
   std::vector<std::uint64_t>* wakes_;
   std::size_t producer_slot_ = 0, consumer_slot_ = 0;
   // Statistics (owned by the kernel's registry; the counts since the last flush_stats() are kept
-  // here, in the line commit() touches anyway).
+  // here, in the lines commit() touches anyway).
+  std::uint64_t pending_pushes_ = 0;
+  int max_count_ = 0;
+  // Occupancy integrated over time.
+  std::uint64_t occupancy_area_ = 0;
+  std::uint64_t last_change_ = 0;
+  // Cold.
   void flush_stats();
   Counter* pushes_stat_ = nullptr;
   Counter* max_occupancy_stat_ = nullptr;
-  std::uint64_t pending_pushes_ = 0;
-  int max_count_ = 0;
-  // Occupancy integrated over time, updated lazily on change (idle cycles cost nothing).
-  std::uint64_t occupancy_area_ = 0;
-  std::uint64_t last_change_ = 0;
+  Module* producer_ = nullptr;  // declared ends (Module::produces/consumes); null: not declared
+  Module* consumer_ = nullptr;
+  std::string name_;
 
   friend class Kernel;
   friend class Module;

@@ -15,13 +15,13 @@ namespace saarcor::hw {
 // ---- ChannelBase ------------------------------------------------------------------------------
 
 ChannelBase::ChannelBase(Kernel& kernel, std::string name, int capacity, int latency, int width)
-    : name_(std::move(name)),
+    : now_(&kernel.cycle_),
       capacity_(capacity),
       latency_(latency),
       width_(width),
-      now_(&kernel.cycle_),
       dirty_list_(&kernel.dirty_),
-      wakes_(&kernel.wake_) {
+      wakes_(&kernel.wake_),
+      name_(std::move(name)) {
   if (capacity < 1 || latency < 1 || width < 1) {
     throw std::logic_error("channel '" + name_ +
                            "': capacity, latency and width must be >= 1 (got " +
