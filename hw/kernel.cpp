@@ -95,7 +95,7 @@ void ChannelBase::flush_stats() {
 // ---- Module -------------------------------------------------------------------------------------
 
 Module::Module(Kernel& kernel, std::string name)
-    : name_(std::move(name)), kernel_(&kernel), now_(&kernel.cycle_) {
+    : now_(&kernel.cycle_), kernel_(&kernel), name_(std::move(name)) {
   kernel.add_module(this);
 }
 
@@ -175,14 +175,18 @@ void Kernel::wake_all() {
 void Kernel::account(Module* m) {
   const std::uint64_t n = cycle_ - m->accounted_;
   if (n == 0) return;
-  if (m->stalled_) m->stall_stat_->value += n;
+  if (m->stalled_) m->stall_count_ += n;
   if (!m->skipped_is_noop_) m->skipped(n);
   m->accounted_ = cycle_;
 }
 
 void Kernel::account_all() {
-  for (Module* m : modules_)
+  for (Module* m : modules_) {
     account(m);
+    m->busy_stat_->value += m->busy_count_;
+    m->stall_stat_->value += m->stall_count_;
+    m->busy_count_ = m->stall_count_ = 0;
+  }
   for (ChannelBase* c : channels_)
     c->flush_stats();
 }
@@ -205,11 +209,11 @@ int Kernel::step_cycle() {
     const int p = m->evaluate();
     m->last_progress_ = p;
     m->accounted_ = next;
-    m->stall_stat_->value += m->stalled_;
+    m->stall_count_ += m->stalled_;
     progress += p;
     ++evaluated;
     if (p > 0) {
-      ++m->busy_stat_->value;
+      ++m->busy_count_;
       wake[m->slot_] = next;
       busy[busy_count++] = m;
     } else {

@@ -82,22 +82,25 @@ class Module {
  private:
   friend class Kernel;
   friend class ChannelBase;
-  std::string name_;
-  Kernel* kernel_;
+  // What the kernel touches every evaluation comes first (one cache line with the vtable pointer).
   const std::uint64_t* now_;
+  // Event scheduling: evaluated in cycle c only if the kernel's wake cycle at slot_ is <= c;
+  // cycles before accounted_ have their busy/stall statistics and skipped() counted (the rest are
+  // counted lazily on waking).
+  std::uint64_t accounted_ = 0;
+  std::size_t slot_ = 0;
+  // busy/stall cycles not yet handed to the registry (Kernel::account_all does).
+  std::uint64_t busy_count_ = 0, stall_count_ = 0;
   int last_progress_ = 0;
   bool stalled_ = false;
   bool sleeps_ = false;
   bool skipped_is_noop_ = false;  // set by the default skipped(): the kernel stops calling it
   bool commit_is_noop_ = false;   // set by the default commit(): the kernel stops calling it
-  // Event scheduling: evaluated in cycle c only if the kernel's wake cycle at slot_ is <= c;
-  // cycles before accounted_ have their busy/stall statistics and skipped() counted (the rest are
-  // counted lazily on waking).
-  std::size_t slot_ = 0;
-  std::uint64_t accounted_ = 0;
+  Kernel* kernel_;
   std::vector<ChannelBase*> inputs_;  // consumed channels: their front items wake the module
   Counter* busy_stat_ = nullptr;
   Counter* stall_stat_ = nullptr;
+  std::string name_;
 };
 
 // A register inside a module: get() returns the value committed last cycle, set() stages the next
