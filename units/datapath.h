@@ -9,9 +9,12 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
+#include <limits>
 
 #include "fixedfloat/float.h"
+#include "fixedfloat/pack.h"
 #include "memif/image_format.h"
 #include "units/unit_fp.h"
 
@@ -141,6 +144,175 @@ template <class F, class Fp, class Den>
     tf = fp.min(tf, t);
 }
 
+// ---- the traversal unit in binary64 (nearest-even only)
+// ------------------------------------------ The same steps on the exact binary64 values of the
+// encodings, for speed: the segment bounds live as binary64 (a value of F converts exactly both
+// ways), O[axis] is decoded and 1/D[axis] computed once per level. Each op's binary64 result is
+// rounded to F's precision in binary64 (round_to_format): for + and - that is double rounding,
+// innocuous as 53 >= 2(M+1)+2 (Figueroa 1995, as in fixedfloat/ops.h), and x * (1/D) rounds like x
+// / D (the midpoint-distance argument of ff::fast::div_reciprocal). A result is accepted only when
+// it is zero or normal and finite in F, where both ways agree bit for bit; otherwise (overflow,
+// underflow, inf or NaN operands, a divisor that is not normal, truncation: 1/D is then NaN) the
+// caller redoes the lane with the encoding path above. Compares and the max/min multiplexers are
+// binary64 compares of the exact values (NaN never reaches them on this path). Tested against the
+// encoding path in units/datapath_test.cpp.
+
+// Rounds v to F's precision (nearest-even) in binary64; clears ok unless the result is zero or
+// normal and finite in F.
+template <class F>
+inline double round_to_format(double v, bool& ok) {
+  constexpr int kShift = 52 - F::kManBits;
+  constexpr std::uint64_t kLowBits = (std::uint64_t{1} << kShift) - 1u;
+  constexpr std::uint64_t kInfMag = std::uint64_t{0x7FF} << 53;  // magnitude bits, shifted by one
+  constexpr std::uint64_t kMinMag = static_cast<std::uint64_t>(1023 + F::kFormat.emin()) << 53;
+  constexpr std::uint64_t kSpanMag =
+      static_cast<std::uint64_t>(F::kFormat.emax() - F::kFormat.emin() + 1) << 53;
+  const auto u = std::bit_cast<std::uint64_t>(v);
+  const std::uint64_t r = (u + (kLowBits >> 1) + ((u >> kShift) & 1u)) & ~kLowBits;
+  const std::uint64_t mag = r << 1;
+  ok &= ((u << 1) < kInfMag) & ((mag - kMinMag < kSpanMag) | (mag == 0));
+  return std::bit_cast<double>(r);
+}
+
+// 1/D for the binary64 path: NaN unless D is normal and the mode rounds to nearest-even.
+template <class F, class Fp>
+inline double traversal_reciprocal(const Fp& fp, F d) {
+  constexpr std::uint32_t kExpMax = F::kFormat.exp_field_max();
+  const std::uint32_t e = (d.bits >> F::kManBits) & kExpMax;
+  if (e == 0 || e == kExpMax || fp.mode().rounding != ff::Rounding::kNearestEven)
+    return std::numeric_limits<double>::quiet_NaN();
+  return 1.0 / fp.to_double(d);
+}
+
+// The value of an encoding: exact, a subnormal read as +-0 in flush mode (as every op reads it).
+template <class F>
+[[gnu::always_inline]] inline double value_of(F x, ff::Subnormals s) {
+  constexpr std::uint32_t kExpMax = F::kFormat.exp_field_max();
+  const std::uint32_t e = (x.bits >> F::kManBits) & kExpMax;
+  if (e - 1u < kExpMax - 1u) [[likely]]
+    return ff::fast::decode_normal<F::kExpBits, F::kManBits>(x.bits);
+  if ((x.bits & (F::kFormat.sign_mask() - 1u)) == 0) return x.sign() ? -0.0 : 0.0;
+  return ff::decode(x.bits, F::kFormat, s);
+}
+
+// The encoding of a value that round_to_format accepted (zero or normal).
+template <class F>
+[[gnu::always_inline]] inline F encoding_of(double v) {
+  constexpr int kShift = 52 - F::kManBits;
+  constexpr std::uint64_t kRebias = static_cast<std::uint64_t>(1023 - F::kFormat.bias()) << 52;
+  const auto u = std::bit_cast<std::uint64_t>(v);
+  const std::uint64_t mag = u & ~(std::uint64_t{1} << 63);
+  const auto sign = static_cast<std::uint32_t>(u >> 63) << (F::kExpBits + F::kManBits);
+  return F{sign | (mag == 0 ? 0u : static_cast<std::uint32_t>((mag - kRebias) >> kShift))};
+}
+
+// transform_step on values, for operands in a safe range. If every matrix entry and vector
+// component is zero or normal with an exponent in [kSafeMin, kSafeMax], no product or sum of the
+// step can leave F's normal range except to an exact zero: products lie in
+// [2^(2 kSafeMin), 2^(2 kSafeMax + 2)], the two levels of sums below 2^(2 kSafeMax + 4) <= 2^emax,
+// and a nonzero sum is at least the smallest ulp of its operands, 2^(2 kSafeMin - M) >= 2^emin.
+// Then each op is its binary64 result rounded to F's precision without range checks: products
+// are exact in binary64 (significands of at most 24 bits) and rounded once, sums are rounded
+// twice, innocuously (53 >= 2(M+1)+2); zeros give the IEEE signed zeros the encoding path gives.
+template <class F>
+struct SafeRange {
+  static constexpr int kSafeMin = (F::kFormat.emin() + F::kManBits + 1) / 2;  // ceil for < 0
+  static constexpr int kSafeMax = (F::kFormat.emax() - 4) / 2;
+  static_assert(2 * kSafeMin - F::kManBits >= F::kFormat.emin());
+  static_assert(2 * kSafeMax + 4 <= F::kFormat.emax());
+  static bool contains(F x) {
+    constexpr std::uint32_t kLow = static_cast<std::uint32_t>(F::kFormat.bias() + kSafeMin);
+    constexpr std::uint32_t kSpan = static_cast<std::uint32_t>(kSafeMax - kSafeMin);
+    const std::uint32_t e = (x.bits >> F::kManBits) & F::kFormat.exp_field_max();
+    return ((x.bits & (F::kFormat.sign_mask() - 1u)) == 0) | (e - kLow <= kSpan);
+  }
+};
+
+// Rounds v to F's precision (nearest-even) in binary64, for results known to be zero or normal.
+template <class F>
+[[gnu::always_inline]] inline double round_in_range(double v) {
+  constexpr int kShift = 52 - F::kManBits;
+  constexpr std::uint64_t kLowBits = (std::uint64_t{1} << kShift) - 1u;
+  const auto u = std::bit_cast<std::uint64_t>(v);
+  return std::bit_cast<double>((u + (kLowBits >> 1) + ((u >> kShift) & 1u)) & ~kLowBits);
+}
+
+// The matrix entries as values, and whether all are in the safe range.
+template <class F>
+struct MatrixValues {
+  std::array<std::array<double, 4>, 3> m{};
+  bool safe = false;
+};
+template <class F>
+inline MatrixValues<F> matrix_values(const Mat34<F>& m, ff::Subnormals s) {
+  MatrixValues<F> v;
+  bool safe = true;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) {
+      v.m[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] = value_of(m[r][c], s);
+      safe &= SafeRange<F>::contains(m[r][c]);
+    }
+  v.safe = safe;
+  return v;
+}
+
+// false: an operand is outside the safe range (or the mode is not nearest-even, which the caller
+// checks); use transform_step.
+template <class F>
+[[gnu::always_inline]] inline bool transform_step64(const MatrixValues<F>& mv, const Vec3<F>& v,
+                                                    bool translate, Vec3<F>& out) {
+  if (!(mv.safe & SafeRange<F>::contains(v[0]) & SafeRange<F>::contains(v[1]) &
+        SafeRange<F>::contains(v[2])))
+    return false;
+  const std::array<double, 3> x = {value_of(v[0], ff::Subnormals::kFlush),
+                                   value_of(v[1], ff::Subnormals::kFlush),
+                                   value_of(v[2], ff::Subnormals::kFlush)};  // no subnormals here
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& m = mv.m[k];
+    const double t = translate ? m[3] : 0.0;
+    const double a = round_in_range<F>(m[0] * x[0]);
+    const double b = round_in_range<F>(m[1] * x[1]);
+    const double c = round_in_range<F>(m[2] * x[2]);
+    out[static_cast<int>(k)] =
+        encoding_of<F>(round_in_range<F>(round_in_range<F>(a + b) + round_in_range<F>(c + t)));
+  }
+  return true;
+}
+
+struct TraversalLane64 {
+  bool go_near = false;
+  bool go_far = false;
+  double near_tf = 0.0;
+  double far_tn = 0.0;
+};
+
+// traversal_lane on values; false: not decided here, use traversal_lane.
+template <class F>
+[[gnu::always_inline]] inline bool traversal_lane64(double split, double o_axis, double inv_d,
+                                                    double tn, double tf, TraversalLane64& r) {
+  bool ok = true;
+  const double d = round_to_format<F>(round_to_format<F>(split - o_axis, ok) * inv_d, ok);
+  r.go_near = !(d < tn);
+  r.go_far = !(tf < d);
+  r.near_tf = r.go_far ? d : tf;
+  r.far_tn = r.go_near ? d : tn;
+  return ok;
+}
+
+// clip_face on values; false (tn, tf unchanged): not decided here, use clip_face.
+template <class F>
+[[gnu::always_inline]] inline bool clip_face64(double plane, double o_axis, double inv_d,
+                                               bool entry, double& tn, double& tf) {
+  bool ok = true;
+  const double t = round_to_format<F>(round_to_format<F>(plane - o_axis, ok) * inv_d, ok);
+  if (!ok) return false;
+  if (entry)
+    tn = tn < t ? t : tn;
+  else
+    tf = t < tf ? t : tf;
+  return true;
+}
+
 // ---- intersection unit (paper 2.1.2, DESIGN.md 5: 3 add, 2 mul, 1 div per ray) --------------
 template <class F>
 struct Candidate {
@@ -189,10 +361,16 @@ inline bool accepts(const Candidate<F>& c, std::uint32_t instance, std::uint32_t
 }
 
 // ---- memory image reads (what the caches deliver) ---------------------------------------------
+// As image.row(row) for an image in F's format (the thread program checks that), unpacked with the
+// format known at compile time.
 template <class F>
 inline std::array<F, 4> read_row(const memif::MemoryImage& image, std::uint32_t row) {
-  const auto w = image.row(row);
-  return {F::from_bits(w[0]), F::from_bits(w[1]), F::from_bits(w[2]), F::from_bits(w[3])};
+  constexpr int kWords = ff::row_words(F::kFormat);
+  std::array<std::uint32_t, 4> w{};
+  for (int i = 0; i < kWords; ++i)
+    w[static_cast<std::size_t>(i)] = image.item_word(memif::ItemType::kRow, row, i);
+  const auto v = ff::unpack_row(w.data(), F::kFormat);
+  return {F::from_bits(v[0]), F::from_bits(v[1]), F::from_bits(v[2]), F::from_bits(v[3])};
 }
 template <class F>
 inline Mat34<F> read_matrix(const memif::MemoryImage& image, std::uint32_t first_row) {

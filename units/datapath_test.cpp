@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+#include <vector>
+
 #include "units/mailbox.h"
 
 namespace saarcor::units {
@@ -207,6 +210,136 @@ TEST(Mailbox, SkipsVisitedRaysOnlyAndEvictsOldest) {
   Mailbox off(0);
   EXPECT_EQ(off.filter(1, 3), 3u);
   EXPECT_EQ(off.filter(1, 3), 3u);
+}
+
+// ---- the binary64 paths against the encoding paths -------------------------------------------
+
+// Operands: mostly values of moderate size (the common case the binary64 paths decide), plus
+// zeros, subnormals, the extremes of the range, inf and NaN (which they must hand back).
+template <class G>
+std::uint32_t operand(std::mt19937_64& rng) {
+  const auto u = rng();
+  const std::uint32_t sign = (u & 1u) != 0 ? G::kFormat.sign_mask() : 0u;
+  const std::uint32_t man = static_cast<std::uint32_t>(u >> 8) & G::kFormat.man_mask();
+  const auto bias = static_cast<std::uint32_t>(G::kFormat.bias());
+  switch ((u >> 1) % 16) {
+    case 0:
+      return sign;  // +-0
+    case 1:
+      return sign | (man == 0 ? 1u : man);  // subnormal
+    case 2:
+      return sign | G::kFormat.inf_bits();
+    case 3:
+      return G::kFormat.nan_bits();
+    case 4:  // near the top of the range
+      return sign |
+             ((G::kFormat.exp_field_max() - 1u - static_cast<std::uint32_t>((u >> 40) % 4))
+              << G::kManBits) |
+             man;
+    case 5:  // near the bottom
+      return sign | ((1u + static_cast<std::uint32_t>((u >> 40) % 4)) << G::kManBits) | man;
+    case 6:  // wide
+      return sign |
+             ((1u + static_cast<std::uint32_t>((u >> 40) % (G::kFormat.exp_field_max() - 1u)))
+              << G::kManBits) |
+             man;
+    default:  // moderate: 2^-12 .. 2^12
+      return sign | ((bias - 12u + static_cast<std::uint32_t>((u >> 40) % 25)) << G::kManBits) |
+             man;
+  }
+}
+
+template <class G>
+void check_binary64_paths(ff::Mode mode, int n) {
+  const RawFp<G, false> fp(mode);
+  std::mt19937_64 rng(2024);
+  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
+  const auto value = [&](G x) { return value_of(x, mode.subnormals); };
+  int decided = 0, transforms = 0;
+  for (int it = 0; it < n; ++it) {
+    // Traversal lane: the segment bounds are values of encodings, never NaN (tf may be inf).
+    const G split = op(), o = op(), d = op();
+    G tn = op(), tf = op();
+    if (bits_nan(tn)) tn = G::zero();
+    if (bits_nan(tf)) tf = G::infinity();
+    TraversalLane64 r64;
+    const double inv = traversal_reciprocal(fp, d);
+    if (traversal_lane64<G>(value(split), value(o), inv, value(tn), value(tf), r64)) {
+      ++decided;
+      const TraversalLane<G> r = traversal_lane(fp, split, o, d, tn, tf);
+      ASSERT_EQ(r64.go_near, r.go_near) << split.bits << " " << o.bits << " " << d.bits;
+      ASSERT_EQ(r64.go_far, r.go_far) << split.bits << " " << o.bits << " " << d.bits;
+      // The model keeps segment bounds as values (a subnormal reads as +-0 in flush mode).
+      const auto same = [&](double v, G e) {
+        return v == value(e) && std::signbit(v) == std::signbit(value(e));
+      };
+      ASSERT_TRUE(same(r64.near_tf, r.near_tf) && same(r64.far_tn, r.far_tn))
+          << ff::format_name(G::kFormat) << " keep=" << (mode.subnormals == ff::Subnormals::kKeep)
+          << " split " << split.bits << " o " << o.bits << " d " << d.bits << " tn " << tn.bits
+          << " tf " << tf.bits;
+    }
+    // Clip face.
+    for (const bool entry : {true, false}) {
+      double tn64 = value(tn), tf64 = value(tf);
+      G tn_e = tn, tf_e = tf;
+      if (clip_face64<G>(value(split), value(o), inv, entry, tn64, tf64)) {
+        clip_face(fp, split, o, d, entry, tn_e, tf_e);
+        ASSERT_EQ(tn64, value(tn_e));
+        ASSERT_EQ(tf64, value(tf_e));
+        ASSERT_EQ(std::signbit(tn64), std::signbit(value(tn_e)));
+        ASSERT_EQ(std::signbit(tf64), std::signbit(value(tf_e)));
+      }
+    }
+    // Transformation step: mostly moderate operands, so that many steps are decided here.
+    const auto op_t = [&] {
+      const G x = op();
+      return (rng() % 16) == 0 || SafeRange<G>::contains(x)
+                 ? x
+                 : G::from_bits(G::one().bits | (x.bits & G::kFormat.man_mask()) |
+                                (x.bits & G::kFormat.sign_mask()));
+    };
+    Mat34<G> m;
+    for (auto& row : m)
+      for (auto& x : row)
+        x = op_t();
+    const Vec3<G> v{op_t(), op_t(), op_t()};
+    MatrixValues<G> mv = matrix_values(m, mode.subnormals);
+    for (const bool translate : {true, false}) {
+      Vec3<G> out;
+      if (transform_step64<G>(mv, v, translate, out)) {
+        ++transforms;
+        const Vec3<G> want = transform_step(fp, m, v, translate);
+        for (int k = 0; k < 3; ++k)
+          ASSERT_EQ(out[k].bits, want[k].bits) << "row " << k;
+      }
+    }
+  }
+  EXPECT_GT(decided, n / 4);  // the binary64 paths decide the common case
+  EXPECT_GT(transforms, n / 4);
+}
+
+TEST(Binary64Paths, AgreeWithTheEncodingPaths) {
+#if defined(SAARCOR_SANITIZED)
+  const int n = 20'000;
+#else
+  const int n = 400'000;
+#endif
+  for (const ff::Subnormals s : {ff::Subnormals::kFlush, ff::Subnormals::kKeep}) {
+    check_binary64_paths<ff::fp24>({ff::Rounding::kNearestEven, s}, n);
+    check_binary64_paths<ff::Float<7, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
+    check_binary64_paths<ff::Float<8, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
+    check_binary64_paths<ff::Float<7, 10>>({ff::Rounding::kNearestEven, s}, n / 4);
+  }
+}
+
+// Truncation: the binary64 traversal path never decides (1/D is NaN).
+TEST(Binary64Paths, TruncationAlwaysFallsBack) {
+  const RawFp<F> fp({ff::Rounding::kTowardZero, ff::Subnormals::kFlush});
+  TraversalLane64 r;
+  EXPECT_FALSE(traversal_lane64<F>(1.0, 0.0, traversal_reciprocal(fp, f(2)), 0.0, 10.0, r));
+  const RawFp<F> rne;
+  EXPECT_TRUE(traversal_lane64<F>(1.0, 0.0, traversal_reciprocal(rne, f(2)), 0.0, 10.0, r));
+  EXPECT_EQ(r.near_tf, 0.5);
 }
 
 }  // namespace

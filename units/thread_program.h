@@ -228,9 +228,9 @@ class ThreadProgram {
       throw std::runtime_error("functional model: stack depth must be at least 1");
     lanes_.resize(static_cast<std::size_t>(p_));
     surf_.resize(static_cast<std::size_t>(p_));
-    stack_node_.reserve(static_cast<std::size_t>(params.stack_depth));
-    stack_mask_.reserve(static_cast<std::size_t>(params.stack_depth));
-    stack_t_.reserve(static_cast<std::size_t>(params.stack_depth) * 2u * lanes_.size());
+    stack_node_.resize(static_cast<std::size_t>(params.stack_depth));
+    stack_mask_.resize(static_cast<std::size_t>(params.stack_depth));
+    stack_t_.resize(static_cast<std::size_t>(params.stack_depth) * 2u * lanes_.size());
     const auto& regs = image.registers();
     max_depth_ =
         params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth) : regs.max_depth;
@@ -241,6 +241,7 @@ class ThreadProgram {
       scene_hi_[i] = F::from_bits(regs.scene_max[i]);
     }
     epsilon_ = F::from_bits(regs.epsilon);
+    nearest_ = params.mode.rounding == ff::Rounding::kNearestEven;
     shadow_t_max_ = F::from_double(1.0 - 1.0 / 512.0);
   }
 
@@ -387,12 +388,14 @@ class ThreadProgram {
     std::uint32_t pixel = memif::kNone;
     std::uint32_t weight = 0;
     Ray<F> world, current, tri;
-    // 1/|D| of the world and the current direction per axis (Divisor): the traversal unit's
-    // divisions by D during a level use them.
-    std::array<double, 3> world_inv{}, inv{};
-    F tn{}, tf{};            // segment of the node being visited
-    F clip_tn{}, clip_tf{};  // the level's clipped segment (restart of a sign group)
-    HitRecord<F> hit;        // hit.t = t_best (starts at the ray's t_max)
+    // The traversal unit works on binary64 values (datapath.h, traversal_lane64): O and 1/D per
+    // axis of the world and of the current ray, and the segments. Every one is the exact value of
+    // an encoding of F, so the encodings are recovered exactly where the encoding path is needed.
+    std::array<double, 3> world_o{}, world_inv{}, o{}, inv{};
+    double tn = 0.0, tf = 0.0;            // segment of the node being visited
+    double clip_tn = 0.0, clip_tf = 0.0;  // the level's clipped segment (restart of a sign group)
+    double t_best = 0.0;                  // value of hit.t
+    HitRecord<F> hit;                     // hit.t = t_best (starts at the ray's t_max)
     RayCounters counters;
   };
 
@@ -434,13 +437,28 @@ class ThreadProgram {
     PipelineUnits<F>::count(u_.transformation_ops, 9 * steps, 9 * steps, 0, 0);
   }
   Lane& lane(int i) { return lanes_[static_cast<std::size_t>(i)]; }
-  static void set_inverses(std::array<double, 3>& inv, const Vec3<F>& d) {
-    for (int k = 0; k < 3; ++k)
-      inv[static_cast<std::size_t>(k)] = RawFp<F>::divisor(d[k]).inv;
+  void set_axis_values(std::array<double, 3>& o, std::array<double, 3>& inv,
+                       const Ray<F>& r) const {
+    for (int k = 0; k < 3; ++k) {
+      o[static_cast<std::size_t>(k)] = u_.raw.to_double(r.o[k]);
+      inv[static_cast<std::size_t>(k)] = traversal_reciprocal(u_.raw, r.d[k]);
+    }
   }
-  static Divisor<F> divisor(const Lane& l, int axis) {
-    return {l.current.d[axis], l.inv[static_cast<std::size_t>(axis)]};
+  double value(F x) const { return value_of(x, u_.raw.mode().subnormals); }
+
+  // A transformation step (transform_step) through the binary64 path where it decides.
+  using Mat64 = MatrixValues<F>;
+  Mat64 matrix_values(const Mat34<F>& m) const {
+    Mat64 v = units::matrix_values(m, u_.raw.mode().subnormals);
+    v.safe &= nearest_;
+    return v;
   }
+  Vec3<F> transform(const Mat34<F>& m, const Mat64& mv, const Vec3<F>& v, bool translate) const {
+    Vec3<F> out;
+    if (transform_step64<F>(mv, v, translate, out)) return out;
+    return transform_step(u_.raw, m, v, translate);
+  }
+  F encoding(double v) const { return u_.raw.from_double(v); }  // exact: v is a value of F
   static bool has(std::uint64_t m, int i) { return ((m >> i) & 1u) != 0; }
 
   // ---- packet start (path a) ------------------------------------------------------------------
@@ -462,25 +480,27 @@ class ThreadProgram {
   }
 
   void do_generate() {
-    const auto& fp = u_.raw;
     count_transform();
     const auto& g0 = gen_.lanes[0];
     Vec3<F> shared{};
-    if (shared_origin_) shared = transform_step(fp, g0.t, g0.ro, true);
+    if (shared_origin_) shared = transform(g0.t, matrix_values(g0.t), g0.ro, true);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
       if (!l.valid) {
         l.world.o = shared;
       } else {
-        l.world.o = shared_origin_ ? shared : transform_step(fp, g.t, g.ro, true);
-        l.world.d = transform_step(fp, g.t, g.rd, false);
+        const Mat64 mv = matrix_values(g.t);
+        l.world.o = shared_origin_ ? shared : transform(g.t, mv, g.ro, true);
+        l.world.d = transform(g.t, mv, g.rd, false);
       }
       l.current = l.world;
-      set_inverses(l.world_inv, l.world.d);
+      set_axis_values(l.world_o, l.world_inv, l.world);
+      l.o = l.world_o;
       l.inv = l.world_inv;
       l.hit = HitRecord<F>{};
       if (kind_ == RayKind::kShadow) l.hit.t = shadow_t_max_;
+      l.t_best = value(l.hit.t);
       if (l.valid) ++l.counters.transformations;
     }
     if (kind_ == RayKind::kShadow) {
@@ -516,72 +536,83 @@ class ThreadProgram {
         if (lane(i).valid && !lane(i).done) clip_mask_ |= std::uint64_t{1} << i;
       for (int i = 0; i < p_; ++i) {
         lane(i).current = lane(i).world;
+        lane(i).o = lane(i).world_o;
         lane(i).inv = lane(i).world_inv;
-        lane(i).clip_tn = F::zero();
-        lane(i).clip_tf = lane(i).hit.t;
+        lane(i).clip_tn = 0.0;
+        lane(i).clip_tf = lane(i).t_best;
       }
       phase_ = Phase::kClipTop;
     } else {
       clip_mask_ = entry_mask_;
       for (int i = 0; i < p_; ++i) {
-        lane(i).clip_tn = F::zero();
-        lane(i).clip_tf = lane(i).hit.t;
+        lane(i).clip_tn = 0.0;
+        lane(i).clip_tf = lane(i).t_best;
       }
       phase_ = Phase::kClipBottom;
     }
   }
 
   void do_clip() {
-    const auto& fp = u_.direct;
     ++u_.clip_steps;
     const auto lanes = static_cast<std::uint64_t>(p_);
     // Per lane 1 add, 1 div, 1 cmp; the last face 1 more cmp (the empty-segment test).
     PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, clip_face_ == 5 ? 2 * lanes : lanes);
-    const int axis = clip_face_ / 2;
-    const bool exit_face = (clip_face_ % 2) == 1;
-    const F lo = box_lo_[static_cast<std::size_t>(axis)];
-    const F hi = box_hi_[static_cast<std::size_t>(axis)];
-    for (int i = 0; i < p_; ++i) {
-      Lane& l = lane(i);
-      if (!has(clip_mask_, i)) continue;
-      const bool neg = l.current.d[axis].sign();
-      const bool entry = !exit_face;
-      // Entry face: lo for a positive direction, hi for a negative one; exit face the other.
-      const F plane = (entry != neg) ? lo : hi;
-      F tn = l.clip_tn, tf = l.clip_tf;
-      clip_face(fp, plane, l.current.o[axis], divisor(l, axis), entry, tn, tf);
-      l.clip_tn = tn;
-      l.clip_tf = tf;
-    }
+    // The six face steps only change the lanes' clipped segments, which nothing reads before the
+    // last face; so the first step computes all six (per lane in face order, the same results)
+    // and saves five passes over the packet.
+    if (clip_face_ == 0) clip_box();
     if (++clip_face_ < 6) return;
-    // Last face: a ray misses the box when its segment is empty (1 cmp per lane).
-    std::uint64_t inside = 0;
+    // Last face: a ray misses the box when its segment is empty (1 cmp per lane). Sign groups:
+    // rays with equal direction signs share one front-to-back order (D27). Groups in increasing
+    // sign-pattern order; each is a masked sub-packet traversed to the end.
+    std::array<std::uint64_t, 8> by_pattern{};
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
-      if (!has(clip_mask_, i)) continue;
-      if (!fp.lt(l.clip_tf, l.clip_tn)) inside |= std::uint64_t{1} << i;
+      if (!has(clip_mask_, i) || l.clip_tf < l.clip_tn) continue;
+      const int s = (l.current.d[0].sign() ? 1 : 0) | (l.current.d[1].sign() ? 2 : 0) |
+                    (l.current.d[2].sign() ? 4 : 0);
+      by_pattern[static_cast<std::size_t>(s)] |= std::uint64_t{1} << i;
     }
-    // Sign groups: rays with equal direction signs share one front-to-back order (D27). Groups
-    // in increasing sign-pattern order; each is a masked sub-packet traversed to the end.
     n_groups_ = 0;
-    for (int pattern = 0; pattern < 8; ++pattern) {
-      std::uint64_t g = 0;
-      for (int i = 0; i < p_; ++i) {
-        const Lane& l = lane(i);
-        const int s = (l.current.d[0].sign() ? 1 : 0) | (l.current.d[1].sign() ? 2 : 0) |
-                      (l.current.d[2].sign() ? 4 : 0);
-        if (has(inside, i) && s == pattern) g |= std::uint64_t{1} << i;
-      }
+    for (const std::uint64_t g : by_pattern)
       if (g != 0) groups_[n_groups_++] = g;
-    }
     if (n_groups_ > 1) u_.sub_packets += n_groups_ - 1;
     group_ = 0;
-    stack_base_ = stack_node_.size();
+    stack_base_ = stack_size_;
     if (n_groups_ == 0) {
       finish_level();
       return;
     }
     start_group();
+  }
+
+  // The slab clip of the level's box (D29), faces 0..5: x entry, x exit, y entry, ... The entry
+  // face is lo for a positive direction, hi for a negative one; the exit face the other.
+  void clip_box() {
+    const auto& fp = u_.direct;
+    std::array<double, 3> lo_value, hi_value;
+    for (std::size_t k = 0; k < 3; ++k) {
+      lo_value[k] = value(box_lo_[k]);
+      hi_value[k] = value(box_hi_[k]);
+    }
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      if (!has(clip_mask_, i)) continue;
+      for (int face = 0; face < 6; ++face) {
+        const int axis = face / 2;
+        const auto k = static_cast<std::size_t>(axis);
+        const bool entry = (face % 2) == 0;
+        const bool lo_face = entry != l.current.d[axis].sign();
+        if (clip_face64<F>(lo_face ? lo_value[k] : hi_value[k], l.o[k], l.inv[k], entry, l.clip_tn,
+                           l.clip_tf))
+          continue;
+        F tn = encoding(l.clip_tn), tf = encoding(l.clip_tf);
+        clip_face(fp, lo_face ? box_lo_[k] : box_hi_[k], l.current.o[axis], l.current.d[axis],
+                  entry, tn, tf);
+        l.clip_tn = value(tn);
+        l.clip_tf = value(tf);
+      }
+    }
   }
 
   void start_group() {
@@ -608,7 +639,7 @@ class ThreadProgram {
     std::uint64_t active = 0;
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
-      if (!has(mask_, i) || l.done || terminated(fp, l.hit.t, l.tn)) continue;
+      if (!has(mask_, i) || l.done || l.t_best < l.tn) continue;  // terminated()
       active |= std::uint64_t{1} << i;
       ++l.counters.traversal_steps;
     }
@@ -629,16 +660,22 @@ class ThreadProgram {
     // The group's shared direction sign on this axis picks the near child.
     const bool neg = lane(std::countr_zero(active)).current.d[axis].sign();
     std::uint64_t near_mask = 0, far_mask = 0;
-    std::array<F, kMaxPacket> near_tf, far_tn;  // lanes 0..P-1 set below
+    std::array<double, kMaxPacket> near_tf, far_tn;  // lanes 0..P-1 set below
+    const double split_value = value(split);
+    const auto a = static_cast<std::size_t>(axis);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const auto k = static_cast<std::size_t>(i);
       if (!has(active, i)) {
-        near_tf[k] = far_tn[k] = F::zero();
+        near_tf[k] = far_tn[k] = 0.0;
         continue;
       }
-      const TraversalLane<F> r =
-          traversal_lane(fp, split, l.current.o[axis], divisor(l, axis), l.tn, l.tf);
+      TraversalLane64 r;
+      if (!traversal_lane64<F>(split_value, l.o[a], l.inv[a], l.tn, l.tf, r)) {
+        const TraversalLane<F> e = traversal_lane(fp, split, l.current.o[axis], l.current.d[axis],
+                                                  encoding(l.tn), encoding(l.tf));
+        r = {e.go_near, e.go_far, value(e.near_tf), value(e.far_tn)};
+      }
       near_mask |= std::uint64_t{r.go_near} << i;
       far_mask |= std::uint64_t{r.go_far} << i;
       near_tf[k] = r.near_tf;
@@ -661,41 +698,40 @@ class ThreadProgram {
     }
   }
 
-  void push(std::uint32_t node, std::uint64_t mask, const std::array<F, kMaxPacket>& far_tn) {
-    if (stack_node_.size() >= static_cast<std::size_t>(params_.stack_depth))
+  void push(std::uint32_t node, std::uint64_t mask, const std::array<double, kMaxPacket>& far_tn) {
+    if (stack_size_ >= stack_node_.size())
       throw std::runtime_error("functional model: traversal stack overflow (depth " +
                                std::to_string(params_.stack_depth) +
                                "); the kd-trees are deeper than the stack");
-    stack_node_.push_back(node);
-    stack_mask_.push_back(mask);
+    stack_node_[stack_size_] = node;
+    stack_mask_[stack_size_] = mask;
+    double* t = &stack_t_[stack_size_ * 2u * lanes_.size()];
     for (int i = 0; i < p_; ++i) {
-      stack_t_.push_back(far_tn[static_cast<std::size_t>(i)]);
-      stack_t_.push_back(lane(i).tf);
+      t[2 * i] = far_tn[static_cast<std::size_t>(i)];
+      t[2 * i + 1] = lane(i).tf;
     }
+    ++stack_size_;
   }
 
   // Pops the next node of the current group, or ends the group.
   void pop() {
     // Entries whose rays have all finished (any-hit) are dropped without a node fetch.
-    while (stack_node_.size() > stack_base_ && (stack_mask_.back() & ~done_mask()) == 0)
-      drop_top();
-    if (stack_node_.size() == stack_base_) return finish_group();
-    node_ = stack_node_.back();
-    mask_ = stack_mask_.back();
-    const std::size_t base = stack_t_.size() - 2u * static_cast<std::size_t>(p_);
+    if (kind_ == RayKind::kShadow) {
+      const std::uint64_t done = done_mask();
+      while (stack_size_ > stack_base_ && (stack_mask_[stack_size_ - 1] & ~done) == 0)
+        --stack_size_;
+    }
+    if (stack_size_ == stack_base_) return finish_group();
+    --stack_size_;
+    node_ = stack_node_[stack_size_];
+    mask_ = stack_mask_[stack_size_];
+    const double* t = &stack_t_[stack_size_ * 2u * lanes_.size()];
     for (int i = 0; i < p_; ++i) {
       if (!has(mask_, i)) continue;
-      lane(i).tn = stack_t_[base + 2u * static_cast<std::size_t>(i)];
-      lane(i).tf = stack_t_[base + 2u * static_cast<std::size_t>(i) + 1u];
+      lane(i).tn = t[2 * i];
+      lane(i).tf = t[2 * i + 1];
     }
-    drop_top();
     phase_ = Phase::kTraverse;
-  }
-
-  void drop_top() {
-    stack_node_.pop_back();
-    stack_mask_.pop_back();
-    stack_t_.resize(stack_t_.size() - 2u * static_cast<std::size_t>(p_));
   }
 
   std::uint64_t done_mask() const {
@@ -720,6 +756,7 @@ class ThreadProgram {
       stack_base_ = top_stack_base_;
       for (int i = 0; i < p_; ++i) {
         lane(i).current = lane(i).world;
+        lane(i).o = lane(i).world_o;
         lane(i).inv = lane(i).world_inv;
       }
       return list_continue();
@@ -767,10 +804,10 @@ class ThreadProgram {
   // ---- transformation unit (path d) -----------------------------------------------------------
   // Transforms `in` of every lane with m (n+1 or 2n steps whatever the mask, D30).
   void transform_lanes(const Mat34<F>& m, Ray<F> Lane::*in, Ray<F> Lane::*out) {
-    const auto& fp = u_.raw;
     count_transform();
     Vec3<F> shared{};
-    if (shared_origin_) shared = transform_step(fp, m, (lanes_[0].*in).o, true);
+    const Mat64 mv = matrix_values(m);
+    if (shared_origin_) shared = transform(m, mv, (lanes_[0].*in).o, true);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       if (!has(entry_mask_, i)) {
@@ -778,8 +815,8 @@ class ThreadProgram {
         continue;
       }
       const Ray<F> src = l.*in;
-      (l.*out).o = shared_origin_ ? shared : transform_step(fp, m, src.o, true);
-      (l.*out).d = transform_step(fp, m, src.d, false);
+      (l.*out).o = shared_origin_ ? shared : transform(m, mv, src.o, true);
+      (l.*out).d = transform(m, mv, src.d, false);
       ++l.counters.transformations;
     }
   }
@@ -788,7 +825,7 @@ class ThreadProgram {
     instance_row_ = image_.registers().instance_row_base + memif::kInstanceRows * instance_;
     transform_lanes(read_matrix<F>(image_, instance_row_), &Lane::world, &Lane::current);
     for (int i = 0; i < p_; ++i)
-      if (has(entry_mask_, i)) set_inverses(lane(i).inv, lane(i).current.d);
+      if (has(entry_mask_, i)) set_axis_values(lane(i).o, lane(i).inv, lane(i).current);
     header_ = image_.instance_header(instance_);
     // Enter the bottom level: save the top level's groups and stack base (the top-level stack
     // entries stay below; the bottom level pushes above them, D26).
@@ -820,6 +857,7 @@ class ThreadProgram {
       ++l.counters.intersections;
       if (!accepts(c, instance_, triangle_, l.hit)) continue;
       l.hit.t = c.t;
+      l.t_best = value(c.t);
       l.hit.u = c.u;
       l.hit.v = c.v;
       l.hit.c = c.c;
@@ -1103,6 +1141,7 @@ class ThreadProgram {
   std::array<F, 3> scene_lo_{}, scene_hi_{};
   std::array<F, 3> box_lo_{}, box_hi_{};  // the current level's box (clip steps)
   F epsilon_{}, shadow_t_max_{};
+  bool nearest_ = true;  // the binary64 paths (datapath.h) decide only for nearest-even
 
   Phase phase_ = Phase::kDone;
   RayKind kind_ = RayKind::kPrimary;
@@ -1125,7 +1164,8 @@ class ThreadProgram {
   std::uint64_t mask_ = 0;
   std::vector<std::uint32_t> stack_node_;
   std::vector<std::uint64_t> stack_mask_;
-  std::vector<F> stack_t_;
+  std::vector<double> stack_t_;  // per entry and lane: far tn, tf (values)
+  std::size_t stack_size_ = 0;   // entries in use (the vectors are allocated once)
   ListCursor top_list_, bottom_list_;
   Mailbox mailbox_, tri_mailbox_;
   std::uint64_t entry_mask_ = 0;
