@@ -171,7 +171,7 @@ std::uint32_t FloatScene::add_instance(std::uint32_t object, const Affine64& wor
   if (object >= objects_.size())
     throw std::runtime_error("float reference: instance of unknown object " +
                              std::to_string(object));
-  instances_.push_back(FloatInstance{world_to_object, object, id});
+  instances_.push_back(FloatInstance{world_to_object, to_float(world_to_object), object, id});
   return static_cast<std::uint32_t>(instances_.size() - 1);
 }
 
@@ -247,8 +247,12 @@ void FloatScene::trace_object(std::uint32_t instance, const FloatRay& world, flo
   const FloatInstance& inst = instances_[instance];
   const FloatObject& obj = objects_[inst.object];
   ++stats.transformations;
-  const FloatRay ray{glm::vec3(inst.world_to_object.apply_point(glm::dvec3(world.origin))),
-                     glm::vec3(inst.world_to_object.apply_vector(glm::dvec3(world.direction)))};
+  const FloatRay ray =
+      step_ == InstanceStep::kBinary64
+          ? FloatRay{glm::vec3(inst.world_to_object.apply_point(glm::dvec3(world.origin))),
+                     glm::vec3(inst.world_to_object.apply_vector(glm::dvec3(world.direction)))}
+          : FloatRay{transform_point(inst.world_to_object32, world.origin),
+                     transform_vector(inst.world_to_object32, world.direction)};
   // DIGEST D29: the object's tree is traversed over the ray's whole [t_min, t_best], clipped to
   // the object's box, not to the top-level leaf.
   float t_near = t_min;
@@ -343,7 +347,7 @@ FloatRay primary_ray(const PrimaryBasis32& c, int x, int y) {
 
 // ---- the image's view ---------------------------------------------------------------------------
 
-FloatScene::FloatScene(const BuiltImage& image) {
+FloatScene::FloatScene(const BuiltImage& image, InstanceStep step) : step_(step) {
   for (const ObjectInfo& o : image.objects) {
     if (o.stored && !o.tree.nodes.empty()) {
       add_object(o.tree, o.t_delta);
@@ -359,7 +363,7 @@ FloatScene::FloatScene(const BuiltImage& image) {
     if (i.object >= objects_.size())
       throw std::runtime_error("float reference: instance of unknown object " +
                                std::to_string(i.object));
-    instances_.push_back(FloatInstance{i.world_to_object, i.object, i.id});
+    instances_.push_back(FloatInstance{i.world_to_object, i.world_to_object32, i.object, i.id});
   }
   set_top(image.top);
 }
@@ -470,15 +474,11 @@ class Shader {
     // Section 4: the world normal M^T * n_o, facing the ray.
     const Affine32& td = scene_.t_delta(inst.object, hit.triangle);
     const glm::vec3 n_o(td.rows[2][0], td.rows[2][1], td.rows[2][2]);
-    // Shading stays binary32: the matrix rounded once, as the image holds it.
-    const auto& m = inst.world_to_object.rows;
-    const auto m32 = [&](int i, std::size_t j) {
-      return static_cast<float>(m[static_cast<std::size_t>(i)][j]);
-    };
+    const auto& m = inst.world_to_object32.rows;  // shading stays binary32
     glm::vec3 n;
     for (int r = 0; r < 3; ++r) {
       const auto rr = static_cast<std::size_t>(r);
-      n[r] = (m32(0, rr) * n_o.x + m32(1, rr) * n_o.y) + (m32(2, rr) * n_o.z + 0.0f);
+      n[r] = (m[0][rr] * n_o.x + m[1][rr] * n_o.y) + (m[2][rr] * n_o.z + 0.0f);
     }
     if (hit.cos > 0.0f) n = -n;
     const float nn = dot_t(n, n);
@@ -659,7 +659,7 @@ FloatFrame render_float(const FloatScene& float_scene, const BuiltImage& image, 
 }
 
 FloatFrame render_float(const BuiltImage& image, const Scene& scene, const FloatParams& params) {
-  const FloatScene float_scene(image);
+  const FloatScene float_scene(image, params.instance_step);
   return render_float(float_scene, image, scene, params);
 }
 

@@ -57,11 +57,19 @@ struct FloatTraceStats {
 };
 
 // The float reference's copy of one instance, one object and the trees, all in binary32.
+// How the float reference takes a ray into an instance's object space (docs/float-reference.md).
+enum class InstanceStep {
+  // binary64, the object-space ray rounded once: the golden image (instances scaled ~40 and
+  // translated ~600, as in VC, lose ~1e-5 of t to a binary32 step).
+  kBinary64,
+  // binary32 in the datapath's op order, as every other step: then Float<7,23> hardware gives
+  // the reference's results bit for bit on every scene (a check of both models' op orders).
+  kBinary32,
+};
+
 struct FloatInstance {
-  // The ray's world -> object step runs in binary64 and rounds the object-space ray once
-  // (docs/float-reference.md: instances scaled ~40 and translated ~600, as in VC, lose ~1e-5 of t
-  // to a binary32 step).
   Affine64 world_to_object;
+  Affine32 world_to_object32;  // the same rounded once
   std::uint32_t object = 0;
   std::uint32_t id = 0;  // glTF node index (built-ins: instance index), what hit records report
 };
@@ -88,7 +96,8 @@ class FloatScene {
  public:
   FloatScene() = default;
   // The image's trees and binary64 matrices (each rounded once to binary32).
-  explicit FloatScene(const BuiltImage& image);
+  explicit FloatScene(const BuiltImage& image, InstanceStep step = InstanceStep::kBinary64);
+  void set_instance_step(InstanceStep step) { step_ = step; }
 
   // Adds an object: its bottom-level tree (over triangle ids) and one T_delta per triangle slot
   // (std::nullopt = degenerate, never listed). Returns its index.
@@ -126,6 +135,7 @@ class FloatScene {
   std::vector<FloatObject> objects_;
   std::vector<FloatInstance> instances_;
   std::uint32_t top_root_ = 0;
+  InstanceStep step_ = InstanceStep::kBinary64;
   bool has_top_ = false;
   Aabb top_bounds_;
 };
@@ -155,6 +165,7 @@ struct FloatParams {
   bool shadows = false;    // shadow rays towards every light
   bool secondary = false;  // reflection and transparency rays up to the depth bound
   int max_depth = -1;      // secondary-ray depth bound, -1 = FrameRegisters::max_depth
+  InstanceStep instance_step = InstanceStep::kBinary64;  // render_float(image, ...) only
 };
 
 // Per pixel: the closest hit and the world-space primary ray (what a hit EXR stores).

@@ -86,10 +86,13 @@ TEST(PrecisionStudy, EndPointsAndFiles) {
   const std::vector<PrecisionRow> rows = run_precision_study("builtin:cube", s, 22, 23);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].mantissa, 22);
-  // Float<7,23> has binary32's precision and the same op order: identical to the reference.
+  // Float<7,23> has binary32's precision and the same op order: the golden reference's binary64
+  // step into the cube's instance leaves only the last bits of t (bit-identity with the binary32
+  // step is RenderModels.Mantissa23ReproducesTheFloatReferenceBitForBit).
   EXPECT_DOUBLE_EQ(rows[1].same_triangle_pct, 100.0);
   EXPECT_TRUE(std::isinf(rows[1].psnr_db));
-  EXPECT_EQ(*rows[1].t_rel_err_max, 0.0);
+  EXPECT_LT(*rows[1].t_rel_err_max, 1e-6);
+  EXPECT_LT(*rows[1].t_rel_err_max, *rows[0].t_rel_err_max);
   // One bit fewer: t differs somewhere, but stays within a few 2^-23 units.
   EXPECT_GT(*rows[0].t_rel_err_max, 0.0);
   EXPECT_LT(*rows[0].t_rel_err_median, 1e-5);

@@ -52,6 +52,7 @@ host::FloatParams float_params(const RenderSettings& s) {
   host::FloatParams p;
   p.shadows = s.shadows;
   p.secondary = s.depth > 0;
+  p.instance_step = s.float_instance_step;
   return p;
 }
 
@@ -115,8 +116,9 @@ FrameResult render_float_frame(const PreparedScene& prep, const RenderSettings& 
   return r;
 }
 
-PixelHit trace_float_pixel(const PreparedScene& prep, PixelCoord px) {
-  const host::FloatScene fs(prep.built);
+PixelHit trace_float_pixel(const PreparedScene& prep, const RenderSettings& settings,
+                           PixelCoord px) {
+  const host::FloatScene fs(prep.built, settings.float_instance_step);
   const host::FloatRay ray = host::primary_ray(host::to_float(prep.built.basis), px.x, px.y);
   // Primary rays: t_min = 0 (strict), t_max = +inf (docs/shading.md section 2).
   const host::FloatHit h = fs.trace(ray, 0.0f, std::numeric_limits<float>::infinity());
@@ -424,7 +426,7 @@ PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prep,
                      const RenderSettings& settings, PixelCoord pixel) {
   switch (model.kind) {
     case ModelKind::kFloat:
-      return trace_float_pixel(prep, pixel);
+      return trace_float_pixel(prep, settings, pixel);
     case ModelKind::kFunctional: {
       check_functional_format(model, prep);
       const units::PixelTrace t =

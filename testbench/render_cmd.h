@@ -9,6 +9,7 @@
 #include <string>
 
 #include "fixedfloat/format.h"
+#include "host/float_reference.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
 #include "testbench/cycle_render.h"
@@ -43,10 +44,13 @@ inline constexpr int kMaxMantissa = 23;
 
 struct RenderSettings {
   Resolution res;
-  double time = 0.0;         // seconds into the scene's animation
-  bool shadows = false;      // shadow rays (docs/shading.md section 6)
-  int depth = 0;             // secondary rays (reflection, transparency) up to this depth; 0 = none
-  double bank_mb = 4.0;      // SRAM bank size of the memory image (the prototype: 4 MB)
+  double time = 0.0;     // seconds into the scene's animation
+  bool shadows = false;  // shadow rays (docs/shading.md section 6)
+  int depth = 0;         // secondary rays (reflection, transparency) up to this depth; 0 = none
+  double bank_mb = 4.0;  // SRAM bank size of the memory image (the prototype: 4 MB)
+  // --model float: how rays enter an instance (host/float_reference.h); binary32 makes Float<7,23>
+  // bit-identical to the reference on every scene (tests), binary64 is the golden image.
+  host::InstanceStep float_instance_step = host::InstanceStep::kBinary64;
   CycleRenderOptions cycle;  // --model cycle: preset, --set overrides, --interval, --vcd
 };
 
