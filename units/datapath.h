@@ -8,6 +8,7 @@
 // step's ops in bulk).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -206,25 +207,30 @@ template <class F>
   return F{sign | (mag == 0 ? 0u : static_cast<std::uint32_t>((mag - kRebias) >> kShift))};
 }
 
-// transform_step on values, for operands in a safe range. If every matrix entry and vector
-// component is zero or normal with an exponent in [kSafeMin, kSafeMax], no product or sum of the
-// step can leave F's normal range except to an exact zero: products lie in
-// [2^(2 kSafeMin), 2^(2 kSafeMax + 2)], the two levels of sums below 2^(2 kSafeMax + 4) <= 2^emax,
-// and a nonzero sum is at least the smallest ulp of its operands, 2^(2 kSafeMin - M) >= 2^emin.
-// Then each op is its binary64 result rounded to F's precision without range checks: products
-// are exact in binary64 (significands of at most 24 bits) and rounded once, sums are rounded
-// twice, innocuously (53 >= 2(M+1)+2); zeros give the IEEE signed zeros the encoding path gives.
-template <class F>
-struct SafeRange {
-  static constexpr int kSafeMin = (F::kFormat.emin() + F::kManBits + 1) / 2;  // ceil for < 0
-  static constexpr int kSafeMax = (F::kFormat.emax() - 4) / 2;
-  static_assert(2 * kSafeMin - F::kManBits >= F::kFormat.emin());
-  static_assert(2 * kSafeMax + 4 <= F::kFormat.emax());
-  static bool contains(F x) {
-    constexpr std::uint32_t kLow = static_cast<std::uint32_t>(F::kFormat.bias() + kSafeMin);
-    constexpr std::uint32_t kSpan = static_cast<std::uint32_t>(kSafeMax - kSafeMin);
-    const std::uint32_t e = (x.bits >> F::kManBits) & F::kFormat.exp_field_max();
-    return ((x.bits & (F::kFormat.sign_mask() - 1u)) == 0) | (e - kLow <= kSpan);
+// transform_step on values, for operands whose exponents keep every intermediate in range. Let
+// the nonzero linear matrix entries, the nonzero vector components and the nonzero translations
+// have unbiased exponents in [lm, hm], [lv, hv], [lt, ht] (all normal). Then every product and
+// translation, and so every sum, is a multiple of 2^L with L = min(lm + lv, lt) - M, and rounding
+// at M+1 significant bits keeps that (a value below 2^(L+M+1) is already exact), so a nonzero
+// intermediate is at least 2^L; and every first-level operand is below 2^B with
+// B = max(hm + hv + 2, ht + 1), the sums below 2^(B+2). With L >= emin and B + 2 <= emax nothing
+// leaves F's normal range except to an exact zero, and each op is its binary64 result rounded
+// to F's precision without range checks: products are exact in binary64 (significands of at
+// most 24 bits) and rounded once, sums rounded twice, innocuously (53 >= 2(M+1)+2); zeros give
+// the IEEE signed zeros the encoding path gives.
+struct ExponentRange {
+  int lo = 1 << 20;  // empty: the bounds below then hold trivially
+  int hi = -(1 << 20);
+  bool normal = true;  // no subnormal, inf or NaN among the entries
+  template <class F>
+  void include(F x) {
+    constexpr std::uint32_t kExpMax = F::kFormat.exp_field_max();
+    if ((x.bits & (F::kFormat.sign_mask() - 1u)) == 0) return;
+    const std::uint32_t e = (x.bits >> F::kManBits) & kExpMax;
+    normal &= e != 0 && e != kExpMax;
+    const int u = static_cast<int>(e) - F::kFormat.bias();
+    lo = u < lo ? u : lo;
+    hi = u > hi ? u : hi;
   }
 };
 
@@ -237,44 +243,54 @@ template <class F>
   return std::bit_cast<double>((u + (kLowBits >> 1) + ((u >> kShift) & 1u)) & ~kLowBits);
 }
 
-// The matrix entries as values, and whether all are in the safe range.
+// The matrix entries as values, with the exponent ranges of the linear part and the translation.
 template <class F>
 struct MatrixValues {
   std::array<std::array<double, 4>, 3> m{};
-  bool safe = false;
+  ExponentRange linear, translation;
+  bool nearest = true;  // the caller clears it for truncation (then no step is decided here)
 };
 template <class F>
 inline MatrixValues<F> matrix_values(const Mat34<F>& m, ff::Subnormals s) {
   MatrixValues<F> v;
-  bool safe = true;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) {
       v.m[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] = value_of(m[r][c], s);
-      safe &= SafeRange<F>::contains(m[r][c]);
+      if (c < 3)
+        v.linear.include(m[r][c]);
+      else
+        v.translation.include(m[r][c]);
     }
-  v.safe = safe;
   return v;
 }
 
-// false: an operand is outside the safe range (or the mode is not nearest-even, which the caller
-// checks); use transform_step.
+// false: the exponent condition above fails, an operand is not normal, or the mode is not
+// nearest-even; use transform_step.
 template <class F>
 [[gnu::always_inline]] inline bool transform_step64(const MatrixValues<F>& mv, const Vec3<F>& v,
                                                     bool translate, Vec3<F>& out) {
-  if (!(mv.safe & SafeRange<F>::contains(v[0]) & SafeRange<F>::contains(v[1]) &
-        SafeRange<F>::contains(v[2])))
+  ExponentRange rv;
+  rv.include(v[0]);
+  rv.include(v[1]);
+  rv.include(v[2]);
+  const ExponentRange t = translate ? mv.translation : ExponentRange{};
+  const int low = std::min(mv.linear.lo + rv.lo, t.lo) - F::kManBits;
+  const int high = std::max(mv.linear.hi + rv.hi + 2, t.hi + 1);
+  if (!(mv.nearest & mv.linear.normal & t.normal & rv.normal & (low >= F::kFormat.emin()) &
+        (high + 2 <= F::kFormat.emax())))
     return false;
+  // Normal or zero operands: value_of's subnormal mode does not matter.
   const std::array<double, 3> x = {value_of(v[0], ff::Subnormals::kFlush),
                                    value_of(v[1], ff::Subnormals::kFlush),
-                                   value_of(v[2], ff::Subnormals::kFlush)};  // no subnormals here
+                                   value_of(v[2], ff::Subnormals::kFlush)};
   for (std::size_t k = 0; k < 3; ++k) {
     const auto& m = mv.m[k];
-    const double t = translate ? m[3] : 0.0;
+    const double tk = translate ? m[3] : 0.0;
     const double a = round_in_range<F>(m[0] * x[0]);
     const double b = round_in_range<F>(m[1] * x[1]);
     const double c = round_in_range<F>(m[2] * x[2]);
     out[static_cast<int>(k)] =
-        encoding_of<F>(round_in_range<F>(round_in_range<F>(a + b) + round_in_range<F>(c + t)));
+        encoding_of<F>(round_in_range<F>(round_in_range<F>(a + b) + round_in_range<F>(c + tk)));
   }
   return true;
 }

@@ -28,9 +28,11 @@ PacketTiling packet_tiling(int width, int height, int packet) {
   return t;
 }
 
-std::vector<std::uint32_t> packet_pixels(const PacketTiling& t, int width, int height, int index) {
-  std::vector<std::uint32_t> px(static_cast<std::size_t>(t.tile_width * t.tile_height),
-                                memif::kNone);
+namespace {
+
+void fill_packet_pixels(const PacketTiling& t, int width, int height, int index,
+                        std::vector<std::uint32_t>& px) {
+  px.assign(static_cast<std::size_t>(t.tile_width * t.tile_height), memif::kNone);
   const int x0 = (index % t.tiles_x) * t.tile_width;
   const int y0 = (index / t.tiles_x) * t.tile_height;
   for (int j = 0; j < t.tile_height; ++j)
@@ -40,6 +42,13 @@ std::vector<std::uint32_t> packet_pixels(const PacketTiling& t, int width, int h
         px[static_cast<std::size_t>(j * t.tile_width + i)] =
             static_cast<std::uint32_t>(y * width + x);
     }
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> packet_pixels(const PacketTiling& t, int width, int height, int index) {
+  std::vector<std::uint32_t> px;
+  fill_packet_pixels(t, width, height, index, px);
   return px;
 }
 
@@ -115,8 +124,10 @@ FunctionalFrame run_functional(const memif::MemoryImage& image, const Functional
   frame.height = h;
   frame.params = params;
   const int total = tiling.count();
+  std::vector<std::uint32_t> pixels;  // reused: no allocation per packet
   for (int p = 0; p < total; ++p) {
-    thread.start_primary(packet_pixels(tiling, w, h, p));
+    fill_packet_pixels(tiling, w, h, p, pixels);
+    thread.start_primary(pixels);
     frame.units.requests += thread.run();
     if (progress && ((p + 1) % 1024 == 0 || p + 1 == total)) progress(p + 1, total);
   }

@@ -249,11 +249,11 @@ class ThreadProgram {
   void start_primary(const std::vector<std::uint32_t>& pixel) {
     pending_.clear();
     const auto width = static_cast<std::uint32_t>(sink_.width);
-    Packet pk;
+    Packet& pk = gen_;  // built in place (begin_packet's copy is then a self-assignment)
     pk.kind = RayKind::kPrimary;
     pk.depth = 0;
     pk.shared_origin = params_.shared_origin;
-    pk.lanes.resize(lanes_.size());
+    pk.lanes.assign(lanes_.size(), GenLane{});
     for (int i = 0; i < p_; ++i) {
       auto& g = pk.lanes[static_cast<std::size_t>(i)];
       g.t = cam_;
@@ -263,7 +263,9 @@ class ThreadProgram {
       g.valid = true;
       g.pixel = px;
       g.weight = 255;
-      g.rd = {F::from_int(px % width), F::from_int(px / width), F::one()};
+      // The pixel coordinates as F (exact binary64 integers, rounded once: as F::from_int).
+      g.rd = {u_.raw.from_double(static_cast<double>(px % width)),
+              u_.raw.from_double(static_cast<double>(px / width)), F::one()};
     }
     begin_packet(pk);
   }
@@ -450,7 +452,7 @@ class ThreadProgram {
   using Mat64 = MatrixValues<F>;
   Mat64 matrix_values(const Mat34<F>& m) const {
     Mat64 v = units::matrix_values(m, u_.raw.mode().subnormals);
-    v.safe &= nearest_;
+    v.nearest = nearest_;
     return v;
   }
   Vec3<F> transform(const Mat34<F>& m, const Mat64& mv, const Vec3<F>& v, bool translate) const {
@@ -483,14 +485,20 @@ class ThreadProgram {
     count_transform();
     const auto& g0 = gen_.lanes[0];
     Vec3<F> shared{};
-    if (shared_origin_) shared = transform(g0.t, matrix_values(g0.t), g0.ro, true);
+    Mat34<F> mt = g0.t;
+    Mat64 mv = matrix_values(g0.t);
+    if (shared_origin_) shared = transform(g0.t, mv, g0.ro, true);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
       if (!l.valid) {
         l.world.o = shared;
       } else {
-        const Mat64 mv = matrix_values(g.t);
+        // Lanes usually share T (primary rays: the camera's); decode it once per distinct T.
+        if (!(g.t == mt)) {
+          mt = g.t;
+          mv = matrix_values(g.t);
+        }
         l.world.o = shared_origin_ ? shared : transform(g.t, mv, g.ro, true);
         l.world.d = transform(g.t, mv, g.rd, false);
       }
@@ -654,6 +662,10 @@ class ThreadProgram {
       return;
     }
     ++u_.inner_steps;
+    // Host-side prefetch of both children's node words (one of them is the next step's node,
+    // the other may be pushed): no effect on results.
+    prefetch_node(node.child_pair);
+    prefetch_node(node.child_pair + 1);
     PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, 2 * lanes);  // traversal_lane
     const int axis = static_cast<int>(node.axis);
     const F split = F::from_bits(node.split);
@@ -698,6 +710,11 @@ class ThreadProgram {
     }
   }
 
+  void prefetch_item(memif::ItemType t, std::uint32_t index, int word = 0) const {
+    const memif::WordLocation w = image_.locate(t, index, word);
+    __builtin_prefetch(image_.bank(w.bank).data() + w.offset);
+  }
+  void prefetch_node(std::uint32_t index) const { prefetch_item(memif::ItemType::kNode, index); }
   void push(std::uint32_t node, std::uint64_t mask, const std::array<double, kMaxPacket>& far_tn) {
     if (stack_size_ >= stack_node_.size())
       throw std::runtime_error("functional model: traversal stack overflow (depth " +
