@@ -150,8 +150,9 @@ TEST(DynRtc, PrototypeOnTheRoomBesideTable4) {
   const double predicted =
       static_cast<double>(u.intersection_packets * 4) / static_cast<double>(u.transformation_steps);
   EXPECT_NEAR(ratio, predicted, 0.01);
-  // The issue's band (paper: 0.41-0.65 over its scenes). The room sits near the top: its tree
-  // gives about 12 triangle tests per packet against Scene6's ~3 (docs/cycle-model.md).
+  // The issue's band (paper: 0.41-0.65 over its scenes). The room's tree gives about 2.4
+  // triangle tests per packet (Scene6's calibration: ~3), near the band's bottom
+  // (docs/cycle-model.md).
   EXPECT_GT(ratio, 0.4);
   EXPECT_LT(ratio, 0.7);
   EXPECT_EQ(c.issue_cycles[2], u.transformation_steps);
