@@ -306,7 +306,9 @@ void build_top_level(BuiltImage& b) {
   if (boxes.empty()) {
     b.top = empty_tree();
   } else {
-    b.top = build_kdtree(std::span<const Aabb>(boxes), b.params.kd);
+    KdBuildParams top = b.params.kd;
+    top.intersection_cost *= b.params.top_item_cost_factor;
+    b.top = build_kdtree(std::span<const Aabb>(boxes), top);
     for (std::uint32_t& item : b.top.items)
       item = which.at(item);
   }
@@ -636,6 +638,10 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
     throw std::runtime_error("image format " + ff::format_name(params.format) +
                              " is not supported");
   if (params.bank_words == 0) throw std::runtime_error("bank size must be at least one word");
+  if (!(params.top_item_cost_factor > 0.0f) || !std::isfinite(params.top_item_cost_factor))
+    throw std::runtime_error("top-level item cost factor " +
+                             std::to_string(params.top_item_cost_factor) +
+                             " must be positive and finite");
   BuiltImage b;
   b.params = params;
   b.params.kd.split_format = params.format;

@@ -31,6 +31,10 @@ struct ImageParams {
   ff::Format format = ff::kFp24;                        // every float in the image
   std::uint32_t bank_words = memif::kDefaultBankWords;  // 32-bit words per bank (1M = 4 MB)
   KdBuildParams kd;  // both levels; kd.split_format is forced to `format`
+  // The top level's item cost in units of kd.intersection_cost. A top-level item is an object
+  // visit: a transformation like a triangle test's, a 6-cycle box clip, the bottom tree's descent
+  // and its own triangle tests, about 16 triangle tests' worth (docs/kdtree.md, "Top level").
+  float top_item_cost_factor = 16.0f;
   int width = 512;
   int height = 384;
   int camera = -1;  // index into Scene::cameras; -1 = scene_camera() (first camera, else default)

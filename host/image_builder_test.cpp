@@ -499,6 +499,13 @@ TEST(ImageBuilder, BadInputsGiveOneLineErrors) {
   ImageParams size = small_params();
   size.width = 0;
   EXPECT_NE(error_of(few_triangles(), size).find("image size 0x48"), std::string::npos);
+
+  for (const float factor : {0.0f, -1.0f, std::nanf(""), HUGE_VALF}) {
+    ImageParams top = small_params();
+    top.top_item_cost_factor = factor;
+    EXPECT_NE(error_of(few_triangles(), top).find("top-level item cost factor"), std::string::npos)
+        << factor;
+  }
 }
 
 TEST(ImageBuilder, FlaggedDegenerateTrianglesAreDropped) {
