@@ -23,6 +23,7 @@
 #include "host/kdtree.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -179,11 +180,16 @@ struct Box {
   float lo[3];
   float hi[3];
 };
-double box_half_area(const Box& b) {
-  const double d[3] = {static_cast<double>(b.hi[0]) - b.lo[0],
-                       static_cast<double>(b.hi[1]) - b.lo[1],
-                       static_cast<double>(b.hi[2]) - b.lo[2]};
+// Extents in binary64 (exact for binary32 bounds) and the half surface area from them.
+std::array<double, 3> extents(const Box& b) {
+  return {static_cast<double>(b.hi[0]) - b.lo[0], static_cast<double>(b.hi[1]) - b.lo[1],
+          static_cast<double>(b.hi[2]) - b.lo[2]};
+}
+double half_area(const std::array<double, 3>& d) {
   return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+}
+double half_area(const Box& b) {
+  return half_area(extents(b));
 }
 
 // Item side after classification. kBoth items are dropped from the old lists (they get new
@@ -453,7 +459,7 @@ void Builder::run() {
   tree_.bounds.lo = glm::vec3(root_.lo[0], root_.lo[1], root_.lo[2]);
   tree_.bounds.hi = glm::vec3(root_.hi[0], root_.hi[1], root_.hi[2]);
   const std::size_t n = items_.top_;
-  min_half_area_ = box_half_area(root_) * kMinAreaShare;
+  min_half_area_ = half_area(root_) * kMinAreaShare;
   bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n));
 }
 
@@ -507,12 +513,10 @@ void Builder::exact_subtree(std::uint32_t node, int depth, const Box& box, std::
 BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
                                        std::uint32_t n) const {
   BinnedSplit best;
-  const double d[3] = {static_cast<double>(box.hi[0]) - box.lo[0],
-                       static_cast<double>(box.hi[1]) - box.lo[1],
-                       static_cast<double>(box.hi[2]) - box.lo[2]};
-  const double half_area = d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
-  if (!(half_area > 0.0)) return best;
-  const double inv_area = 1.0 / half_area;
+  const std::array<double, 3> d = extents(box);
+  const double area = half_area(d);
+  if (!(area > 0.0)) return best;
+  const double inv_area = 1.0 / area;
   const double kt = p_.traversal_cost;
   const double ki = p_.intersection_cost;
   const double bonus = p_.empty_bonus;
@@ -714,7 +718,7 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
     return;
   }
   if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth ||
-      box_half_area(box) < min_half_area_) {
+      half_area(box) < min_half_area_) {
     leaf_scratch_.clear();
     for (std::uint32_t i = 0; i < n; ++i)
       leaf_scratch_.push_back(items_.data()[b + i].id);
@@ -800,12 +804,10 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
 Split Builder::find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
                           std::uint32_t n) const {
   Split best;
-  const double d[3] = {static_cast<double>(box.hi[0]) - box.lo[0],
-                       static_cast<double>(box.hi[1]) - box.lo[1],
-                       static_cast<double>(box.hi[2]) - box.lo[2]};
-  const double half_area = d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
-  if (!(half_area > 0.0)) return best;  // a line or a point: no plane can separate anything
-  const double inv_area = 1.0 / half_area;
+  const std::array<double, 3> d = extents(box);
+  const double area = half_area(d);
+  if (!(area > 0.0)) return best;  // a line or a point: no plane can separate anything
+  const double inv_area = 1.0 / area;
   const double kt = p_.traversal_cost;
   const double ki = p_.intersection_cost;
   const double bonus = p_.empty_bonus;
@@ -1138,7 +1140,7 @@ std::size_t split_events(const Key* ev, std::size_t n, const std::uint8_t* side,
 void Builder::build_node(std::uint32_t node, int depth, const Box& box, const std::size_t b[3],
                          const std::size_t e[3], std::uint32_t n) {
   if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth ||
-      box_half_area(box) < min_half_area_) {
+      half_area(box) < min_half_area_) {
     make_leaf(node, b[0], e[0]);
     return;
   }
@@ -1287,13 +1289,6 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
   build_node(child + 1, depth + 1, rbox, rb, re, n_right);
   for (int j = 0; j < 3; ++j)
     ev_[j].top_ = lb[j];
-}
-
-double half_area(const Box& b) {
-  const double d0 = static_cast<double>(b.hi[0]) - b.lo[0];
-  const double d1 = static_cast<double>(b.hi[1]) - b.lo[1];
-  const double d2 = static_cast<double>(b.hi[2]) - b.lo[2];
-  return d0 * d1 + d1 * d2 + d2 * d0;
 }
 
 }  // namespace
