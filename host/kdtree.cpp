@@ -300,8 +300,8 @@ class Builder {
   void emit_leaf(std::uint32_t node, std::vector<std::uint32_t>& ids);
   Split find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
                    std::uint32_t n) const;
-  void face_slabs(const Box& box, int k, std::size_t b, std::size_t e, std::uint32_t n,
-                  double inv_area, Split& best) const;
+  void face_slabs(const Box& box, int k, double sum, double prod, std::size_t b, std::size_t e,
+                  std::uint32_t n, double inv_area, Split& best) const;
   int clip_split(std::uint32_t id, const Box& box, int axis, float split, float llo[3],
                  float lhi[3], float rlo[3], float rhi[3]) const;
   void add_clipped(std::uint32_t id, const float lo[3], const float hi[3], std::vector<Key>* out);
@@ -869,7 +869,7 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
       pending = 0;
       np = 0;
     }
-    face_slabs(box, k, b[k], e[k], n, inv_area, face);
+    face_slabs(box, k, sum, prod, b[k], e[k], n, inv_area, face);
   }
   // A face slab wins when it is cheaper, and also when no other plane beats the leaf but the slab
   // lies within the slack (build_node applies the slack to it).
@@ -885,18 +885,13 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
 // slab's width inside the face does: the thin slab holds the face's items and is entered only by
 // rays near the face. The width is a fixed share of the root extent so that the traversal's
 // rounded plane distances (about 2^-15 of the distance, fp24) cannot skip the slab.
-void Builder::face_slabs(const Box& box, int k, std::size_t b, std::size_t e, std::uint32_t n,
-                         double inv_area, Split& best) const {
+// sum, prod: the sum and product of the box's two other extents (the sweep's per-axis constants).
+void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::size_t b,
+                         std::size_t e, std::uint32_t n, double inv_area, Split& best) const {
   const double width = (static_cast<double>(root_.hi[k]) - root_.lo[k]) * kFaceSlabShare;
   const float lo = box.lo[k];
   const float hi = box.hi[k];
   if (!(static_cast<double>(hi) - lo > 4.0 * width) || !(width > 0.0)) return;
-  const int j = (k + 1) % 3;
-  const int l = (k + 2) % 3;
-  const double dj = static_cast<double>(box.hi[j]) - box.lo[j];
-  const double dl = static_cast<double>(box.hi[l]) - box.lo[l];
-  const double sum = dj + dl;
-  const double prod = dj * dl;
   const Key* ev = ev_[k].data();
   auto evaluate = [&](float x, std::uint32_t nl, std::uint32_t nr) {
     const double al = (static_cast<double>(x) - lo) * sum + prod;
