@@ -46,6 +46,10 @@ void ChannelBase::misuse(const char* what) const {
 [[gnu::always_inline]] inline int ChannelBase::commit_now() {
   const int pushes = pushes_, pops = pops_;
   const std::uint64_t now = *now_;
+  // A producer sees its output only through can_push(), which a pop turns from false to true only
+  // when the channel was full (the per-cycle width is reset by the cycle itself, and a producer
+  // that pushed in this cycle is evaluated next cycle anyway).
+  const bool was_full = count_ == capacity_;
   // The old occupancy held from last_change_ through this cycle (also when it does not change:
   // the integral is the same either way, and no branch is taken).
   occupancy_area_ += static_cast<std::uint64_t>(count_) * (now + 1 - last_change_);
@@ -70,7 +74,7 @@ void ChannelBase::misuse(const char* what) const {
   std::uint64_t* wake = wakes_->data();
   const std::uint64_t consumer_at =
       pushes != 0 ? now + static_cast<std::uint64_t>(latency_) : kNever;
-  const std::uint64_t producer_at = pops != 0 ? now + 1 : kNever;
+  const std::uint64_t producer_at = pops != 0 && was_full ? now + 1 : kNever;
   wake[consumer_slot_] = std::min(wake[consumer_slot_], consumer_at);
   wake[producer_slot_] = std::min(wake[producer_slot_], producer_at);
   pushes_ = pops_ = 0;

@@ -63,10 +63,12 @@ class Module {
   // state, on time through next_wakeup(), and on the channels it declared with consumes() and
   // produces() (each of its channels, every end it touches). The kernel then evaluates it only in
   // cycles where something it depends on may have changed: the cycle after it made progress, an
-  // item pushed to one of its inputs becoming visible, a pop freeing room in one of its outputs,
-  // its next_wakeup(), and the first cycle of every run()/step(). Skipped cycles would have
-  // repeated its last idle cycle exactly, so every figure is the same as evaluating every cycle
-  // (KernelConfig::idle_skip = false evaluates every module every cycle: the reference).
+  // item pushed to one of its inputs becoming visible, a pop freeing room in one of its outputs
+  // that was full, its next_wakeup(), and the first cycle of every run()/step(). (So a producer
+  // may look at its outputs only through can_push()/push(): their occupancy is not an event.)
+  // Skipped cycles would have repeated its last idle cycle exactly, so every figure is the same as
+  // evaluating every cycle (KernelConfig::idle_skip = false evaluates every module every cycle: the
+  // reference).
   void sleep_when_idle() { sleeps_ = true; }
   // This module pops from `c` (its one consumer) / pushes into `c` (its one producer). Throws
   // std::logic_error if another module already holds that end.
