@@ -144,6 +144,9 @@ class Channel : public ChannelBase {
         items_(static_cast<std::size_t>(mask_) + 1) {}
 
   void push(T item) { items_[static_cast<std::size_t>(reserve_push())] = std::move(item); }
+  // Books a push and returns its slot to be filled in place (an item built field by field is
+  // not copied once more on the way in).
+  T& push_slot() { return items_[static_cast<std::size_t>(reserve_push())]; }
   const T& peek() const { return items_[static_cast<std::size_t>(front_slot())]; }
   T pop() { return std::move(items_[static_cast<std::size_t>(reserve_pop())]); }
 

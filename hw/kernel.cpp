@@ -50,10 +50,12 @@ void ChannelBase::misuse(const char* what) const {
   // when the channel was full (the per-cycle width is reset by the cycle itself, and a producer
   // that pushed in this cycle is evaluated next cycle anyway).
   const bool was_full = count_ == capacity_;
-  // The old occupancy held from last_change_ through this cycle (also when it does not change:
-  // the integral is the same either way, and no branch is taken).
-  occupancy_area_ += static_cast<std::uint64_t>(count_) * (now + 1 - last_change_);
-  last_change_ = now + 1;
+  // The old occupancy held from last_change_ through this cycle; it is integrated when it
+  // changes (the average's formula adds the part since the last change).
+  if (pushes != pops) {
+    occupancy_area_ += static_cast<std::uint64_t>(count_) * (now + 1 - last_change_);
+    last_change_ = now + 1;
+  }
   // An empty slot is never poppable (the popped ones kept their cycle until now for valid()).
   if (width_ == 1) {
     std::uint64_t& front = ready_at_[static_cast<std::size_t>(head_)];
@@ -68,7 +70,7 @@ void ChannelBase::misuse(const char* what) const {
   // The statistics are kept here and handed to the registry when the kernel brings the
   // statistics up to date (Kernel::account_all).
   pending_pushes_ += static_cast<std::uint64_t>(pushes);
-  max_count_ = std::max(max_count_, count_);
+  if (pushes > pops) max_count_ = std::max(max_count_, count_);
   // Event scheduling: the items pushed now become visible after the latency; the slots popped now
   // are free for the producer next cycle.
   std::uint64_t* wake = wakes_->data();

@@ -116,12 +116,11 @@ int Cache::deliver() {
     stall();
     return 0;
   }
-  CacheResponse r;
+  CacheResponse& r = out.push_slot();
   r.index = m.item;
   r.label = m.targets.front().label;
   r.words = m.words;
   r.count = words_;
-  out.push(r);
   m.targets.pop_front();
   if (m.targets.empty()) {
     m.busy = false;
@@ -173,12 +172,11 @@ int Cache::lookup(bool port_free) {
         stall();
         return 0;
       }
-      CacheResponse r;
+      CacheResponse& r = out.push_slot();
       r.index = req.index;
       r.label = req.label;
       r.words = l.words;
       r.count = words_;
-      out.push(r);
       l.lru = ++use_clock_;
       ++*hits_;
       accepted();

@@ -38,7 +38,11 @@ int CycleUnit::evaluate() {
   if (deliver_at_ <= now()) progress += deliver();
   if (steps_left_ != 0 || chained_ || !ready_.empty()) progress += issue();
   if (cache_responses_ != nullptr && cache_responses_->can_pop()) progress += receive();
-  if (fetching_ || input_waiting()) progress += accept();
+  if (fetching_) {
+    progress += accept(nullptr);
+  } else if (ThreadPath* from = waiting_input()) {
+    progress += accept(from);
+  }
   if (has_extra_) progress += extra();
   if (progress == 0 && inside_ > 0) stall();  // threads inside, all waiting for memory
   return progress;
@@ -114,15 +118,8 @@ int CycleUnit::receive() {
   return 1;
 }
 
-int CycleUnit::accept() {
+int CycleUnit::accept(ThreadPath* from) {
   if (!fetching_) {
-    ThreadPath* from = nullptr;
-    for (ThreadPath* p : inputs_)
-      if (p->can_pop()) {
-        from = p;
-        break;
-      }
-    if (from == nullptr) return 0;
     const ThreadToken t = from->pop();
     ++inside_;
     const Fetch f = fetch(threads_.request(t));

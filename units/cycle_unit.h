@@ -122,7 +122,7 @@ class CycleUnit : public hw::Module {
   int deliver();  // threads whose pipeline latency elapsed leave on their next path
   int issue();    // the issue slot: one step of the current request, or the next ready thread
   int receive();  // one cache response: its thread becomes ready when all its items arrived
-  int accept();   // one thread from the input paths; its cache requests go out one per cycle
+  int accept(ThreadPath* from);  // one thread from `from` (null while fetching); one request out
 
   ThreadTable& threads_;
   std::array<ThreadPath*, kUnitCount> outputs_{};
@@ -134,11 +134,11 @@ class CycleUnit : public hw::Module {
     std::uint64_t done_at;
     ThreadToken thread;
   };
-  // Whether a thread waits on an input path (accept() has one to take).
-  bool input_waiting() const {
-    for (const ThreadPath* p : inputs_)
-      if (p->can_pop()) return true;
-    return false;
+  // The first input path (in priority order) with a thread to take; null if none.
+  ThreadPath* waiting_input() const {
+    for (ThreadPath* p : inputs_)
+      if (p->can_pop()) return p;
+    return nullptr;
   }
 
   UnitId id_;
