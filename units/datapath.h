@@ -264,11 +264,11 @@ inline MatrixValues<F> matrix_values(const Mat34<F>& m, ff::Subnormals s) {
   return v;
 }
 
-// false: the exponent condition above fails, an operand is not normal, or the mode is not
-// nearest-even; use transform_step.
+// true when the exponent condition above holds for this vector, every operand is normal or zero
+// and the mode is nearest-even: then transform_step64 and transform_pair64 decide the step.
 template <class F>
-[[gnu::always_inline]] inline bool transform_step64(const MatrixValues<F>& mv, const Vec3<F>& v,
-                                                    bool translate, Vec3<F>& out) {
+[[gnu::always_inline]] inline bool transform_decides(const MatrixValues<F>& mv, const Vec3<F>& v,
+                                                     bool translate) {
   ExponentRange rv;
   rv.include(v[0]);
   rv.include(v[1]);
@@ -276,9 +276,15 @@ template <class F>
   const ExponentRange t = translate ? mv.translation : ExponentRange{};
   const int low = std::min(mv.linear.lo + rv.lo, t.lo) - F::kManBits;
   const int high = std::max(mv.linear.hi + rv.hi + 2, t.hi + 1);
-  if (!(mv.nearest & mv.linear.normal & t.normal & rv.normal & (low >= F::kFormat.emin()) &
-        (high + 2 <= F::kFormat.emax())))
-    return false;
+  return mv.nearest & mv.linear.normal & t.normal & rv.normal & (low >= F::kFormat.emin()) &
+         (high + 2 <= F::kFormat.emax());
+}
+
+// false: transform_decides does not hold; use transform_step.
+template <class F>
+[[gnu::always_inline]] inline bool transform_step64(const MatrixValues<F>& mv, const Vec3<F>& v,
+                                                    bool translate, Vec3<F>& out) {
+  if (!transform_decides<F>(mv, v, translate)) return false;
   // Normal or zero operands: value_of's subnormal mode does not matter.
   const std::array<double, 3> x = {value_of(v[0], ff::Subnormals::kFlush),
                                    value_of(v[1], ff::Subnormals::kFlush),
@@ -293,6 +299,72 @@ template <class F>
         encoding_of<F>(round_in_range<F>(round_in_range<F>(a + b) + round_in_range<F>(c + tk)));
   }
   return true;
+}
+
+// ---- two lanes at a time ----------------------------------------------------------------------
+// The same value paths on pairs of lanes (GCC/Clang vector extensions: one SSE2 register per pair
+// on x86-64). Every lane's op sequence is unchanged, so each lane's results are those of the
+// scalar functions above; the rounding to F's precision is the same integer arithmetic on the
+// binary64 bit patterns, lane by lane.
+using V2d = double __attribute__((vector_size(16)));
+using V2u = std::uint64_t __attribute__((vector_size(16)));
+using V2i = std::int64_t __attribute__((vector_size(16)));
+
+// round_in_range on both lanes.
+template <class F>
+[[gnu::always_inline]] inline V2d round_in_range2(V2d v) {
+  constexpr int kShift = 52 - F::kManBits;
+  constexpr std::uint64_t kLowBits = (std::uint64_t{1} << kShift) - 1u;
+  const auto u = std::bit_cast<V2u>(v);
+  return std::bit_cast<V2d>((u + (kLowBits >> 1) + ((u >> kShift) & 1u)) & ~kLowBits);
+}
+
+// The exact values of two encodings that are zero or normal (value_of; the subnormal mode does not
+// matter for them). The magnitude is decoded as if normal: a zero then lands on 2^-bias, which no
+// normal value of F equals, and is cleared there.
+template <class F>
+[[gnu::always_inline]] inline V2d decode_pair(std::uint32_t a, std::uint32_t b) {
+  constexpr int kShift = 52 - F::kManBits;
+  constexpr std::uint64_t kRebias = static_cast<std::uint64_t>(1023 - F::kFormat.bias()) << 52;
+  constexpr std::uint64_t kMag = F::kFormat.sign_mask() - 1u;
+  constexpr double kZeroImage = std::bit_cast<double>(kRebias);
+  const V2u e = {a, b};
+  const V2u sign = (e >> (F::kExpBits + F::kManBits)) << 63;
+  V2u mag = ((e & kMag) << kShift) + kRebias;
+  mag &= ~std::bit_cast<V2u>(std::bit_cast<V2d>(mag) == kZeroImage);
+  return std::bit_cast<V2d>(mag | sign);
+}
+
+// encoding_of on both lanes (values that are zero or normal in F and on its grid).
+template <class F>
+[[gnu::always_inline]] inline V2u encode_pair(V2d v) {
+  constexpr int kShift = 52 - F::kManBits;
+  constexpr std::uint64_t kRebias = static_cast<std::uint64_t>(1023 - F::kFormat.bias()) << 52;
+  const auto u = std::bit_cast<V2u>(v);
+  const V2u mag = u & ~(std::uint64_t{1} << 63);
+  const auto zero = std::bit_cast<V2u>(v == 0.0);
+  return (((mag - kRebias) >> kShift) & ~zero) | ((u >> 63) << (F::kExpBits + F::kManBits));
+}
+template <class F>
+[[gnu::always_inline]] inline Vec3<F> lane_of(const V2u (&e)[3], int lane) {
+  return {F{static_cast<std::uint32_t>(e[0][lane])}, F{static_cast<std::uint32_t>(e[1][lane])},
+          F{static_cast<std::uint32_t>(e[2][lane])}};
+}
+
+// transform_step64's arithmetic for two vectors x (components as pairs); each lane must satisfy
+// transform_decides (lanes that do not give meaningless results, to be discarded).
+template <class F>
+[[gnu::always_inline]] inline void transform_pair64(const MatrixValues<F>& mv, const V2d (&x)[3],
+                                                    bool translate, V2u (&out)[3]) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& m = mv.m[k];
+    const double tk = translate ? m[3] : 0.0;
+    const V2d a = round_in_range2<F>(m[0] * x[0]);
+    const V2d b = round_in_range2<F>(m[1] * x[1]);
+    const V2d c = round_in_range2<F>(m[2] * x[2]);
+    out[k] =
+        encode_pair<F>(round_in_range2<F>(round_in_range2<F>(a + b) + round_in_range2<F>(c + tk)));
+  }
 }
 
 struct TraversalLane64 {
@@ -327,6 +399,71 @@ template <class F>
   else
     tf = t < tf ? t : tf;
   return true;
+}
+
+// round_to_format on both lanes; a lane of `ok` is cleared unless its result is zero or normal
+// and finite in F. The same decision as round_to_format's integer tests, made by double compares
+// of the rounded magnitude: a non-finite input rounds to inf or NaN, which fails them too
+// (tested in units/datapath_test.cpp).
+template <class F>
+[[gnu::always_inline]] inline V2d round_to_format2(V2d v, V2i& ok) {
+  constexpr double kMin =
+      std::bit_cast<double>(static_cast<std::uint64_t>(1023 + F::kFormat.emin()) << 52);
+  constexpr double kLimit =
+      std::bit_cast<double>(static_cast<std::uint64_t>(1023 + F::kFormat.emax() + 1) << 52);
+  const V2d r = round_in_range2<F>(v);
+  const auto mag = std::bit_cast<V2d>(std::bit_cast<V2u>(r) & ~(std::uint64_t{1} << 63));
+  ok &= ((mag >= kMin) & (mag < kLimit)) | (r == 0.0);
+  return r;
+}
+
+// Lane-wise select: c ? a : b for a compare result c (all ones or zero per lane).
+[[gnu::always_inline]] inline V2d select2(V2i c, V2d a, V2d b) {
+  const auto m = std::bit_cast<V2u>(c);
+  return std::bit_cast<V2d>((m & std::bit_cast<V2u>(a)) | (~m & std::bit_cast<V2u>(b)));
+}
+
+// The lanes of a compare result as bits 0 and 1.
+[[gnu::always_inline]] inline std::uint64_t mask2(V2i c) {
+#if defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
+  return static_cast<std::uint64_t>(__builtin_ia32_movmskpd(std::bit_cast<V2d>(c)));
+#else
+  return static_cast<std::uint64_t>((c[0] & 1) | (c[1] & 2));
+#endif
+}
+
+// traversal_lane64 on two lanes. go_near, go_far and fail as bits 0 and 1; a failed lane (not
+// decided here, as traversal_lane64's false) must be redone with traversal_lane.
+struct TraversalPair64 {
+  std::uint64_t go_near = 0, go_far = 0, fail = 0;
+  V2d near_tf{}, far_tn{};
+};
+template <class F>
+[[gnu::always_inline]] inline TraversalPair64 traversal_pair64(V2d split, V2d o_axis, V2d inv_d,
+                                                               V2d tn, V2d tf) {
+  V2i ok = {-1, -1};
+  const V2d d = round_to_format2<F>(round_to_format2<F>(split - o_axis, ok) * inv_d, ok);
+  const V2i before = d < tn;  // not go_near
+  const V2i after = tf < d;   // not go_far
+  TraversalPair64 r;
+  r.go_near = ~mask2(before) & 3u;
+  r.go_far = ~mask2(after) & 3u;
+  r.fail = ~mask2(ok) & 3u;
+  r.near_tf = select2(after, tf, d);  // go_far ? d : tf
+  r.far_tn = select2(before, tn, d);  // go_near ? d : tn
+  return r;
+}
+
+// clip_face64 on two lanes (plane per lane); lanes of `ok` are cleared where it would return
+// false (then tn, tf of that lane are meaningless and the caller redoes the lane).
+template <class F>
+[[gnu::always_inline]] inline void clip_face_pair64(V2d plane, V2d o_axis, V2d inv_d, bool entry,
+                                                    V2d& tn, V2d& tf, V2i& ok) {
+  const V2d t = round_to_format2<F>(round_to_format2<F>(plane - o_axis, ok) * inv_d, ok);
+  if (entry)
+    tn = select2(tn < t, t, tn);
+  else
+    tf = select2(t < tf, t, tf);
 }
 
 // ---- intersection unit (paper 2.1.2, DESIGN.md 5: 3 add, 2 mul, 1 div per ray) --------------

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <bit>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -331,6 +334,132 @@ TEST(Binary64Paths, AgreeWithTheEncodingPaths) {
     check_binary64_paths<ff::Float<7, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
     check_binary64_paths<ff::Float<8, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
     check_binary64_paths<ff::Float<7, 10>>({ff::Rounding::kNearestEven, s}, n / 4);
+  }
+}
+
+// The two-lane forms (thread program) against the one-lane value paths, lane by lane.
+template <class G>
+void check_pair_paths(ff::Mode mode, int n) {
+  std::mt19937_64 rng(77);
+  const RawFp<G, false> fp(mode);
+  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
+  const auto value = [&](G x) { return value_of(x, mode.subnormals); };
+  const auto same = [](double a, double b) {
+    return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+  };
+  int decided_lanes = 0, transforms = 0;
+  for (int it = 0; it < n; ++it) {
+    // round_to_format2 on arbitrary binary64 patterns (specials included) and on values near F's
+    // range limits.
+    std::array<double, 2> x;
+    for (auto& v : x) {
+      const std::uint64_t r = rng();
+      v = (r & 3u) == 0 ? std::bit_cast<double>(rng())
+                        : std::ldexp(std::bit_cast<double>((r >> 12) | 0x3FF0000000000000ull),
+                                     static_cast<int>(rng() % 8) - 4 +
+                                         ((r & 4u) != 0 ? G::kFormat.emin() : G::kFormat.emax()));
+    }
+    V2i ok = {-1, -1};
+    const V2d r = round_to_format2<G>(V2d{x[0], x[1]}, ok);
+    for (int k = 0; k < 2; ++k) {
+      bool ok1 = true;
+      const double r1 = round_to_format<G>(x[static_cast<std::size_t>(k)], ok1);
+      ASSERT_EQ(ok[k] != 0, ok1) << x[static_cast<std::size_t>(k)];
+      if (ok1) {
+        ASSERT_TRUE(same(r[k], r1));
+      }
+    }
+    // Traversal and clip on two lanes.
+    std::array<double, 2> split, o, inv, tn, tf;
+    for (std::size_t k = 0; k < 2; ++k) {
+      split[k] = value(op());
+      o[k] = value(op());
+      inv[k] = traversal_reciprocal(fp, op());
+      G a = op(), b = op();
+      if (bits_nan(a)) a = G::zero();
+      if (bits_nan(b)) b = G::infinity();
+      tn[k] = value(a);
+      tf[k] = value(b);
+    }
+    const auto v2 = [](const std::array<double, 2>& a) { return V2d{a[0], a[1]}; };
+    const TraversalPair64 p = traversal_pair64<G>(v2(split), v2(o), v2(inv), v2(tn), v2(tf));
+    for (std::size_t k = 0; k < 2; ++k) {
+      TraversalLane64 r1;
+      const bool decided = traversal_lane64<G>(split[k], o[k], inv[k], tn[k], tf[k], r1);
+      ASSERT_EQ(((p.fail >> k) & 1u) == 0, decided);
+      if (!decided) continue;
+      ++decided_lanes;
+      ASSERT_EQ(((p.go_near >> k) & 1u) != 0, r1.go_near);
+      ASSERT_EQ(((p.go_far >> k) & 1u) != 0, r1.go_far);
+      ASSERT_TRUE(same(p.near_tf[static_cast<int>(k)], r1.near_tf));
+      ASSERT_TRUE(same(p.far_tn[static_cast<int>(k)], r1.far_tn));
+    }
+    for (const bool entry : {true, false}) {
+      V2d tn2 = v2(tn), tf2 = v2(tf);
+      V2i ok2 = {-1, -1};
+      clip_face_pair64<G>(v2(split), v2(o), v2(inv), entry, tn2, tf2, ok2);
+      for (std::size_t k = 0; k < 2; ++k) {
+        double tn1 = tn[k], tf1 = tf[k];
+        const bool decided = clip_face64<G>(split[k], o[k], inv[k], entry, tn1, tf1);
+        ASSERT_EQ(ok2[static_cast<int>(k)] != 0, decided);
+        if (decided) {
+          ASSERT_TRUE(same(tn2[static_cast<int>(k)], tn1) && same(tf2[static_cast<int>(k)], tf1));
+        }
+      }
+    }
+    // Decode, encode and the transformation step on two lanes.
+    Mat34<G> m;
+    for (auto& row : m)
+      for (auto& e : row)
+        e = G::from_bits(G::one().bits ^
+                         (static_cast<std::uint32_t>(rng()) &
+                          (G::kFormat.man_mask() | G::kFormat.sign_mask() | (7u << G::kManBits))));
+    const MatrixValues<G> mv = matrix_values(m, mode.subnormals);
+    std::array<Vec3<G>, 2> v;
+    for (auto& vec : v)
+      for (auto& c : vec)
+        c = op();
+    for (int c = 0; c < 3; ++c) {
+      const V2d d = decode_pair<G>(v[0][c].bits, v[1][c].bits);
+      const V2u e = encode_pair<G>(d);
+      for (int k = 0; k < 2; ++k) {
+        const G x1 = v[static_cast<std::size_t>(k)][c];
+        if (!bits_zero(x1) && !ff::fast::is_normal<G::kExpBits, G::kManBits>(x1.bits)) continue;
+        ASSERT_TRUE(same(d[k], value(x1))) << x1.bits;
+        ASSERT_EQ(static_cast<std::uint32_t>(e[k]), x1.bits);
+      }
+    }
+    for (const bool translate : {true, false}) {
+      const V2d xs[3] = {decode_pair<G>(v[0][0].bits, v[1][0].bits),
+                         decode_pair<G>(v[0][1].bits, v[1][1].bits),
+                         decode_pair<G>(v[0][2].bits, v[1][2].bits)};
+      V2u out[3];
+      transform_pair64<G>(mv, xs, translate, out);
+      for (int k = 0; k < 2; ++k) {
+        if (!transform_decides<G>(mv, v[static_cast<std::size_t>(k)], translate)) continue;
+        ++transforms;
+        const Vec3<G> want = transform_step(fp, m, v[static_cast<std::size_t>(k)], translate);
+        const Vec3<G> got = lane_of<G>(out, k);
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(got[c].bits, want[c].bits);
+      }
+    }
+  }
+  EXPECT_GT(decided_lanes, n / 4);  // the value paths decide the common case
+  EXPECT_GT(transforms, n / 8);
+}
+
+TEST(Binary64Paths, PairFormsAgreeWithOneLane) {
+#if defined(SAARCOR_SANITIZED)
+  const int n = 10'000;
+#else
+  const int n = 200'000;
+#endif
+  for (const ff::Subnormals s : {ff::Subnormals::kFlush, ff::Subnormals::kKeep}) {
+    check_pair_paths<ff::fp24>({ff::Rounding::kNearestEven, s}, n);
+    check_pair_paths<ff::Float<7, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
+    check_pair_paths<ff::Float<8, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
+    check_pair_paths<ff::Float<7, 10>>({ff::Rounding::kNearestEven, s}, n / 4);
   }
 }
 

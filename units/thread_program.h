@@ -11,6 +11,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -205,6 +206,30 @@ struct FrameSink {
   }
 };
 
+// Direct reads of kd-nodes from the scene banks: what MemoryImage::node computes (item i of a type
+// in bank 3 + i mod 3 at word base[type] + (i div 3) * words), with the bank addresses taken once.
+// Refreshed at every primary packet, so an image rebuilt between frames is read afresh.
+class SceneView {
+ public:
+  void refresh(const memif::MemoryImage& image) {
+    for (int b = 0; b < memif::kSceneBanks; ++b)
+      bank_[static_cast<std::size_t>(b)] = image.bank(memif::kFirstSceneBank + b).data();
+    node_base_ = image.regions().base[static_cast<std::size_t>(memif::ItemType::kNode)];
+  }
+  memif::KdNode node(std::uint32_t index) const {
+    const std::uint32_t* w = node_words(index);
+    return memif::decode_node(w[0], w[1]);
+  }
+  void prefetch_node(std::uint32_t index) const { __builtin_prefetch(node_words(index)); }
+
+ private:
+  const std::uint32_t* node_words(std::uint32_t index) const {
+    return bank_[index % memif::kSceneBanks] + node_base_ + (index / memif::kSceneBanks) * 2u;
+  }
+  std::array<const std::uint32_t*, memif::kSceneBanks> bank_{};
+  std::uint32_t node_base_ = 0;
+};
+
 template <class F>
 class ThreadProgram {
  public:
@@ -230,7 +255,9 @@ class ThreadProgram {
     surf_.resize(static_cast<std::size_t>(p_));
     stack_node_.resize(static_cast<std::size_t>(params.stack_depth));
     stack_mask_.resize(static_cast<std::size_t>(params.stack_depth));
-    stack_t_.resize(static_cast<std::size_t>(params.stack_depth) * 2u * lanes_.size());
+    slots_ = p_ + (p_ & 1);
+    stack_t_.resize(static_cast<std::size_t>(params.stack_depth) * 2u *
+                    static_cast<std::size_t>(slots_));
     const auto& regs = image.registers();
     max_depth_ =
         params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth) : regs.max_depth;
@@ -248,6 +275,7 @@ class ThreadProgram {
   // The RGC hands the thread the primary packet of pixels `pixel[i]` (memif::kNone = empty lane).
   void start_primary(const std::vector<std::uint32_t>& pixel) {
     pending_.clear();
+    scene_.refresh(image_);
     const auto width = static_cast<std::uint32_t>(sink_.width);
     Packet& pk = gen_;  // built in place (begin_packet's copy is then a self-assignment)
     pk.kind = RayKind::kPrimary;
@@ -390,15 +418,24 @@ class ThreadProgram {
     std::uint32_t pixel = memif::kNone;
     std::uint32_t weight = 0;
     Ray<F> world, current, tri;
-    // The traversal unit works on binary64 values (datapath.h, traversal_lane64): O and 1/D per
-    // axis of the world and of the current ray, and the segments. Every one is the exact value of
-    // an encoding of F, so the encodings are recovered exactly where the encoding path is needed.
-    std::array<double, 3> world_o{}, world_inv{}, o{}, inv{};
-    double tn = 0.0, tf = 0.0;            // segment of the node being visited
-    double clip_tn = 0.0, clip_tf = 0.0;  // the level's clipped segment (restart of a sign group)
-    double t_best = 0.0;                  // value of hit.t
-    HitRecord<F> hit;                     // hit.t = t_best (starts at the ray's t_max)
+    HitRecord<F> hit;  // hit.t = t_best (starts at the ray's t_max)
     RayCounters counters;
+  };
+
+  // The traversal unit works on binary64 values (datapath.h, traversal_lane64): O and 1/D per
+  // axis of the world and of the current (object) ray, and the segments. Every one is the exact
+  // value of an encoding of F, so the encodings are recovered exactly where the encoding path is
+  // needed. Kept per packet as arrays over the lanes, so two lanes go through one vector op
+  // (datapath.h, traversal_pair64); slots from P up to the next even count are padding, computed
+  // along and never used. A lane's tn, tf are meaningful only while it is in the packet's mask:
+  // it enters the mask only where they are set (start of a sign group, pop, the near child), so
+  // whole-array copies may overwrite the others.
+  using Slots = std::array<double, kMaxPacket>;
+  struct alignas(16) LaneValues {
+    std::array<Slots, 3> world_o{}, world_inv{}, o{}, inv{};
+    Slots tn{}, tf{};            // segment of the node being visited
+    Slots clip_tn{}, clip_tf{};  // the level's clipped segment (restart of a sign group)
+    Slots t_best{};              // value of hit.t
   };
 
   // The RGS's per-lane surface context while it shades a packet's hits.
@@ -439,13 +476,25 @@ class ThreadProgram {
     PipelineUnits<F>::count(u_.transformation_ops, 9 * steps, 9 * steps, 0, 0);
   }
   Lane& lane(int i) { return lanes_[static_cast<std::size_t>(i)]; }
-  void set_axis_values(std::array<double, 3>& o, std::array<double, 3>& inv,
+  void set_axis_values(std::array<Slots, 3>& o, std::array<Slots, 3>& inv, int i,
                        const Ray<F>& r) const {
+    const auto s = static_cast<std::size_t>(i);
     for (int k = 0; k < 3; ++k) {
-      o[static_cast<std::size_t>(k)] = u_.raw.to_double(r.o[k]);
-      inv[static_cast<std::size_t>(k)] = traversal_reciprocal(u_.raw, r.d[k]);
+      o[static_cast<std::size_t>(k)][s] = u_.raw.to_double(r.o[k]);
+      inv[static_cast<std::size_t>(k)][s] = traversal_reciprocal(u_.raw, r.d[k]);
     }
   }
+  // O and 1/D of the current level's rays.
+  const std::array<Slots, 3>& level_o() const { return level_ == Level::kTop ? v_.world_o : v_.o; }
+  const std::array<Slots, 3>& level_inv() const {
+    return level_ == Level::kTop ? v_.world_inv : v_.inv;
+  }
+  static V2d load2(const double* p) {
+    V2d v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  }
+  static void store2(double* p, V2d v) { std::memcpy(p, &v, sizeof v); }
   double value(F x) const { return value_of(x, u_.raw.mode().subnormals); }
 
   // A transformation step (transform_step) through the binary64 path where it decides.
@@ -459,6 +508,32 @@ class ThreadProgram {
     Vec3<F> out;
     if (transform_step64<F>(mv, v, translate, out)) return out;
     return transform_step(u_.raw, m, v, translate);
+  }
+  // out(i) = m * in(i) (a transformation step) for the lanes in `mask`: two lanes at a time on
+  // values where transform_decides holds for both or one of them, the others on encodings.
+  template <class In, class Out>
+  void transform_masked(const Mat34<F>& m, const Mat64& mv, std::uint64_t mask, bool translate,
+                        In in, Out out) {
+    for (int i = 0; i < p_; i += 2) {
+      const int j = i + 1 < p_ ? i + 1 : i;
+      const bool a = has(mask, i), b = j != i && has(mask, j);
+      if (!(a | b)) continue;
+      const Vec3<F>& va = in(i);
+      const Vec3<F>& vb = in(j);
+      const bool da = a && transform_decides<F>(mv, va, translate);
+      const bool db = b && transform_decides<F>(mv, vb, translate);
+      if (da | db) {
+        const V2d x[3] = {decode_pair<F>(va[0].bits, vb[0].bits),
+                          decode_pair<F>(va[1].bits, vb[1].bits),
+                          decode_pair<F>(va[2].bits, vb[2].bits)};
+        V2u r[3];
+        transform_pair64<F>(mv, x, translate, r);
+        if (da) out(i) = lane_of<F>(r, 0);
+        if (db) out(j) = lane_of<F>(r, 1);
+      }
+      if (a && !da) out(i) = transform_step(u_.raw, m, in(i), translate);
+      if (b && !db) out(j) = transform_step(u_.raw, m, in(j), translate);
+    }
   }
   F encoding(double v) const { return u_.raw.from_double(v); }  // exact: v is a value of F
   static bool has(std::uint64_t m, int i) { return ((m >> i) & 1u) != 0; }
@@ -485,30 +560,48 @@ class ThreadProgram {
     count_transform();
     const auto& g0 = gen_.lanes[0];
     Vec3<F> shared{};
-    Mat34<F> mt = g0.t;
-    Mat64 mv = matrix_values(g0.t);
-    if (shared_origin_) shared = transform(g0.t, mv, g0.ro, true);
+    const Mat64 mv0 = matrix_values(g0.t);
+    if (shared_origin_) shared = transform(g0.t, mv0, g0.ro, true);
+    // Lanes usually share T (primary rays: the camera's): those with lane 0's T two at a time,
+    // the others one by one, T decoded once per distinct T.
+    std::uint64_t same = 0, other = 0;
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
-      if (!l.valid) {
-        l.world.o = shared;
-      } else {
-        // Lanes usually share T (primary rays: the camera's); decode it once per distinct T.
+      if (!l.valid || shared_origin_) l.world.o = shared;
+      if (l.valid) (g.t == g0.t ? same : other) |= std::uint64_t{1} << i;
+    }
+    const auto gen = [&](int i) -> const GenLane& {
+      return gen_.lanes[static_cast<std::size_t>(i)];
+    };
+    if (!shared_origin_)
+      transform_masked(
+          g0.t, mv0, same, true, [&](int i) -> const Vec3<F>& { return gen(i).ro; },
+          [&](int i) -> Vec3<F>& { return lane(i).world.o; });
+    transform_masked(
+        g0.t, mv0, same, false, [&](int i) -> const Vec3<F>& { return gen(i).rd; },
+        [&](int i) -> Vec3<F>& { return lane(i).world.d; });
+    if (other != 0) {
+      Mat34<F> mt = g0.t;
+      Mat64 mv = mv0;
+      for (int i = 0; i < p_; ++i) {
+        if (!has(other, i)) continue;
+        const GenLane& g = gen(i);
         if (!(g.t == mt)) {
           mt = g.t;
           mv = matrix_values(g.t);
         }
-        l.world.o = shared_origin_ ? shared : transform(g.t, mv, g.ro, true);
-        l.world.d = transform(g.t, mv, g.rd, false);
+        if (!shared_origin_) lane(i).world.o = transform(g.t, mv, g.ro, true);
+        lane(i).world.d = transform(g.t, mv, g.rd, false);
       }
+    }
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
       l.current = l.world;
-      set_axis_values(l.world_o, l.world_inv, l.world);
-      l.o = l.world_o;
-      l.inv = l.world_inv;
+      set_axis_values(v_.world_o, v_.world_inv, i, l.world);
       l.hit = HitRecord<F>{};
       if (kind_ == RayKind::kShadow) l.hit.t = shadow_t_max_;
-      l.t_best = value(l.hit.t);
+      v_.t_best[static_cast<std::size_t>(i)] = value(l.hit.t);
       if (l.valid) ++l.counters.transformations;
     }
     if (kind_ == RayKind::kShadow) {
@@ -542,21 +635,16 @@ class ThreadProgram {
       clip_mask_ = 0;
       for (int i = 0; i < p_; ++i)
         if (lane(i).valid && !lane(i).done) clip_mask_ |= std::uint64_t{1} << i;
-      for (int i = 0; i < p_; ++i) {
+      for (int i = 0; i < p_; ++i)
         lane(i).current = lane(i).world;
-        lane(i).o = lane(i).world_o;
-        lane(i).inv = lane(i).world_inv;
-        lane(i).clip_tn = 0.0;
-        lane(i).clip_tf = lane(i).t_best;
-      }
       phase_ = Phase::kClipTop;
     } else {
       clip_mask_ = entry_mask_;
-      for (int i = 0; i < p_; ++i) {
-        lane(i).clip_tn = 0.0;
-        lane(i).clip_tf = lane(i).t_best;
-      }
       phase_ = Phase::kClipBottom;
+    }
+    for (int i = 0; i < slots_; ++i) {
+      v_.clip_tn[static_cast<std::size_t>(i)] = 0.0;
+      v_.clip_tf[static_cast<std::size_t>(i)] = v_.t_best[static_cast<std::size_t>(i)];
     }
   }
 
@@ -576,7 +664,8 @@ class ThreadProgram {
     std::array<std::uint64_t, 8> by_pattern{};
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
-      if (!has(clip_mask_, i) || l.clip_tf < l.clip_tn) continue;
+      const auto k = static_cast<std::size_t>(i);
+      if (!has(clip_mask_, i) || v_.clip_tf[k] < v_.clip_tn[k]) continue;
       const int s = (l.current.d[0].sign() ? 1 : 0) | (l.current.d[1].sign() ? 2 : 0) |
                     (l.current.d[2].sign() ? 4 : 0);
       by_pattern[static_cast<std::size_t>(s)] |= std::uint64_t{1} << i;
@@ -603,33 +692,67 @@ class ThreadProgram {
       lo_value[k] = value(box_lo_[k]);
       hi_value[k] = value(box_hi_[k]);
     }
-    for (int i = 0; i < p_; ++i) {
-      Lane& l = lane(i);
-      if (!has(clip_mask_, i)) continue;
+    const auto& lo = level_o();
+    const auto& inv = level_inv();
+    // Two lanes at a time through the six faces on values; a lane that any face does not decide
+    // there is redone alone from its start values (0, t_best), face by face as below.
+    std::uint64_t redo = 0;
+    for (int i = 0; i < p_; i += 2) {
+      const std::uint64_t lanes = (clip_mask_ >> i) & 3u;
+      if (lanes == 0) continue;
+      const Lane& l0 = lane(i);
+      const Lane& l1 = lane(i + 1 < p_ ? i + 1 : i);
+      const auto s = static_cast<std::size_t>(i);
+      V2i ok = {-1, -1};
+      V2d tn = load2(&v_.clip_tn[s]), tf = load2(&v_.clip_tf[s]);
+      for (int axis = 0; axis < 3; ++axis) {
+        const auto k = static_cast<std::size_t>(axis);
+        // Per lane: the entry face is lo for a positive direction (sign bit clear).
+        const V2i neg = {l0.current.d[axis].sign() ? -1 : 0, l1.current.d[axis].sign() ? -1 : 0};
+        const V2d lo_plane = {lo_value[k], lo_value[k]}, hi_plane = {hi_value[k], hi_value[k]};
+        const V2d o = load2(&lo[k][s]), d = load2(&inv[k][s]);
+        clip_face_pair64<F>(select2(neg, hi_plane, lo_plane), o, d, true, tn, tf, ok);
+        clip_face_pair64<F>(select2(neg, lo_plane, hi_plane), o, d, false, tn, tf, ok);
+      }
+      const std::uint64_t decided = lanes & mask2(ok);
+      if ((decided & 1u) != 0) {
+        v_.clip_tn[s] = tn[0];
+        v_.clip_tf[s] = tf[0];
+      }
+      if ((decided & 2u) != 0) {
+        v_.clip_tn[s + 1] = tn[1];
+        v_.clip_tf[s + 1] = tf[1];
+      }
+      redo |= (lanes & ~decided) << i;
+    }
+    for (; redo != 0; redo &= redo - 1) {
+      const int i = std::countr_zero(redo);
+      const auto s = static_cast<std::size_t>(i);
+      const Lane& l = lane(i);
+      double& clip_tn = v_.clip_tn[s];
+      double& clip_tf = v_.clip_tf[s];
       for (int face = 0; face < 6; ++face) {
         const int axis = face / 2;
         const auto k = static_cast<std::size_t>(axis);
         const bool entry = (face % 2) == 0;
         const bool lo_face = entry != l.current.d[axis].sign();
-        if (clip_face64<F>(lo_face ? lo_value[k] : hi_value[k], l.o[k], l.inv[k], entry, l.clip_tn,
-                           l.clip_tf))
+        if (clip_face64<F>(lo_face ? lo_value[k] : hi_value[k], lo[k][s], inv[k][s], entry, clip_tn,
+                           clip_tf))
           continue;
-        F tn = encoding(l.clip_tn), tf = encoding(l.clip_tf);
+        F tn = encoding(clip_tn), tf = encoding(clip_tf);
         clip_face(fp, lo_face ? box_lo_[k] : box_hi_[k], l.current.o[axis], l.current.d[axis],
                   entry, tn, tf);
-        l.clip_tn = value(tn);
-        l.clip_tf = value(tf);
+        clip_tn = value(tn);
+        clip_tf = value(tf);
       }
     }
   }
 
   void start_group() {
     const std::uint64_t g = groups_[group_];
-    for (int i = 0; i < p_; ++i) {
-      if (!has(g, i)) continue;
-      lane(i).tn = lane(i).clip_tn;
-      lane(i).tf = lane(i).clip_tf;
-    }
+    // The other lanes' tn, tf are not read while they are outside the mask (LaneValues).
+    std::memcpy(v_.tn.data(), v_.clip_tn.data(), sizeof(double) * static_cast<std::size_t>(slots_));
+    std::memcpy(v_.tf.data(), v_.clip_tf.data(), sizeof(double) * static_cast<std::size_t>(slots_));
     node_ = level_ == Level::kTop ? image_.registers().top_root : header_.root;
     mask_ = g;
     // Groups of a level live on the stack one after another: a level keeps its base.
@@ -642,15 +765,17 @@ class ThreadProgram {
     ++u_.traversal_steps;
     const auto lanes = static_cast<std::uint64_t>(p_);
     PipelineUnits<F>::count(u_.traversal_ops, 0, 0, 0, lanes);  // termination, 1 cmp per lane
-    const memif::KdNode node = image_.node(node_);
-    // Early termination at node entry (1 cmp per lane).
-    std::uint64_t active = 0;
-    for (int i = 0; i < p_; ++i) {
-      Lane& l = lane(i);
-      if (!has(mask_, i) || l.done || l.t_best < l.tn) continue;  // terminated()
-      active |= std::uint64_t{1} << i;
-      ++l.counters.traversal_steps;
+    const memif::KdNode node = scene_.node(node_);
+    // Early termination at node entry (1 cmp per lane): t_best < tn leaves.
+    std::uint64_t terminated = 0;
+    for (int i = 0; i < p_; i += 2) {
+      const auto s = static_cast<std::size_t>(i);
+      terminated |= mask2(load2(&v_.t_best[s]) < load2(&v_.tn[s])) << i;
     }
+    std::uint64_t active = mask_ & ~terminated;
+    if (kind_ == RayKind::kShadow) active &= ~done_mask();
+    for (std::uint64_t m = active; m != 0; m &= m - 1)
+      ++lane(std::countr_zero(m)).counters.traversal_steps;
     if (active == 0) return pop();
     if (node.leaf) {
       if (node.count == 0) return pop();
@@ -664,41 +789,52 @@ class ThreadProgram {
     ++u_.inner_steps;
     // Host-side prefetch of both children's node words (one of them is the next step's node,
     // the other may be pushed): no effect on results.
-    prefetch_node(node.child_pair);
-    prefetch_node(node.child_pair + 1);
+    scene_.prefetch_node(node.child_pair);
+    scene_.prefetch_node(node.child_pair + 1);
     PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, 2 * lanes);  // traversal_lane
     const int axis = static_cast<int>(node.axis);
     const F split = F::from_bits(node.split);
     // The group's shared direction sign on this axis picks the near child.
     const bool neg = lane(std::countr_zero(active)).current.d[axis].sign();
-    std::uint64_t near_mask = 0, far_mask = 0;
-    std::array<double, kMaxPacket> near_tf, far_tn;  // lanes 0..P-1 set below
+    std::uint64_t near_mask = 0, far_mask = 0, fail = 0;
+    alignas(16) Slots near_tf, far_tn;  // slots 0..P-1 (rounded up to even) set below
     const double split_value = value(split);
+    const V2d split2 = {split_value, split_value};
     const auto a = static_cast<std::size_t>(axis);
-    for (int i = 0; i < p_; ++i) {
-      Lane& l = lane(i);
-      const auto k = static_cast<std::size_t>(i);
-      if (!has(active, i)) {
-        near_tf[k] = far_tn[k] = 0.0;
-        continue;
-      }
-      TraversalLane64 r;
-      if (!traversal_lane64<F>(split_value, l.o[a], l.inv[a], l.tn, l.tf, r)) {
-        const TraversalLane<F> e = traversal_lane(fp, split, l.current.o[axis], l.current.d[axis],
-                                                  encoding(l.tn), encoding(l.tf));
-        r = {e.go_near, e.go_far, value(e.near_tf), value(e.far_tn)};
-      }
-      near_mask |= std::uint64_t{r.go_near} << i;
-      far_mask |= std::uint64_t{r.go_far} << i;
-      near_tf[k] = r.near_tf;
-      far_tn[k] = r.far_tn;
+    const Slots& o = level_o()[a];
+    const Slots& inv = level_inv()[a];
+    // Two lanes at a time on values (inactive lanes are computed along and dropped).
+    for (int i = 0; i < p_; i += 2) {
+      const auto s = static_cast<std::size_t>(i);
+      const TraversalPair64 r = traversal_pair64<F>(split2, load2(&o[s]), load2(&inv[s]),
+                                                    load2(&v_.tn[s]), load2(&v_.tf[s]));
+      near_mask |= r.go_near << i;
+      far_mask |= r.go_far << i;
+      fail |= r.fail << i;
+      store2(&near_tf[s], r.near_tf);
+      store2(&far_tn[s], r.far_tn);
+    }
+    near_mask &= active;
+    far_mask &= active;
+    // Lanes the value path does not decide: the encoding path.
+    for (std::uint64_t m = fail & active; m != 0; m &= m - 1) {
+      const int i = std::countr_zero(m);
+      const auto s = static_cast<std::size_t>(i);
+      const Lane& l = lane(i);
+      const TraversalLane<F> e = traversal_lane(fp, split, l.current.o[axis], l.current.d[axis],
+                                                encoding(v_.tn[s]), encoding(v_.tf[s]));
+      const std::uint64_t bit = std::uint64_t{1} << i;
+      near_mask = e.go_near ? near_mask | bit : near_mask & ~bit;
+      far_mask = e.go_far ? far_mask | bit : far_mask & ~bit;
+      near_tf[s] = value(e.near_tf);
+      far_tn[s] = value(e.far_tn);
     }
     const std::uint32_t near_child = neg ? node.child_pair + 1 : node.child_pair;
     const std::uint32_t far_child = neg ? node.child_pair : node.child_pair + 1;
     if (far_mask != 0 && near_mask != 0) {
       push(far_child, far_mask, far_tn);
-      for (int i = 0; i < p_; ++i)
-        if (has(near_mask, i)) lane(i).tf = near_tf[static_cast<std::size_t>(i)];
+      // Lanes outside near_mask leave the mask: their tf is not read (LaneValues).
+      std::memcpy(v_.tf.data(), near_tf.data(), sizeof(double) * static_cast<std::size_t>(slots_));
       node_ = near_child;
       mask_ = near_mask;
     } else if (near_mask != 0) {
@@ -710,23 +846,18 @@ class ThreadProgram {
     }
   }
 
-  void prefetch_item(memif::ItemType t, std::uint32_t index, int word = 0) const {
-    const memif::WordLocation w = image_.locate(t, index, word);
-    __builtin_prefetch(image_.bank(w.bank).data() + w.offset);
-  }
-  void prefetch_node(std::uint32_t index) const { prefetch_item(memif::ItemType::kNode, index); }
-  void push(std::uint32_t node, std::uint64_t mask, const std::array<double, kMaxPacket>& far_tn) {
+  // Stack entry: node, mask, and per slot the far segment's tn, then per slot tf.
+  void push(std::uint32_t node, std::uint64_t mask, const Slots& far_tn) {
     if (stack_size_ >= stack_node_.size())
       throw std::runtime_error("functional model: traversal stack overflow (depth " +
                                std::to_string(params_.stack_depth) +
                                "); the kd-trees are deeper than the stack");
     stack_node_[stack_size_] = node;
     stack_mask_[stack_size_] = mask;
-    double* t = &stack_t_[stack_size_ * 2u * lanes_.size()];
-    for (int i = 0; i < p_; ++i) {
-      t[2 * i] = far_tn[static_cast<std::size_t>(i)];
-      t[2 * i + 1] = lane(i).tf;
-    }
+    const auto n = static_cast<std::size_t>(slots_);
+    double* t = &stack_t_[stack_size_ * 2u * n];
+    std::memcpy(t, far_tn.data(), sizeof(double) * n);
+    std::memcpy(t + n, v_.tf.data(), sizeof(double) * n);
     ++stack_size_;
   }
 
@@ -742,12 +873,11 @@ class ThreadProgram {
     --stack_size_;
     node_ = stack_node_[stack_size_];
     mask_ = stack_mask_[stack_size_];
-    const double* t = &stack_t_[stack_size_ * 2u * lanes_.size()];
-    for (int i = 0; i < p_; ++i) {
-      if (!has(mask_, i)) continue;
-      lane(i).tn = t[2 * i];
-      lane(i).tf = t[2 * i + 1];
-    }
+    // Every slot: lanes outside the entry's mask are not read until set again (LaneValues).
+    const auto n = static_cast<std::size_t>(slots_);
+    const double* t = &stack_t_[stack_size_ * 2u * n];
+    std::memcpy(v_.tn.data(), t, sizeof(double) * n);
+    std::memcpy(v_.tf.data(), t + n, sizeof(double) * n);
     phase_ = Phase::kTraverse;
   }
 
@@ -771,11 +901,8 @@ class ThreadProgram {
       n_groups_ = top_n_groups_;
       group_ = top_group_;
       stack_base_ = top_stack_base_;
-      for (int i = 0; i < p_; ++i) {
+      for (int i = 0; i < p_; ++i)
         lane(i).current = lane(i).world;
-        lane(i).o = lane(i).world_o;
-        lane(i).inv = lane(i).world_inv;
-      }
       return list_continue();
     }
     phase_ = kind_ == RayKind::kShadow ? Phase::kShadeShadow : Phase::kShadeSurface;
@@ -827,22 +954,23 @@ class ThreadProgram {
     if (shared_origin_) shared = transform(m, mv, (lanes_[0].*in).o, true);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
-      if (!has(entry_mask_, i)) {
-        (l.*out).o = shared;
-        continue;
-      }
-      const Ray<F> src = l.*in;
-      (l.*out).o = shared_origin_ ? shared : transform(m, mv, src.o, true);
-      (l.*out).d = transform(m, mv, src.d, false);
-      ++l.counters.transformations;
+      if (!has(entry_mask_, i) || shared_origin_) (l.*out).o = shared;
+      if (has(entry_mask_, i)) ++l.counters.transformations;
     }
+    if (!shared_origin_)
+      transform_masked(
+          m, mv, entry_mask_, true, [&](int i) -> const Vec3<F>& { return (lane(i).*in).o; },
+          [&](int i) -> Vec3<F>& { return (lane(i).*out).o; });
+    transform_masked(
+        m, mv, entry_mask_, false, [&](int i) -> const Vec3<F>& { return (lane(i).*in).d; },
+        [&](int i) -> Vec3<F>& { return (lane(i).*out).d; });
   }
 
   void do_transform_object() {
     instance_row_ = image_.registers().instance_row_base + memif::kInstanceRows * instance_;
     transform_lanes(read_matrix<F>(image_, instance_row_), &Lane::world, &Lane::current);
     for (int i = 0; i < p_; ++i)
-      if (has(entry_mask_, i)) set_axis_values(lane(i).o, lane(i).inv, lane(i).current);
+      if (has(entry_mask_, i)) set_axis_values(v_.o, v_.inv, i, lane(i).current);
     header_ = image_.instance_header(instance_);
     // Enter the bottom level: save the top level's groups and stack base (the top-level stack
     // entries stay below; the bottom level pushes above them, D26).
@@ -874,7 +1002,7 @@ class ThreadProgram {
       ++l.counters.intersections;
       if (!accepts(c, instance_, triangle_, l.hit)) continue;
       l.hit.t = c.t;
-      l.t_best = value(c.t);
+      v_.t_best[static_cast<std::size_t>(i)] = value(c.t);
       l.hit.u = c.u;
       l.hit.v = c.v;
       l.hit.c = c.c;
@@ -1181,8 +1309,11 @@ class ThreadProgram {
   std::uint64_t mask_ = 0;
   std::vector<std::uint32_t> stack_node_;
   std::vector<std::uint64_t> stack_mask_;
-  std::vector<double> stack_t_;  // per entry and lane: far tn, tf (values)
-  std::size_t stack_size_ = 0;   // entries in use (the vectors are allocated once)
+  std::vector<double> stack_t_;  // per entry: far tn per slot, then tf per slot (values)
+  int slots_ = 0;                // P rounded up to even: the slots of LaneValues in use
+  LaneValues v_;
+  SceneView scene_;
+  std::size_t stack_size_ = 0;  // entries in use (the vectors are allocated once)
   ListCursor top_list_, bottom_list_;
   Mailbox mailbox_, tri_mailbox_;
   std::uint64_t entry_mask_ = 0;
