@@ -206,15 +206,35 @@ struct FrameSink {
   }
 };
 
-// Direct reads of kd-nodes from the scene banks: what MemoryImage::node computes (item i of a type
-// in bank 3 + i mod 3 at word base[type] + (i div 3) * words), with the bank addresses taken once.
-// Refreshed at every primary packet, so an image rebuilt between frames is read afresh.
+// Direct reads of kd-nodes and list entries from the scene banks: what MemoryImage::node and
+// list_entry compute (item i of a type in bank 3 + i mod 3 at word base[type] + (i div 3) * words),
+// with the bank addresses taken once, and host prefetches of items the thread will read soon
+// (no effect on results). Refreshed at every primary packet, so an image rebuilt between frames
+// is read afresh.
 class SceneView {
  public:
   void refresh(const memif::MemoryImage& image) {
     for (int b = 0; b < memif::kSceneBanks; ++b)
       bank_[static_cast<std::size_t>(b)] = image.bank(memif::kFirstSceneBank + b).data();
     node_base_ = image.regions().base[static_cast<std::size_t>(memif::ItemType::kNode)];
+    list_base_ = image.regions().base[static_cast<std::size_t>(memif::ItemType::kList)];
+    row_base_ = image.regions().base[static_cast<std::size_t>(memif::ItemType::kRow)];
+    row_words_ = static_cast<std::uint32_t>(image.item_words(memif::ItemType::kRow));
+  }
+  std::uint32_t list_entry(std::uint32_t index) const {
+    return bank_[index % memif::kSceneBanks][list_base_ + index / memif::kSceneBanks];
+  }
+  void prefetch_list(std::uint32_t index) const {
+    __builtin_prefetch(bank_[index % memif::kSceneBanks] + list_base_ + index / memif::kSceneBanks);
+  }
+  // Rows first .. first + n - 1 (a row may straddle two host cache lines: both ends).
+  void prefetch_rows(std::uint32_t first, std::uint32_t n) const {
+    for (std::uint32_t r = first; r < first + n; ++r) {
+      const std::uint32_t* w =
+          bank_[r % memif::kSceneBanks] + row_base_ + (r / memif::kSceneBanks) * row_words_;
+      __builtin_prefetch(w);
+      __builtin_prefetch(w + row_words_ - 1u);
+    }
   }
   memif::KdNode node(std::uint32_t index) const {
     const std::uint32_t* w = node_words(index);
@@ -227,7 +247,7 @@ class SceneView {
     return bank_[index % memif::kSceneBanks] + node_base_ + (index / memif::kSceneBanks) * 2u;
   }
   std::array<const std::uint32_t*, memif::kSceneBanks> bank_{};
-  std::uint32_t node_base_ = 0;
+  std::uint32_t node_base_ = 0, list_base_ = 0, row_base_ = 0, row_words_ = 3;
 };
 
 template <class F>
@@ -385,6 +405,14 @@ class ThreadProgram {
   std::uint64_t run() {
     std::uint64_t n = 0;
     while (phase_ != Phase::kDone) {
+      // Runs of traversal steps without the dispatch (the same steps as execute()).
+      if (phase_ == Phase::kTraverse) {
+        do {
+          do_traverse();
+          ++n;
+        } while (phase_ == Phase::kTraverse);
+        continue;
+      }
       execute();
       ++n;
     }
@@ -495,6 +523,11 @@ class ThreadProgram {
     return v;
   }
   static void store2(double* p, V2d v) { std::memcpy(p, &v, sizeof v); }
+  // Copies the slots in use, a pair at a time (P = 4: two vector moves, no library call).
+  void copy_slots(double* dst, const double* src) const {
+    for (int i = 0; i < slots_; i += 2)
+      store2(dst + i, load2(src + i));
+  }
   double value(F x) const { return value_of(x, u_.raw.mode().subnormals); }
 
   // A transformation step (transform_step) through the binary64 path where it decides.
@@ -545,6 +578,7 @@ class ThreadProgram {
     depth_ = pk.depth;
     shared_origin_ = pk.shared_origin;
     gen_ = pk;
+    traversal_steps_ = {};
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = pk.lanes[static_cast<std::size_t>(i)];
@@ -751,8 +785,8 @@ class ThreadProgram {
   void start_group() {
     const std::uint64_t g = groups_[group_];
     // The other lanes' tn, tf are not read while they are outside the mask (LaneValues).
-    std::memcpy(v_.tn.data(), v_.clip_tn.data(), sizeof(double) * static_cast<std::size_t>(slots_));
-    std::memcpy(v_.tf.data(), v_.clip_tf.data(), sizeof(double) * static_cast<std::size_t>(slots_));
+    copy_slots(v_.tn.data(), v_.clip_tn.data());
+    copy_slots(v_.tf.data(), v_.clip_tf.data());
     node_ = level_ == Level::kTop ? image_.registers().top_root : header_.root;
     mask_ = g;
     // Groups of a level live on the stack one after another: a level keeps its base.
@@ -774,11 +808,13 @@ class ThreadProgram {
     }
     std::uint64_t active = mask_ & ~terminated;
     if (kind_ == RayKind::kShadow) active &= ~done_mask();
-    for (std::uint64_t m = active; m != 0; m &= m - 1)
-      ++lane(std::countr_zero(m)).counters.traversal_steps;
+    for (int i = 0; i < p_; ++i)
+      traversal_steps_[static_cast<std::size_t>(i)] += (active >> i) & 1u;
     if (active == 0) return pop();
     if (node.leaf) {
       if (node.count == 0) return pop();
+      for (std::uint32_t k = 0; k < node.count && k < 8u; ++k)
+        scene_.prefetch_list(node.first + k);
       ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
       c.next = node.first;
       c.end = node.first + node.count;
@@ -834,7 +870,7 @@ class ThreadProgram {
     if (far_mask != 0 && near_mask != 0) {
       push(far_child, far_mask, far_tn);
       // Lanes outside near_mask leave the mask: their tf is not read (LaneValues).
-      std::memcpy(v_.tf.data(), near_tf.data(), sizeof(double) * static_cast<std::size_t>(slots_));
+      copy_slots(v_.tf.data(), near_tf.data());
       node_ = near_child;
       mask_ = near_mask;
     } else if (near_mask != 0) {
@@ -856,8 +892,8 @@ class ThreadProgram {
     stack_mask_[stack_size_] = mask;
     const auto n = static_cast<std::size_t>(slots_);
     double* t = &stack_t_[stack_size_ * 2u * n];
-    std::memcpy(t, far_tn.data(), sizeof(double) * n);
-    std::memcpy(t + n, v_.tf.data(), sizeof(double) * n);
+    copy_slots(t, far_tn.data());
+    copy_slots(t + n, v_.tf.data());
     ++stack_size_;
   }
 
@@ -876,8 +912,8 @@ class ThreadProgram {
     // Every slot: lanes outside the entry's mask are not read until set again (LaneValues).
     const auto n = static_cast<std::size_t>(slots_);
     const double* t = &stack_t_[stack_size_ * 2u * n];
-    std::memcpy(v_.tn.data(), t, sizeof(double) * n);
-    std::memcpy(v_.tf.data(), t + n, sizeof(double) * n);
+    copy_slots(v_.tn.data(), t);
+    copy_slots(v_.tf.data(), t + n);
     phase_ = Phase::kTraverse;
   }
 
@@ -924,10 +960,22 @@ class ThreadProgram {
     pop();
   }
 
+  void prefetch_entry_rows(std::uint32_t entry) const {
+    if (level_ == Level::kTop)
+      scene_.prefetch_rows(image_.registers().instance_row_base + memif::kInstanceRows * entry,
+                           memif::kInstanceRows);
+    else
+      scene_.prefetch_rows(header_.triangle_row_base + memif::kTriangleRows * entry,
+                           memif::kTriangleRows);
+  }
+
   void do_list() {
     ++u_.list_steps;
     ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
-    const std::uint32_t entry = image_.list_entry(c.next++);
+    const std::uint32_t entry = scene_.list_entry(c.next++);
+    // The matrix rows of this entry and of the next (its list entry was prefetched at the leaf).
+    prefetch_entry_rows(entry);
+    if (c.next < c.end) prefetch_entry_rows(scene_.list_entry(c.next));
     for (int i = 0; i < p_; ++i)
       if (has(c.mask, i)) ++lane(i).counters.list_entries;
     Mailbox& mb = level_ == Level::kTop ? mailbox_ : tri_mailbox_;
@@ -1040,8 +1088,12 @@ class ThreadProgram {
   }
 
   void account_counters() {
-    for (int i = 0; i < p_; ++i)
-      if (lane(i).valid) sink_.by_kind[static_cast<int>(kind_)] += lane(i).counters;
+    for (int i = 0; i < p_; ++i) {
+      Lane& l = lane(i);
+      l.counters.traversal_steps += traversal_steps_[static_cast<std::size_t>(i)];
+      traversal_steps_[static_cast<std::size_t>(i)] = 0;
+      if (l.valid) sink_.by_kind[static_cast<int>(kind_)] += l.counters;
+    }
   }
 
   void do_shade_surface() {
@@ -1312,6 +1364,9 @@ class ThreadProgram {
   std::vector<double> stack_t_;  // per entry: far tn per slot, then tf per slot (values)
   int slots_ = 0;                // P rounded up to even: the slots of LaneValues in use
   LaneValues v_;
+  // Per lane: traversal steps of the current packet, added to its counters when the packet's
+  // counters are accounted (account_counters, before they are recorded).
+  std::array<std::uint64_t, kMaxPacket> traversal_steps_{};
   SceneView scene_;
   std::size_t stack_size_ = 0;  // entries in use (the vectors are allocated once)
   ListCursor top_list_, bottom_list_;
