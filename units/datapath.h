@@ -196,6 +196,14 @@ template <class F>
   return ff::decode(x.bits, F::kFormat, s);
 }
 
+// x is +-0 or normal (what decode_pair takes).
+template <class F>
+[[gnu::always_inline]] inline bool normal_or_zero(F x) {
+  constexpr std::uint32_t kExpMax = F::kFormat.exp_field_max();
+  const std::uint32_t e = (x.bits >> F::kManBits) & kExpMax;
+  return (e - 1u < kExpMax - 1u) | ((x.bits & (F::kFormat.sign_mask() - 1u)) == 0);
+}
+
 // The encoding of a value that round_to_format accepted (zero or normal).
 template <class F>
 [[gnu::always_inline]] inline F encoding_of(double v) {
@@ -246,7 +254,7 @@ template <class F>
 // The matrix entries as values, with the exponent ranges of the linear part and the translation.
 template <class F>
 struct MatrixValues {
-  std::array<std::array<double, 4>, 3> m{};
+  std::array<std::array<double, 4>, 3> m;  // every entry set by matrix_values
   ExponentRange linear, translation;
   bool nearest = true;  // the caller clears it for truncation (then no step is decided here)
 };

@@ -224,6 +224,11 @@ class SceneView {
   std::uint32_t list_entry(std::uint32_t index) const {
     return bank_[index % memif::kSceneBanks][list_base_ + index / memif::kSceneBanks];
   }
+  // The words of matrix row `index`.
+  const std::uint32_t* row_words(std::uint32_t index) const {
+    return bank_[index % memif::kSceneBanks] + row_base_ +
+           (index / memif::kSceneBanks) * row_words_;
+  }
   void prefetch_list(std::uint32_t index) const {
     __builtin_prefetch(bank_[index % memif::kSceneBanks] + list_base_ + index / memif::kSceneBanks);
   }
@@ -533,14 +538,55 @@ class ThreadProgram {
   // A transformation step (transform_step) through the binary64 path where it decides.
   using Mat64 = MatrixValues<F>;
   Mat64 matrix_values(const Mat34<F>& m) const {
-    Mat64 v = units::matrix_values(m, u_.raw.mode().subnormals);
+    bool normal = true;  // every entry zero or normal: decoded two at a time (the same values)
+    for (const auto& r : m)
+      for (const F x : r)
+        normal &= normal_or_zero(x);
+    if (!normal) {
+      Mat64 v = units::matrix_values(m, u_.raw.mode().subnormals);
+      v.nearest = nearest_;
+      return v;
+    }
+    Mat64 v;
+    for (std::size_t r = 0; r < 3; ++r) {
+      const auto& row = m[static_cast<int>(r)];
+      for (int c = 0; c < 4; c += 2) {
+        const V2d x = decode_pair<F>(row[c].bits, row[c + 1].bits);
+        v.m[r][static_cast<std::size_t>(c)] = x[0];
+        v.m[r][static_cast<std::size_t>(c + 1)] = x[1];
+      }
+      v.linear.include(row[0]);
+      v.linear.include(row[1]);
+      v.linear.include(row[2]);
+      v.translation.include(row[3]);
+    }
     v.nearest = nearest_;
     return v;
   }
+  // One vector: the two-lane path with both lanes the same (fewer moves than the scalar path).
   Vec3<F> transform(const Mat34<F>& m, const Mat64& mv, const Vec3<F>& v, bool translate) const {
-    Vec3<F> out;
-    if (transform_step64<F>(mv, v, translate, out)) return out;
-    return transform_step(u_.raw, m, v, translate);
+    if (!transform_decides<F>(mv, v, translate)) return transform_step(u_.raw, m, v, translate);
+    const V2d x[3] = {decode_pair<F>(v[0].bits, v[0].bits), decode_pair<F>(v[1].bits, v[1].bits),
+                      decode_pair<F>(v[2].bits, v[2].bits)};
+    V2u r[3];
+    transform_pair64<F>(mv, x, translate, r);
+    return lane_of<F>(r, 0);
+  }
+  // As read_row / read_matrix (datapath.h), through the cached bank addresses, with the row's
+  // packing known at compile time (fixedfloat/pack.h: four 24-bit fields in three words for
+  // formats up to 24 bits, else one word each).
+  std::array<F, 4> row(std::uint32_t index) const {
+    const std::uint32_t* w = scene_.row_words(index);
+    constexpr std::uint32_t kMask = F::kFormat.bits_mask();
+    if constexpr (ff::row_words(F::kFormat) == 3) {
+      return {F{w[0] & kMask}, F{((w[0] >> 24) | (w[1] << 8)) & kMask},
+              F{((w[1] >> 16) | (w[2] << 16)) & kMask}, F{(w[2] >> 8) & kMask}};
+    } else {
+      return {F{w[0] & kMask}, F{w[1] & kMask}, F{w[2] & kMask}, F{w[3] & kMask}};
+    }
+  }
+  Mat34<F> matrix(std::uint32_t first_row) const {
+    return {row(first_row), row(first_row + 1), row(first_row + 2)};
   }
   // out(i) = m * in(i) (a transformation step) for the lanes in `mask`: two lanes at a time on
   // values where transform_decides holds for both or one of them, the others on encodings.
@@ -660,8 +706,8 @@ class ThreadProgram {
       box_lo_ = scene_lo_;
       box_hi_ = scene_hi_;
     } else {
-      const auto rlo = read_row<F>(image_, instance_row_ + 4);
-      const auto rhi = read_row<F>(image_, instance_row_ + 5);
+      const auto rlo = row(instance_row_ + 4);
+      const auto rhi = row(instance_row_ + 5);
       box_lo_ = {rlo[0], rlo[1], rlo[2]};
       box_hi_ = {rhi[0], rhi[1], rhi[2]};
     }
@@ -949,9 +995,7 @@ class ThreadProgram {
   // ---- mailboxed list unit (paths c, d) ------------------------------------------------------
   void list_continue() {
     ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
-    std::uint64_t live = 0;
-    for (int i = 0; i < p_; ++i)
-      if (has(c.mask, i) && !lane(i).done) live |= std::uint64_t{1} << i;
+    const std::uint64_t live = kind_ == RayKind::kShadow ? c.mask & ~done_mask() : c.mask;
     c.mask = live;
     if (c.next < c.end && live != 0) {
       phase_ = Phase::kList;
@@ -977,11 +1021,11 @@ class ThreadProgram {
     prefetch_entry_rows(entry);
     if (c.next < c.end) prefetch_entry_rows(scene_.list_entry(c.next));
     for (int i = 0; i < p_; ++i)
-      if (has(c.mask, i)) ++lane(i).counters.list_entries;
+      lane(i).counters.list_entries += (c.mask >> i) & 1u;
     Mailbox& mb = level_ == Level::kTop ? mailbox_ : tri_mailbox_;
     const std::uint64_t todo = mb.filter(entry, c.mask);
     for (int i = 0; i < p_; ++i)
-      if (has(c.mask & ~todo, i)) ++lane(i).counters.mailbox_skips;
+      lane(i).counters.mailbox_skips += ((c.mask & ~todo) >> i) & 1u;
     if (todo == 0) return list_continue();
     entry_mask_ = todo;
     if (level_ == Level::kTop) {
@@ -1003,7 +1047,7 @@ class ThreadProgram {
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       if (!has(entry_mask_, i) || shared_origin_) (l.*out).o = shared;
-      if (has(entry_mask_, i)) ++l.counters.transformations;
+      l.counters.transformations += (entry_mask_ >> i) & 1u;
     }
     if (!shared_origin_)
       transform_masked(
@@ -1016,7 +1060,7 @@ class ThreadProgram {
 
   void do_transform_object() {
     instance_row_ = image_.registers().instance_row_base + memif::kInstanceRows * instance_;
-    transform_lanes(read_matrix<F>(image_, instance_row_), &Lane::world, &Lane::current);
+    transform_lanes(matrix(instance_row_), &Lane::world, &Lane::current);
     for (int i = 0; i < p_; ++i)
       if (has(entry_mask_, i)) set_axis_values(v_.o, v_.inv, i, lane(i).current);
     header_ = image_.instance_header(instance_);
@@ -1031,9 +1075,8 @@ class ThreadProgram {
   }
 
   void do_transform_triangle() {
-    transform_lanes(
-        read_matrix<F>(image_, header_.triangle_row_base + memif::kTriangleRows * triangle_),
-        &Lane::current, &Lane::tri);
+    transform_lanes(matrix(header_.triangle_row_base + memif::kTriangleRows * triangle_),
+                    &Lane::current, &Lane::tri);
     phase_ = Phase::kIntersect;
   }
 
