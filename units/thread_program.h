@@ -12,6 +12,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -294,6 +295,7 @@ class ThreadProgram {
     }
     epsilon_ = F::from_bits(regs.epsilon);
     nearest_ = params.mode.rounding == ff::Rounding::kNearestEven;
+    cam_values_ = matrix_values(cam_);
     shadow_t_max_ = F::from_double(1.0 - 1.0 / 512.0);
   }
 
@@ -509,12 +511,26 @@ class ThreadProgram {
     PipelineUnits<F>::count(u_.transformation_ops, 9 * steps, 9 * steps, 0, 0);
   }
   Lane& lane(int i) { return lanes_[static_cast<std::size_t>(i)]; }
-  void set_axis_values(std::array<Slots, 3>& o, std::array<Slots, 3>& inv, int i,
-                       const Ray<F>& r) const {
-    const auto s = static_cast<std::size_t>(i);
-    for (int k = 0; k < 3; ++k) {
-      o[static_cast<std::size_t>(k)][s] = u_.raw.to_double(r.o[k]);
-      inv[static_cast<std::size_t>(k)][s] = traversal_reciprocal(u_.raw, r.d[k]);
+  // O and 1/D (traversal_reciprocal) of every lane's ray `ray`, the reciprocals two lanes per
+  // division (the same binary64 quotients). Lanes outside the level's mask get values nothing
+  // reads.
+  void set_axis_values(std::array<Slots, 3>& o, std::array<Slots, 3>& inv, Ray<F> Lane::*ray) {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    for (int i = 0; i < p_; i += 2) {
+      const Ray<F>& a = lane(i).*ray;
+      const Ray<F>& b = lane(i + 1 < p_ ? i + 1 : i).*ray;
+      const auto s = static_cast<std::size_t>(i);
+      for (std::size_t k = 0; k < 3; ++k) {
+        const int c = static_cast<int>(k);
+        o[k][s] = value(a.o[c]);
+        o[k][s + 1] = value(b.o[c]);
+        // Decoded as if normal; lanes whose D is not normal (or truncation) get NaN.
+        const V2d r = 1.0 / decode_pair<F>(a.d[c].bits, b.d[c].bits);
+        inv[k][s] =
+            nearest_ && ff::fast::is_normal<F::kExpBits, F::kManBits>(a.d[c].bits) ? r[0] : kNaN;
+        inv[k][s + 1] =
+            nearest_ && ff::fast::is_normal<F::kExpBits, F::kManBits>(b.d[c].bits) ? r[1] : kNaN;
+      }
     }
   }
   // O and 1/D of the current level's rays.
@@ -624,7 +640,8 @@ class ThreadProgram {
     depth_ = pk.depth;
     shared_origin_ = pk.shared_origin;
     gen_ = pk;
-    traversal_steps_ = {};
+    for (int i = 0; i < p_; ++i)
+      traversal_steps_[static_cast<std::size_t>(i)] = 0;
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = pk.lanes[static_cast<std::size_t>(i)];
@@ -640,7 +657,7 @@ class ThreadProgram {
     count_transform();
     const auto& g0 = gen_.lanes[0];
     Vec3<F> shared{};
-    const Mat64 mv0 = matrix_values(g0.t);
+    const Mat64 mv0 = g0.t == cam_ ? cam_values_ : matrix_values(g0.t);
     if (shared_origin_) shared = transform(g0.t, mv0, g0.ro, true);
     // Lanes usually share T (primary rays: the camera's): those with lane 0's T two at a time,
     // the others one by one, T decoded once per distinct T.
@@ -678,12 +695,12 @@ class ThreadProgram {
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       l.current = l.world;
-      set_axis_values(v_.world_o, v_.world_inv, i, l.world);
       l.hit = HitRecord<F>{};
       if (kind_ == RayKind::kShadow) l.hit.t = shadow_t_max_;
       v_.t_best[static_cast<std::size_t>(i)] = value(l.hit.t);
       if (l.valid) ++l.counters.transformations;
     }
+    set_axis_values(v_.world_o, v_.world_inv, &Lane::world);
     if (kind_ == RayKind::kShadow) {
       phase_ = Phase::kShadeLight;  // the RGS decides which shadow rays to trace
       return;
@@ -1061,8 +1078,7 @@ class ThreadProgram {
   void do_transform_object() {
     instance_row_ = image_.registers().instance_row_base + memif::kInstanceRows * instance_;
     transform_lanes(matrix(instance_row_), &Lane::world, &Lane::current);
-    for (int i = 0; i < p_; ++i)
-      if (has(entry_mask_, i)) set_axis_values(v_.o, v_.inv, i, lane(i).current);
+    set_axis_values(v_.o, v_.inv, &Lane::current);
     header_ = image_.instance_header(instance_);
     // Enter the bottom level: save the top level's groups and stack base (the top-level stack
     // entries stay below; the bottom level pushes above them, D26).
@@ -1378,6 +1394,7 @@ class ThreadProgram {
   int p_;
   std::uint32_t max_depth_ = 3;
   Mat34<F> cam_{};
+  MatrixValues<F> cam_values_{};  // matrix_values(cam_): primary packets transform through it
   std::array<F, 3> scene_lo_{}, scene_hi_{};
   std::array<F, 3> box_lo_{}, box_hi_{};  // the current level's box (clip steps)
   F epsilon_{}, shadow_t_max_{};
