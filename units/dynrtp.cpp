@@ -13,6 +13,7 @@
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
 #include "units/dynrtc_units.h"
+#include "units/frame_memory.h"
 
 namespace saarcor::units {
 namespace {
@@ -27,7 +28,7 @@ class Threads final : public ThreadTable {
     w_ = static_cast<int>(image.registers().width);
     h_ = static_cast<int>(image.registers().height);
     tiling_ = packet_tiling(w_, h_, params.packet);
-    sink_.reset(w_, h_);
+    reset_frame_sink(sink_, w_, h_);
     for (int i = 0; i < threads; ++i) {
       programs_.push_back(std::make_unique<ThreadProgram<F>>(image, params_, units_, sink_));
       requests_.push_back(programs_.back()->request());
