@@ -20,7 +20,7 @@ namespace {
 
 // The thread table: one thread program per thread, all sharing the DynRTP's float units and the
 // frame sink (their only shared state; both sum order-independently).
-template <class F>
+template <class F, int kLanes>
 class Threads final : public ThreadTable {
  public:
   Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads)
@@ -30,12 +30,13 @@ class Threads final : public ThreadTable {
     tiling_ = packet_tiling(w_, h_, params.packet);
     reset_frame_sink(sink_, w_, h_);
     for (int i = 0; i < threads; ++i) {
-      programs_.push_back(std::make_unique<ThreadProgram<F>>(image, params_, units_, sink_));
+      programs_.push_back(
+          std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
       requests_.push_back(programs_.back()->request());
     }
   }
   void execute(std::uint32_t t) override {
-    ThreadProgram<F>& p = *programs_[t];
+    ThreadProgram<F, kLanes>& p = *programs_[t];
     p.execute();
     // Returned straight into the table (guaranteed elision): a copy of the returned temporary
     // would reload a struct the callee has just written field by field (a store-forward stall).
@@ -57,11 +58,11 @@ class Threads final : public ThreadTable {
   FrameSink sink_;
   PacketTiling tiling_;
   int w_ = 0, h_ = 0;
-  std::vector<std::unique_ptr<ThreadProgram<F>>> programs_;
+  std::vector<std::unique_ptr<ThreadProgram<F, kLanes>>> programs_;
 };
 
-template <class F>
-void collect(FunctionalFrame& frame, Threads<F>& threads) {
+template <class F, int kLanes>
+void collect(FunctionalFrame& frame, Threads<F, kLanes>& threads) {
   frame.format = F::kFormat;
   frame.width = threads.sink().width;
   frame.height = threads.sink().height;
@@ -228,8 +229,8 @@ CycleFigures figures(const Snapshot& a, const Snapshot& b, double clock_mhz) {
   return f;
 }
 
-template <class F>
-std::string thread_report(Threads<F>& threads) {
+template <class F, int kLanes>
+std::string thread_report(Threads<F, kLanes>& threads) {
   std::ostringstream s;
   s << "threads (id: unit, phase, item, rays):";
   for (int t = 0; t < threads.size(); ++t) {
@@ -242,7 +243,7 @@ std::string thread_report(Threads<F>& threads) {
   return s.str();
 }
 
-template <class F>
+template <class F, int kLanes>
 CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
                             const CycleRunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -255,7 +256,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
   // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
   memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
-  Threads<F> threads(image, fp, p.threads);
+  Threads<F, kLanes> threads(image, fp, p.threads);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;
@@ -344,8 +345,12 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
 
 CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
                      const CycleRunOptions& options) {
-  if (image.format() == ff::kFp24)
-    return run_cycle_format<ff::Float<7, 16>>(image, params, options);
+  // The prototype's P = 4 gets thread programs with 4-lane packet arrays (ThreadProgram's
+  // kLanes); wider packets the full 64.
+  if (image.format() == ff::kFp24) {
+    if (params.packet <= 4) return run_cycle_format<ff::Float<7, 16>, 4>(image, params, options);
+    return run_cycle_format<ff::Float<7, 16>, kMaxPacket>(image, params, options);
+  }
   throw std::runtime_error("cycle model: the image is in " + ff::format_name(image.format()) +
                            "; the cycle model is built for fp24 (e7m16)");
 }

@@ -256,8 +256,14 @@ class SceneView {
   std::uint32_t node_base_ = 0, list_base_ = 0, row_base_ = 0, row_words_ = 3;
 };
 
-template <class F>
+// kLanes: the capacity of the packet arrays (>= P). A packet's per-lane values are kept field by
+// field over kLanes slots, so a small capacity keeps a small packet's values in a few cache lines:
+// the cycle model interleaves 64 programs, whose state has mostly left the L1 cache by the time a
+// unit serves the thread again (P = 4 in 4 slots instead of 64: ~4% of a cycle-model frame).
+template <class F, int kLanes = kMaxPacket>
 class ThreadProgram {
+  static_assert(kLanes >= 2 && kLanes <= kMaxPacket && (kLanes & (kLanes - 1)) == 0);
+
  public:
   ThreadProgram(const memif::MemoryImage& image, const FunctionalParams& params,
                 PipelineUnits<F>& units, FrameSink& sink)
@@ -275,6 +281,7 @@ class ThreadProgram {
     if (p_ < 1 || p_ > kMaxPacket || (p_ & (p_ - 1)) != 0)
       throw std::runtime_error("functional model: packet width " + std::to_string(p_) +
                                " is not a power of two in 1..64");
+    if (p_ > kLanes) throw std::logic_error("thread program: packet wider than its lane capacity");
     if (params.stack_depth < 1)
       throw std::runtime_error("functional model: stack depth must be at least 1");
     lanes_.resize(static_cast<std::size_t>(p_));
@@ -465,7 +472,7 @@ class ThreadProgram {
   // along and never used. A lane's tn, tf are meaningful only while it is in the packet's mask:
   // it enters the mask only where they are set (start of a sign group, pop, the near child), so
   // whole-array copies may overwrite the others.
-  using Slots = std::array<double, kMaxPacket>;
+  using Slots = std::array<double, kLanes>;
   struct alignas(16) LaneValues {
     std::array<Slots, 3> world_o{}, world_inv{}, o{}, inv{};
     Slots tn{}, tf{};            // segment of the node being visited
@@ -1426,7 +1433,7 @@ class ThreadProgram {
   LaneValues v_;
   // Per lane: traversal steps of the current packet, added to its counters when the packet's
   // counters are accounted (account_counters, before they are recorded).
-  std::array<std::uint64_t, kMaxPacket> traversal_steps_{};
+  std::array<std::uint64_t, kLanes> traversal_steps_{};
   SceneView scene_;
   std::size_t stack_size_ = 0;  // entries in use (the vectors are allocated once)
   ListCursor top_list_, bottom_list_;
