@@ -13,7 +13,6 @@
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
 #include "units/dynrtc_units.h"
-#include "units/frame_memory.h"
 
 namespace saarcor::units {
 namespace {
@@ -28,7 +27,7 @@ class Threads final : public ThreadTable {
     w_ = static_cast<int>(image.registers().width);
     h_ = static_cast<int>(image.registers().height);
     tiling_ = packet_tiling(w_, h_, params.packet);
-    reset_frame_sink(sink_, w_, h_);
+    sink_.reset(w_, h_);
     for (int i = 0; i < threads; ++i) {
       programs_.push_back(
           std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));

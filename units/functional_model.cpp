@@ -8,8 +8,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include "units/frame_memory.h"
-
 namespace saarcor::units {
 
 PacketTiling packet_tiling(int width, int height, int packet) {
@@ -118,7 +116,7 @@ FunctionalFrame run_functional(const memif::MemoryImage& image, const Functional
   const PacketTiling tiling = packet_tiling(w, h, params.packet);
   PipelineUnits<F> units(params.mode);
   FrameSink sink;
-  reset_frame_sink(sink, w, h);
+  sink.reset(w, h);
   ThreadProgram<F> thread(image, params, units, sink);
   FunctionalFrame frame;
   frame.format = F::kFormat;

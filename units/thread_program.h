@@ -20,6 +20,7 @@
 #include "fixedfloat/float.h"
 #include "memif/image_format.h"
 #include "units/datapath.h"
+#include "units/huge_pages.h"
 #include "units/mailbox.h"
 #include "units/shading.h"
 
@@ -190,8 +191,10 @@ struct FrameSink {
     std::array<std::uint32_t, 3> o{}, d{};
     RayCounters counters;
   };
-  std::vector<Pixel> pixels;
-  std::vector<std::array<std::uint32_t, 3>> colour_sum;  // sum of weight * colour (docs 7)
+  // (HugePageAllocator: a frame's buffers are first touched in 2 MiB pages.)
+  std::vector<Pixel, HugePageAllocator<Pixel>> pixels;
+  std::vector<std::array<std::uint32_t, 3>, HugePageAllocator<std::array<std::uint32_t, 3>>>
+      colour_sum;  // sum of weight * colour (docs 7)
   std::array<RayCounters, kRayKinds> by_kind{};
   std::array<std::uint64_t, kRayKinds> rays_issued{};
   std::array<std::uint64_t, kRayKinds> rays_returned{};
