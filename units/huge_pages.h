@@ -21,12 +21,14 @@ template <class T>
 struct HugePageAllocator {
   using value_type = T;
   static constexpr std::size_t kHugePage = std::size_t{2} << 20;
+  static constexpr std::size_t kMaxBytes = std::size_t{1} << 48;  // no machine holds more
 
   HugePageAllocator() = default;
   template <class U>
   explicit HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
 
   T* allocate(std::size_t n) {
+    if (n > kMaxBytes / sizeof(T)) throw std::bad_array_new_length();
     const std::size_t bytes = n * sizeof(T);
     if (bytes < kHugePage) return std::allocator<T>{}.allocate(n);
     const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
