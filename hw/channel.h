@@ -149,6 +149,8 @@ class Channel : public ChannelBase {
   T& push_slot() { return items_[static_cast<std::size_t>(reserve_push())]; }
   const T& peek() const { return items_[static_cast<std::size_t>(front_slot())]; }
   T pop() { return std::move(items_[static_cast<std::size_t>(reserve_pop())]); }
+  // pop() for a consumer that has read what it needs through peek(): the item is not copied.
+  void drop() { (void)reserve_pop(); }
 
  private:
   std::vector<T> items_;

@@ -188,6 +188,31 @@ TEST(Channel, MisuseThrowsNamingTheChannel) {
   EXPECT_THROW(Channel<int>(k, "bad2", 1, 0), std::logic_error);
 }
 
+// drop() is pop() without the copy: the same slot, the same hand-shake, misuse included.
+TEST(Channel, DropTakesTheFrontItemLikePop) {
+  Kernel k;
+  Channel<int> ch(k, "ch", 4, 1, 2);
+  std::vector<int> seen;
+  FnModule m(k, "m", [&] {
+    if (k.now() == 0) {
+      EXPECT_THROW(ch.drop(), std::logic_error);
+      ch.push(1);
+      ch.push(2);
+    }
+    if (k.now() == 1) {
+      seen.push_back(ch.peek());
+      ch.drop();
+      seen.push_back(ch.pop());  // the second port of the same cycle sees the next item
+      EXPECT_FALSE(ch.can_pop());
+    }
+    return 1;
+  });
+  k.step();
+  k.step();
+  EXPECT_EQ(seen, (std::vector<int>{1, 2}));
+  EXPECT_TRUE(ch.empty());
+}
+
 TEST(Channel, RandomTrafficNeitherLosesNorDuplicatesAndKeepsOrder) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 20; ++trial) {

@@ -109,8 +109,8 @@ int CycleUnit::issue() {
 
 int CycleUnit::receive() {
   if (cache_responses_ == nullptr || !cache_responses_->can_pop()) return 0;
-  const memif::CacheResponse r = cache_responses_->pop();
-  const ThreadToken t = r.label.tag;
+  const ThreadToken t = cache_responses_->peek().label.tag;
+  cache_responses_->drop();
   if (--waiting_[t] == 0) {
     --waiting_threads_;
     ready_.push_back(t);

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -81,8 +82,10 @@ class CycleUnit : public hw::Module {
 
   // Inputs in priority order (the first non-empty path is served, D25).
   void add_input(ThreadPath* path) {
+    if (input_count_ == kUnitCount)
+      throw std::logic_error(name() + ": more input paths than units");
     consumes(*path);
-    inputs_.push_back(path);
+    input_[input_count_++] = path;
   }
   // The path towards unit `to` (also a path back into this unit: the unit's own loop).
   void set_output(UnitId to, ThreadPath* path) {
@@ -136,8 +139,8 @@ class CycleUnit : public hw::Module {
   };
   // The first input path (in priority order) with a thread to take; null if none.
   ThreadPath* waiting_input() const {
-    for (ThreadPath* p : inputs_)
-      if (p->can_pop()) return p;
+    for (int i = 0; i < input_count_; ++i)
+      if (input_[i]->can_pop()) return input_[i];
     return nullptr;
   }
 
@@ -146,7 +149,8 @@ class CycleUnit : public hw::Module {
   memif::Cache* cache_;
   hw::Channel<memif::CacheRequest>* cache_requests_ = nullptr;
   hw::Channel<memif::CacheResponse>* cache_responses_ = nullptr;
-  std::vector<ThreadPath*> inputs_;
+  std::array<ThreadPath*, kUnitCount> input_{};  // in priority order (inline: scanned every cycle)
+  int input_count_ = 0;
   // Fetch stage: the thread whose cache requests are being sent.
   bool fetching_ = false;
   ThreadToken fetch_thread_ = 0;
