@@ -375,6 +375,41 @@ template <class F>
   }
 }
 
+// dot_step on values. dot_step(a, b) is row 0 of a direction step with the linear part (a; 0; 0),
+// so transform_decides' condition with a's exponent range for the matrix's and no translation
+// (L = la + lb - M >= emin, B = ha + hb + 2 <= emax - 2, every operand normal or zero) makes each
+// op its binary64 result rounded once to F's precision, as in transform_step64. rb: b's exponent
+// range (a direction step's rows share it). false: not decided here, use dot_step.
+template <class F>
+[[gnu::always_inline]] inline bool dot_step64(const Vec3<F>& a, const Vec3<F>& b,
+                                              const ExponentRange& rb, bool nearest, F& out) {
+  ExponentRange ra;
+  ra.include(a[0]);
+  ra.include(a[1]);
+  ra.include(a[2]);
+  const int low = ra.lo + rb.lo - F::kManBits;
+  const int high = ra.hi + rb.hi + 2;
+  if (!(nearest & ra.normal & rb.normal & (low >= F::kFormat.emin()) &
+        (high + 2 <= F::kFormat.emax())))
+    return false;
+  const V2d p = decode_pair<F>(a[0].bits, a[1].bits) * decode_pair<F>(b[0].bits, b[1].bits);
+  const V2d c = decode_pair<F>(a[2].bits, b[2].bits);
+  const double x = round_in_range<F>(p[0]);
+  const double y = round_in_range<F>(p[1]);
+  const double z = round_in_range<F>(c[0] * c[1]);
+  out = encoding_of<F>(round_in_range<F>(round_in_range<F>(x + y) + round_in_range<F>(z + 0.0)));
+  return true;
+}
+template <class F>
+[[gnu::always_inline]] inline bool dot_step64(const Vec3<F>& a, const Vec3<F>& b, bool nearest,
+                                              F& out) {
+  ExponentRange rb;
+  rb.include(b[0]);
+  rb.include(b[1]);
+  rb.include(b[2]);
+  return dot_step64<F>(a, b, rb, nearest, out);
+}
+
 struct TraversalLane64 {
   bool go_near = false;
   bool go_far = false;

@@ -463,6 +463,128 @@ TEST(Binary64Paths, PairFormsAgreeWithOneLane) {
   }
 }
 
+// dot_step64 (the RGS's dot products and direction steps) against dot_step on encodings: random
+// operands of every class, mostly moderate ones (decided), and exponents at the limits of its
+// condition. Where it decides, the encoding and the sign of a zero must agree; truncation never
+// decides.
+template <class G>
+void check_dot_paths(ff::Mode mode, int n) {
+  std::mt19937_64 rng(99);
+  const RawFp<G> fp(mode);
+  const bool nearest = mode.rounding == ff::Rounding::kNearestEven;
+  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
+  // Nonzero normal operands with unbiased exponents in [lo, hi] (zero one time in eight).
+  const auto in_range = [&](int lo, int hi) {
+    const auto u = rng();
+    if (u % 8 == 0) return G::from_bits((u & 8u) != 0 ? G::kFormat.sign_mask() : 0u);
+    const int e = lo + static_cast<int>((u >> 4) % static_cast<std::uint64_t>(hi - lo + 1));
+    return G::from_bits(((u & 8u) != 0 ? G::kFormat.sign_mask() : 0u) |
+                        (static_cast<std::uint32_t>(e + G::kFormat.bias()) << G::kManBits) |
+                        (static_cast<std::uint32_t>(u >> 20) & G::kFormat.man_mask()));
+  };
+  const int emin = G::kFormat.emin(), emax = G::kFormat.emax(), m = G::kManBits;
+  int decided = 0, edge = 0;
+  for (int it = 0; it < n; ++it) {
+    Vec3<G> a, b;
+    switch (it % 4) {
+      case 0:  // every class
+        a = {op(), op(), op()};
+        b = {op(), op(), op()};
+        break;
+      case 1:  // moderate
+        a = {in_range(-12, 12), in_range(-12, 12), in_range(-12, 12)};
+        b = {in_range(-12, 12), in_range(-12, 12), in_range(-12, 12)};
+        break;
+      case 2: {  // near the low limit L = la + lb - M = emin (and one below it)
+        const int l = (emin + m) / 2 - static_cast<int>(rng() % 2);
+        a = {in_range(l, l + 3), in_range(l, l + 3), in_range(l, l + 3)};
+        b = {in_range(emin + m - l - 1, emin + m - l + 2), in_range(emin + m - l, emin + m - l + 2),
+             in_range(emin + m - l, emin + m - l + 2)};
+        break;
+      }
+      default: {  // near the high limit ha + hb + 4 = emax (and one above it)
+        const int h = (emax - 4) / 2;
+        a = {in_range(h - 3, h), in_range(h - 3, h), in_range(h - 3, h + 1)};
+        b = {in_range(emax - 4 - h - 3, emax - 4 - h), in_range(emax - 4 - h - 3, emax - 4 - h),
+             in_range(emax - 4 - h - 3, emax - 4 - h + 1)};
+        break;
+      }
+    }
+    const G want = dot_step(fp, a, b);
+    G got;
+    if (!dot_step64<G>(a, b, nearest, got)) continue;
+    ASSERT_TRUE(nearest);
+    ++decided;
+    edge += it % 4 >= 2;
+    ASSERT_EQ(got.bits, want.bits)
+        << ff::format_name(G::kFormat) << " a " << a[0].bits << " " << a[1].bits << " " << a[2].bits
+        << " b " << b[0].bits << " " << b[1].bits << " " << b[2].bits;
+    // A direction step's row is the same expression (the thread program's direction steps).
+    const Mat34<G> mat = {
+        {{a[0], a[1], a[2], op()}, {b[0], b[1], b[2], op()}, {a[2], b[0], a[1], op()}}};
+    ASSERT_EQ(transform_step(fp, mat, b, false)[0].bits, want.bits);
+  }
+  if (nearest) {
+    EXPECT_GT(decided, n / 4);
+    EXPECT_GT(edge, n / 20);
+  }
+}
+
+TEST(Binary64Paths, DotStepAgreesWithTheEncodingPath) {
+#if defined(SAARCOR_SANITIZED)
+  const int n = 20'000;
+#else
+  const int n = 400'000;
+#endif
+  for (const ff::Rounding r : {ff::Rounding::kNearestEven, ff::Rounding::kTowardZero})
+    for (const ff::Subnormals s : {ff::Subnormals::kFlush, ff::Subnormals::kKeep}) {
+      check_dot_paths<ff::fp24>({r, s}, n);
+      check_dot_paths<ff::Float<7, 23>>({r, s}, n / 4);
+      check_dot_paths<ff::Float<8, 23>>({r, s}, n / 4);
+      check_dot_paths<ff::Float<7, 10>>({r, s}, n / 4);
+    }
+}
+
+TEST(Binary64Paths, DotStepEdgeCases) {
+  const UnitFp<F> fp;
+  const auto dot64 = [](const Vec3<F>& a, const Vec3<F>& b, bool nearest = true) {
+    F r;
+    EXPECT_TRUE(dot_step64<F>(a, b, nearest, r));
+    return r.bits;
+  };
+  const auto refused = [](const Vec3<F>& a, const Vec3<F>& b, bool nearest = true) {
+    F r;
+    return !dot_step64<F>(a, b, nearest, r);
+  };
+  // Signed zeros: (-0 + -0) + (-0 + +0) = +0, as on the encodings; all-zero vectors decide.
+  const Vec3<F> nz = v3(-0.0, -0.0, -0.0), pos = v3(1, 2, 3);
+  EXPECT_EQ(dot64(nz, pos), dot_step(fp, nz, pos).bits);
+  EXPECT_EQ(dot64(nz, pos), 0u);
+  EXPECT_EQ(dot64(nz, nz), 0u);
+  // Exact cancellation gives +0; the tie of 1 + 2^-17 rounds to even, as in transform_step.
+  EXPECT_EQ(dot64(v3(3, -3, 0), v3(5, 5, 7)), 0u);
+  const double e = std::ldexp(1.0, -17);
+  EXPECT_EQ(dot64(v3(1, e, e), v3(1, 1, 1)), f(1).bits);
+  EXPECT_EQ(dot64(v3(1, 2, 3), v3(4, 5, 6)), f(32).bits);
+  // Limits of the condition for fp24 (emin = -62, emax = 63, M = 16): la + lb - 16 >= -62 and
+  // ha + hb + 4 <= 63.
+  const auto p2 = [](int k) { return F::from_double(std::ldexp(1.0, k)); };
+  const Vec3<F> one{p2(0), p2(0), p2(0)};
+  EXPECT_FALSE(refused(Vec3<F>{p2(-23), p2(0), p2(0)}, Vec3<F>{p2(-23), p2(0), p2(0)}));
+  EXPECT_TRUE(refused(Vec3<F>{p2(-24), p2(0), p2(0)}, Vec3<F>{p2(-23), p2(0), p2(0)}));
+  EXPECT_FALSE(refused(Vec3<F>{p2(29), p2(0), p2(0)}, Vec3<F>{p2(30), p2(0), p2(0)}));
+  EXPECT_TRUE(refused(Vec3<F>{p2(30), p2(0), p2(0)}, Vec3<F>{p2(30), p2(0), p2(0)}));
+  // Near overflow: the largest finite values would overflow (the encoding path gives inf).
+  const F big = F::from_bits(F::kFormat.inf_bits() - 1u);
+  EXPECT_TRUE(refused(Vec3<F>{big, big, big}, one));
+  EXPECT_TRUE(bits_inf(dot_step(fp, Vec3<F>{big, big, big}, Vec3<F>{big, big, big})));
+  // Subnormal, inf and NaN operands, and truncation, are left to the encoding path.
+  EXPECT_TRUE(refused(Vec3<F>{F::from_bits(1u), p2(0), p2(0)}, one));
+  EXPECT_TRUE(refused(Vec3<F>{F::infinity(), p2(0), p2(0)}, one));
+  EXPECT_TRUE(refused(Vec3<F>{F::from_bits(F::kFormat.nan_bits()), p2(0), p2(0)}, one));
+  EXPECT_TRUE(refused(pos, pos, false));
+}
+
 // Truncation: the binary64 traversal path never decides (1/D is NaN).
 TEST(Binary64Paths, TruncationAlwaysFallsBack) {
   const RawFp<F> fp({ff::Rounding::kTowardZero, ff::Subnormals::kFlush});

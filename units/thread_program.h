@@ -311,8 +311,9 @@ class ThreadProgram {
 
   // The RGC hands the thread the primary packet of pixels `pixel[i]` (memif::kNone = empty lane).
   void start_primary(const std::vector<std::uint32_t>& pixel) {
-    pending_.clear();
+    pending_size_ = 0;
     scene_.refresh(image_);
+    normal_instance_ = memif::kNone;
     const auto width = static_cast<std::uint32_t>(sink_.width);
     Packet& pk = gen_;  // built in place (begin_packet's copy is then a self-assignment)
     pk.kind = RayKind::kPrimary;
@@ -465,6 +466,16 @@ class ThreadProgram {
     Ray<F> world, current, tri;
     HitRecord<F> hit;  // hit.t = t_best (starts at the ray's t_max)
     RayCounters counters;
+    // As *this = Lane{}, member by member: the compiler zeroes a whole Lane with a string store,
+    // whose start-up costs more than these moves (the RGS starts a packet per light).
+    void clear() {
+      valid = done = false;
+      pixel = memif::kNone;
+      weight = 0;
+      world = current = tri = Ray<F>{};
+      hit = HitRecord<F>{};
+      counters = RayCounters{};
+    }
   };
 
   // The traversal unit works on binary64 values (datapath.h, traversal_lane64): O and 1/D per
@@ -655,7 +666,7 @@ class ThreadProgram {
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = pk.lanes[static_cast<std::size_t>(i)];
-      l = Lane{};
+      l.clear();
       l.valid = g.valid;
       l.pixel = g.pixel;
       l.weight = g.weight;
@@ -1131,6 +1142,47 @@ class ThreadProgram {
   }
 
   // ---- RGS (path g): shading and new packets (docs/shading.md) --------------------------------
+  // The RGS's arithmetic through the value paths of datapath.h where they decide, else the ops on
+  // encodings; the ops are counted here per use (the same counts as UnitFp's per op).
+  void count_shading_transform(std::uint64_t steps) {
+    PipelineUnits<F>::count(u_.transformation_ops, 9 * steps, 9 * steps, 0, 0);
+  }
+  // A direction step (ops counted by the caller) as three dot products: each of its rows is
+  // dot_step's expression with the row as the first vector. With a matrix per lane (T_shadow, T_R)
+  // the rows' exponent ranges are cheaper than matrix_values for one step.
+  Vec3<F> direction_step(const Mat34<F>& m, const Vec3<F>& v) const {
+    ExponentRange rv;
+    rv.include(v[0]);
+    rv.include(v[1]);
+    rv.include(v[2]);
+    Vec3<F> out;
+    for (int r = 0; r < 3; ++r) {
+      const Vec3<F> row{m[r][0], m[r][1], m[r][2]};
+      if (!dot_step64<F>(row, v, rv, nearest_, out[r])) out[r] = dot_step(u_.raw, row, v);
+    }
+    return out;
+  }
+  // A dot product on the transformation unit (a zero-translation row: 3 mul, 3 add).
+  F shade_dot(const Vec3<F>& a, const Vec3<F>& b) {
+    PipelineUnits<F>::count(u_.transformation_ops, 3, 3, 0, 0);
+    F r;
+    if (dot_step64<F>(a, b, nearest_, r)) return r;
+    return dot_step(u_.raw, a, b);
+  }
+  // -x / sqrt(a * b) on the RGS helper (1 mul, 1 sqrt, 1 div).
+  F cosine(F x, F a, F b) {
+    PipelineUnits<F>::count(u_.rgs_ops, 0, 1, 1, 0);
+    ++u_.rgs_ops.sqrt;
+    const auto& fp = u_.raw;
+    return fp.div(x.neg(), fp.sqrt(fp.mul(a, b)));
+  }
+  // k + k for k = n / d on the RGS helper (1 div, 1 add).
+  F twice_quotient(F n, F d) {
+    PipelineUnits<F>::count(u_.rgs_ops, 1, 0, 1, 0);
+    const F k = u_.raw.div(n, d);
+    return u_.raw.add(k, k);
+  }
+
   void record_primary() {
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
@@ -1172,12 +1224,11 @@ class ThreadProgram {
     const auto& regs = image_.registers();
     const Rgb8 ambient = unpack_rgb(regs.ambient_rgb);
     const Rgb8 background = unpack_rgb(regs.background_rgb);
-    const auto& ft = u_.transformation;
-    const auto& fr = u_.rgs;
+    static const Surface kClear{};
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
       Surface& s = surf_[static_cast<std::size_t>(i)];
-      s = Surface{};
+      s = kClear;  // as Surface{}, without its string store (see Lane::clear)
       if (!l.valid) continue;
       s.pixel = l.pixel;
       s.weight = l.weight;
@@ -1189,20 +1240,22 @@ class ThreadProgram {
       s.hit = true;
       s.ray = l.world;
       s.rec = l.hit;
-      const std::uint32_t irow = regs.instance_row_base + memif::kInstanceRows * s.rec.instance;
       const memif::InstanceHeader h = image_.instance_header(s.rec.instance);
       // World normal (D19): the triangle's unit normal (row 2 of T_delta) through M^T.
-      const auto nrow =
-          read_row<F>(image_, h.triangle_row_base + memif::kTriangleRows * s.rec.triangle + 2);
-      const Mat34<F> m = read_matrix<F>(image_, irow);
-      Mat34<F> mt{};
-      for (int r = 0; r < 3; ++r)
-        mt[r] = {m[0][r], m[1][r], m[2][r], F::zero()};
-      s.n = transform_step(ft, mt, Vec3<F>{nrow[0], nrow[1], nrow[2]}, false);
+      const auto nrow = row(h.triangle_row_base + memif::kTriangleRows * s.rec.triangle + 2);
+      if (s.rec.instance != normal_instance_) {  // hits of a packet mostly share the instance
+        normal_instance_ = s.rec.instance;
+        const Mat34<F> m = matrix(regs.instance_row_base + memif::kInstanceRows * s.rec.instance);
+        for (int r = 0; r < 3; ++r)
+          normal_m_[r] = {m[0][r], m[1][r], m[2][r], F::zero()};
+        normal_mv_ = matrix_values(normal_m_);
+      }
+      count_shading_transform(1);
+      s.n = transform(normal_m_, normal_mv_, Vec3<F>{nrow[0], nrow[1], nrow[2]}, false);
       if (is_pos_nonzero(s.rec.c))
         for (auto& x : s.n)
           x = x.neg();
-      s.nn = dot_step(ft, s.n, s.n);
+      s.nn = shade_dot(s.n, s.n);
       u_.shading_transformation_steps += 1;  // normal step; the dots count below
       const memif::ShadingRecord rec = read_shading_record(image_, h.shading_base + s.rec.triangle);
       s.mat = read_material(image_, rec.material);
@@ -1211,15 +1264,12 @@ class ThreadProgram {
       s.spec_rgb = unpack_rgb(s.mat.specular_rgb_shininess);
       s.spec = shininess >= 1 && (s.mat.specular_rgb_shininess & 0xFFFFFFu) != 0;
       const bool reflect = params_.secondary && depth_ < max_depth_ && s.mat.reflectivity > 0;
-      if (s.spec || reflect) {
-        const F dn = dot_step(ft, s.ray.d, s.n);
-        const F k = fr.div(dn, s.nn);
-        s.kk = fr.add(k, k);
-      }
+      if (s.spec || reflect) s.kk = twice_quotient(shade_dot(s.ray.d, s.n), s.nn);
       if (s.spec) {
         const Mat34<F> tr = reflect_matrix(s.ray, s.n);
-        s.r = transform_step(ft, tr, Vec3<F>{F::one(), s.kk.neg(), F::zero()}, false);
-        s.rr = dot_step(ft, s.r, s.r);
+        count_shading_transform(1);
+        s.r = direction_step(tr, Vec3<F>{F::one(), s.kk.neg(), F::zero()});
+        s.rr = shade_dot(s.r, s.r);
         u_.shading_transformation_steps += 1;
       }
       for (int k = 0; k < 3; ++k)
@@ -1253,7 +1303,7 @@ class ThreadProgram {
     for (std::uint32_t k = 0; k < 3; ++k)
       pos[k] = F::from_bits(image_.word(memif::kShadingBank, a + k));
     light_rgb_ = unpack_rgb(image_.word(memif::kShadingBank, a + 3));
-    Packet pk;
+    Packet& pk = gen_;  // built in place, as in start_primary (no allocation per packet)
     pk.kind = RayKind::kShadow;
     pk.depth = depth_;
     pk.shared_origin = params_.shared_origin;
@@ -1267,23 +1317,22 @@ class ThreadProgram {
       g.rd = {F::one().neg(), F::one(), s.rec.t};
       g.valid = s.hit;
       g.pixel = s.pixel;
+      g.weight = 0;
     }
     begin_packet(pk);
     if (!params_.shadows) {
       // Without shadow rays only the directions are needed: n direction steps, no origin step.
-      const auto& fp = u_.transformation;
       u_.shading_transformation_steps += static_cast<std::uint64_t>(p_);
+      count_shading_transform(static_cast<std::uint64_t>(p_));
       for (int i = 0; i < p_; ++i) {
         const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
-        lane(i).world.d = transform_step(fp, g.t, g.rd, false);
+        lane(i).world.d = direction_step(g.t, g.rd);
       }
       return do_shade_light();
     }
   }
 
   void do_shade_light() {
-    const auto& ft = u_.transformation;
-    const auto& fr = u_.rgs;
     std::uint64_t trace = 0;
     for (int i = 0; i < p_; ++i) {
       Surface& s = surf_[static_cast<std::size_t>(i)];
@@ -1291,15 +1340,15 @@ class ThreadProgram {
       s.highlight = false;
       if (!s.hit) continue;
       const Vec3<F>& sd = lane(i).world.d;  // hit point - L
-      const F ns = dot_step(ft, s.n, sd);
-      const F ss = dot_step(ft, sd, sd);
+      const F ns = shade_dot(s.n, sd);
+      const F ss = shade_dot(sd, sd);
       s.lit = is_neg_nonzero(ns);
       if (!s.lit) continue;
-      s.cos = fr.div(ns.neg(), fr.sqrt(fr.mul(s.nn, ss)));
+      s.cos = cosine(ns, s.nn, ss);
       if (s.spec) {
-        const F rl = dot_step(ft, s.r, sd);
+        const F rl = shade_dot(s.r, sd);
         s.highlight = is_neg_nonzero(rl);
-        if (s.highlight) s.cos_s = fr.div(rl.neg(), fr.sqrt(fr.mul(s.rr, ss)));
+        if (s.highlight) s.cos_s = cosine(rl, s.rr, ss);
       }
       trace |= std::uint64_t{1} << i;
     }
@@ -1340,12 +1389,17 @@ class ThreadProgram {
 
   // Local colour into the pixel, then reflection and transparency children (D37).
   void finish_surface() {
-    Packet refl, transp;
+    // The children are built in the next two pending slots, whose lane vectors are kept from
+    // earlier packets (no allocation per packet); the reflection packet is traced first.
+    if (pending_.size() < pending_size_ + 2) pending_.resize(pending_size_ + 2);
+    Packet& transp = pending_[pending_size_];
+    Packet& refl = pending_[pending_size_ + 1];
     refl.kind = RayKind::kReflection;
     transp.kind = RayKind::kTransparency;
     refl.depth = transp.depth = depth_ + 1;
-    refl.lanes.resize(lanes_.size());
-    transp.lanes.resize(lanes_.size());
+    refl.shared_origin = transp.shared_origin = false;
+    refl.lanes.assign(lanes_.size(), GenLane{});
+    transp.lanes.assign(lanes_.size(), GenLane{});
     bool any_refl = false, any_transp = false;
     for (int i = 0; i < p_; ++i) {
       const Surface& s = surf_[static_cast<std::size_t>(i)];
@@ -1382,19 +1436,21 @@ class ThreadProgram {
         any_transp = true;
       }
     }
-    if (any_transp) pending_.push_back(transp);
-    if (any_refl) pending_.push_back(refl);
+    if (any_transp) ++pending_size_;
+    if (any_refl) {
+      if (!any_transp) std::swap(transp, refl);
+      ++pending_size_;
+    }
     next_packet();
   }
 
   void next_packet() {
-    if (pending_.empty()) {
+    if (pending_size_ == 0) {
       phase_ = Phase::kDone;
       return;
     }
-    const Packet pk = pending_.back();
-    pending_.pop_back();
-    begin_packet(pk);
+    --pending_size_;
+    begin_packet(pending_[pending_size_]);  // copied into gen_: the slot may be rebuilt
   }
 
   const memif::MemoryImage& image_;
@@ -1415,7 +1471,15 @@ class ThreadProgram {
   std::uint32_t depth_ = 0;
   bool shared_origin_ = false;
   Packet gen_;
+  // Child packets still to trace (a LIFO of pending_size_ entries); slots beyond it keep their
+  // lane vectors for reuse.
   std::vector<Packet> pending_;
+  std::size_t pending_size_ = 0;
+  // M^T (zero translation) of the instance whose normals the RGS transformed last, and its values;
+  // kNone: none yet in this primary packet's tree (the image may change between frames).
+  std::uint32_t normal_instance_ = memif::kNone;
+  Mat34<F> normal_m_{};
+  Mat64 normal_mv_{};
   std::vector<Lane> lanes_;
   std::vector<Surface> surf_;
   std::uint32_t light_ = 0;
