@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <initializer_list>
 #include <random>
 #include <vector>
 
@@ -323,18 +324,32 @@ void check_binary64_paths(ff::Mode mode, int n) {
   EXPECT_GT(transforms, n / 4);
 }
 
-TEST(Binary64Paths, AgreeWithTheEncodingPaths) {
+// The formats the value paths serve, each run through `check(FormatTag<G>{}, mode, count)`: fp24
+// with `n` random cases, the others with n / 4; in every rounding and subnormal mode listed. The
+// sanitizer build runs a twentieth of `n`.
+template <class G>
+struct FormatTag {
+  using type = G;
+};
+template <class Check>
+void over_formats(std::initializer_list<ff::Rounding> roundings, int n, const Check& check) {
 #if defined(SAARCOR_SANITIZED)
-  const int n = 20'000;
-#else
-  const int n = 400'000;
+  n /= 20;
 #endif
-  for (const ff::Subnormals s : {ff::Subnormals::kFlush, ff::Subnormals::kKeep}) {
-    check_binary64_paths<ff::fp24>({ff::Rounding::kNearestEven, s}, n);
-    check_binary64_paths<ff::Float<7, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
-    check_binary64_paths<ff::Float<8, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
-    check_binary64_paths<ff::Float<7, 10>>({ff::Rounding::kNearestEven, s}, n / 4);
-  }
+  for (const ff::Rounding r : roundings)
+    for (const ff::Subnormals s : {ff::Subnormals::kFlush, ff::Subnormals::kKeep}) {
+      const ff::Mode mode{r, s};
+      check(FormatTag<ff::fp24>{}, mode, n);
+      check(FormatTag<ff::Float<7, 23>>{}, mode, n / 4);
+      check(FormatTag<ff::Float<8, 23>>{}, mode, n / 4);
+      check(FormatTag<ff::Float<7, 10>>{}, mode, n / 4);
+    }
+}
+
+TEST(Binary64Paths, AgreeWithTheEncodingPaths) {
+  over_formats({ff::Rounding::kNearestEven}, 400'000, [](auto format, ff::Mode mode, int n) {
+    check_binary64_paths<typename decltype(format)::type>(mode, n);
+  });
 }
 
 // The two-lane forms (thread program) against the one-lane value paths, lane by lane.
@@ -450,17 +465,9 @@ void check_pair_paths(ff::Mode mode, int n) {
 }
 
 TEST(Binary64Paths, PairFormsAgreeWithOneLane) {
-#if defined(SAARCOR_SANITIZED)
-  const int n = 10'000;
-#else
-  const int n = 200'000;
-#endif
-  for (const ff::Subnormals s : {ff::Subnormals::kFlush, ff::Subnormals::kKeep}) {
-    check_pair_paths<ff::fp24>({ff::Rounding::kNearestEven, s}, n);
-    check_pair_paths<ff::Float<7, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
-    check_pair_paths<ff::Float<8, 23>>({ff::Rounding::kNearestEven, s}, n / 4);
-    check_pair_paths<ff::Float<7, 10>>({ff::Rounding::kNearestEven, s}, n / 4);
-  }
+  over_formats({ff::Rounding::kNearestEven}, 200'000, [](auto format, ff::Mode mode, int n) {
+    check_pair_paths<typename decltype(format)::type>(mode, n);
+  });
 }
 
 // dot_step64 (the RGS's dot products and direction steps) against dot_step on encodings: random
@@ -531,18 +538,10 @@ void check_dot_paths(ff::Mode mode, int n) {
 }
 
 TEST(Binary64Paths, DotStepAgreesWithTheEncodingPath) {
-#if defined(SAARCOR_SANITIZED)
-  const int n = 20'000;
-#else
-  const int n = 400'000;
-#endif
-  for (const ff::Rounding r : {ff::Rounding::kNearestEven, ff::Rounding::kTowardZero})
-    for (const ff::Subnormals s : {ff::Subnormals::kFlush, ff::Subnormals::kKeep}) {
-      check_dot_paths<ff::fp24>({r, s}, n);
-      check_dot_paths<ff::Float<7, 23>>({r, s}, n / 4);
-      check_dot_paths<ff::Float<8, 23>>({r, s}, n / 4);
-      check_dot_paths<ff::Float<7, 10>>({r, s}, n / 4);
-    }
+  over_formats({ff::Rounding::kNearestEven, ff::Rounding::kTowardZero}, 400'000,
+               [](auto format, ff::Mode mode, int n) {
+                 check_dot_paths<typename decltype(format)::type>(mode, n);
+               });
 }
 
 TEST(Binary64Paths, DotStepEdgeCases) {
