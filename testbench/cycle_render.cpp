@@ -15,6 +15,9 @@ units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
   for (const std::string& kv : opts.set)
     units::apply_cycle_setting(p, kv);
   units::check_cycle_params(p);
+  if (opts.host_threads < 0 || opts.host_threads > 2)
+    throw std::runtime_error("bad --host-threads " + std::to_string(opts.host_threads) +
+                             ": 1 (thread programs inline) or 2 (thread programs ahead)");
   if (!opts.vcd.empty() && opts.vcd_to < opts.vcd_from)
     throw std::runtime_error("bad --vcd-to " + std::to_string(opts.vcd_to) +
                              ": before --vcd-from " + std::to_string(opts.vcd_from));
@@ -28,6 +31,7 @@ units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
   units::CycleRunOptions ro;
   ro.shading = shading;
   ro.interval = opts.interval;
+  if (opts.host_threads != 0) ro.programs_ahead = opts.host_threads == 2;
   if (isatty(fileno(stderr)))
     ro.progress = [](std::uint64_t cycles, int done, int total) {
       std::fprintf(stderr, "\r  cycle %llu, packets %d / %d",
@@ -94,6 +98,7 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
   j["simd_efficiency"] = c.simd_efficiency;
   j["host"] = {{"seconds", c.host_seconds},
                {"sim_cycles_per_s", c.sim_cycles_per_s},
+               {"threads", c.host_threads},
                {"skipped_cycles", c.skipped_cycles}};
   nlohmann::json units;
   for (int i = 0; i < units::kTable4Units; ++i) {

@@ -20,8 +20,12 @@ struct CycleRenderOptions {
   std::string vcd;               // VCD file of cycles [vcd_from, vcd_to]
   std::uint64_t vcd_from = 0;
   std::uint64_t vcd_to = 10000;
+  // 2: the thread programs run on a second host thread ahead of the simulation; 1: inline. 0: 2
+  // where the machine has two cores or more. The results are the same.
+  int host_threads = 0;
   bool any_given() const {
-    return preset != "prototype" || !set.empty() || interval != 0 || !vcd.empty();
+    return preset != "prototype" || !set.empty() || interval != 0 || !vcd.empty() ||
+           host_threads != 0;
   }
 };
 

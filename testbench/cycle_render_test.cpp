@@ -53,6 +53,7 @@ TEST(CycleRender, ReportVcdAndTable) {
   o.cycle.vcd = (d / "room.vcd").string();
   o.cycle.vcd_from = 100;
   o.cycle.vcd_to = 200;
+  o.cycle.host_threads = 1;  // the programs inline (the report says so)
   testing::internal::CaptureStdout();
   EXPECT_EQ(run_render(o), 0);
   const std::string out = testing::internal::GetCapturedStdout();
@@ -73,6 +74,7 @@ TEST(CycleRender, ReportVcdAndTable) {
   EXPECT_EQ(j["configuration"]["cycle"]["lat.div"]["value"].get<int>(), 12);
   EXPECT_EQ(j["configuration"]["cycle"]["depth.traversal"].get<int>(), 3 + 12 + 1);
   EXPECT_GE(j["time_series"].size(), 2u);
+  EXPECT_EQ(j["host"]["threads"].get<int>(), 1);
   EXPECT_EQ(j["stats"]["dynrtp0.transformation.issue_cycles"]["value"].get<double>(),
             j["units"]["transformation"]["issue_cycles"].get<double>());
   EXPECT_TRUE(j["stats"].contains("dynrtp0.node_cache.hit_rate_with_merges"));
@@ -123,6 +125,13 @@ TEST(CycleRender, BadInput) {
   bad.cycle.vcd_from = 50;
   bad.cycle.vcd_to = 10;
   expect_error(bad, "--vcd-to");
+  bad = o;
+  bad.cycle.host_threads = 3;
+  expect_error(bad, "bad --host-threads 3");
+  bad = o;
+  bad.model = "fp24";
+  bad.cycle.host_threads = 1;
+  expect_error(bad, "--model cycle only");
   bad = o;
   bad.cycle.vcd = (d / "no" / "such" / "dir" / "t.vcd").string();
   expect_error(bad, "cannot write --vcd");

@@ -481,7 +481,8 @@ int run_render(const RenderOptions& opts) {
   if (model.kind == ModelKind::kCycle) {
     resolve_cycle_params(opts.cycle);  // a bad --preset/--set fails before the scene loads
   } else if (opts.cycle.any_given()) {
-    throw std::runtime_error("--preset, --set, --interval and --vcd apply to --model cycle only");
+    throw std::runtime_error(
+        "--preset, --set, --interval, --host-threads and --vcd apply to --model cycle only");
   }
   std::optional<PixelCoord> pixel;
   if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);

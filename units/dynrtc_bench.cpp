@@ -17,6 +17,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <vector>
@@ -48,6 +49,15 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+// CPU seconds of every thread of the process (the cycle model with its program thread).
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 // Per frame kind (hits, shaded): the functional model's best frame time.
 double g_functional_seconds[2] = {0.0, 0.0};
 // Embree's best single-ray rate on the frame's primary rays (the machine yardstick).
@@ -106,6 +116,10 @@ void BM_FunctionalFp24Frame(benchmark::State& state) {
 }
 BENCHMARK(BM_FunctionalFp24Frame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 
+// Args: threads, frame (0 hit sink, 1 shaded), programs ahead (1: the thread programs on a second
+// host thread, the default where the machine has two cores; 0: inline, one host thread). With two
+// host threads a frame is timed by the wall clock (the process CPU time, both threads, is printed
+// beside it); inline frames by this thread's CPU time as the functional model's.
 void BM_CycleModelFrame(benchmark::State& state) {
   const Room& r = room();
   units::CycleParams p = units::prototype_params();
@@ -113,12 +127,15 @@ void BM_CycleModelFrame(benchmark::State& state) {
   const bool shade = state.range(1) != 0;
   units::CycleRunOptions options;
   options.shading.shade = shade;
-  FrameTimes times;
+  options.programs_ahead = state.range(2) != 0;
+  const auto clock = options.programs_ahead ? wall_seconds : cpu_seconds;
+  FrameTimes times, cpu;
   units::CycleFrame last;
   for (auto _ : state) {
-    const double t0 = cpu_seconds();
+    const double t0 = clock(), c0 = process_cpu_seconds();
     last = units::run_cycle(r.built.image, p, options);
-    times.add(cpu_seconds() - t0);
+    times.add(clock() - t0);
+    cpu.add(process_cpu_seconds() - c0);
   }
   const double functional = g_functional_seconds[shade];
   const double rate = static_cast<double>(last.cycles) / times.best;
@@ -130,20 +147,26 @@ void BM_CycleModelFrame(benchmark::State& state) {
   if (embree > 0) state.counters["per_embree_ray_per_s"] = rate / embree;
   state.counters["evaluations_per_cycle"] =
       static_cast<double>(last.module_evaluations) / static_cast<double>(last.cycles);
+  state.counters["process_cpu_s_per_frame"] = cpu.best;
   std::printf(
-      "cycle model, %d threads, %s: %.3f host s per 512x384 frame (best of %d; mean %.3f), %llu "
+      "cycle model, %d threads, %s, %s: %.3f host s per 512x384 frame (best of %d; mean %.3f; "
+      "process CPU %.3f s), %llu "
       "cycles (%.1f fps at %.0f MHz), %.2f M simulated cycles/s (target >= 5: ratio %.2f), %.1fx "
       "the functional fp24 model's %.3f s (target <= 20x: ratio %.2f); yardstick: %.3f simulated "
       "cycles per second per Embree ray per second (Embree %.2f M rays/s on this frame)\n",
-      p.threads, shade ? "shaded (Table 3 setting)" : "hit sink (the issue's frame)", times.best,
-      times.n, times.mean(), static_cast<unsigned long long>(last.cycles), last.fps, p.clock_mhz,
-      rate / 1e6, rate / 5e6, functional > 0 ? times.best / functional : 0.0, functional,
-      functional > 0 ? times.best / functional / 20.0 : 0.0, embree > 0 ? rate / embree : 0.0,
-      embree * 1e-6);
+      p.threads, shade ? "shaded (Table 3 setting)" : "hit sink (the issue's frame)",
+      options.programs_ahead ? "programs ahead (2 host threads, wall clock)"
+                             : "programs inline (1 host thread, CPU time)",
+      times.best, times.n, times.mean(), cpu.best, static_cast<unsigned long long>(last.cycles),
+      last.fps, p.clock_mhz, rate / 1e6, rate / 5e6, functional > 0 ? times.best / functional : 0.0,
+      functional, functional > 0 ? times.best / functional / 20.0 : 0.0,
+      embree > 0 ? rate / embree : 0.0, embree * 1e-6);
 }
 BENCHMARK(BM_CycleModelFrame)
-    ->Args({64, 0})
-    ->Args({64, 1})
+    ->Args({64, 0, 1})
+    ->Args({64, 0, 0})
+    ->Args({64, 1, 1})
+    ->Args({64, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 

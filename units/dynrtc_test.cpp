@@ -87,6 +87,53 @@ TEST(DynRtc, IdleSkipChangesNothing) {
   EXPECT_EQ(a.stats_json, c.stats_json);
 }
 
+// The thread programs on a second host thread ahead of the simulation (the default on a
+// multi-core host) and a program per thread run inline give the same run: cycles, every
+// statistic, every hit record, the image and the op counts, under every configuration of the
+// covering design (one thread, packets of 1 and 16, tiny caches, random latencies, shadow and
+// secondary rays).
+TEST(DynRtc, ProgramsAheadChangeNothing) {
+  const host::BuiltImage b = build("builtin:room", kSanitized ? 16 : 32, kSanitized ? 12 : 24);
+  for (const testing::Config& c : configs()) {
+    const CycleParams p = testing::params_of(c);
+    CycleRunOptions ahead, inline_run;
+    ahead.shading = inline_run.shading = testing::shading_of(c);
+    ahead.programs_ahead = true;
+    inline_run.programs_ahead = false;
+    const CycleFrame a = run_cycle(b.image, p, ahead);
+    const CycleFrame i = run_cycle(b.image, p, inline_run);
+    EXPECT_EQ(a.cycles, i.cycles) << c.name;
+    EXPECT_EQ(a.stats_json, i.stats_json) << c.name;
+    ASSERT_EQ(a.frame.pixels.size(), i.frame.pixels.size()) << c.name;
+    for (std::size_t k = 0; k < a.frame.pixels.size(); ++k)
+      ASSERT_TRUE(testing::same_record(a.frame.pixels[k], i.frame.pixels[k]))
+          << c.name << ": pixel " << k;
+    EXPECT_EQ(a.frame.rgb, i.frame.rgb) << c.name;
+    EXPECT_EQ(a.frame.units.transformation_ops, i.frame.units.transformation_ops) << c.name;
+    EXPECT_EQ(a.frame.units.rgs_ops, i.frame.units.rgs_ops) << c.name;
+    EXPECT_EQ(a.frame.rays_issued, i.frame.rays_issued) << c.name;
+  }
+}
+
+// An error of a thread program on the program thread (here the stack overflow of D26) stops the
+// run with the same one-line error as inline, and with fewer threads than packets in flight.
+TEST(DynRtc, ProgramThreadErrorsReachTheCaller) {
+  const host::BuiltImage b = build("builtin:room", 16, 12);
+  for (const int threads : {1, 64}) {
+    CycleParams p = prototype_params();
+    p.stack = 2;
+    p.threads = threads;
+    CycleRunOptions o;
+    o.programs_ahead = true;
+    try {
+      run_cycle(b.image, p, o);
+      ADD_FAILURE() << "a 2-entry stack was enough";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("stack overflow"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // Thread scaling (paper section 5: nearly linear up to 32 threads, about +10% from 32 to 64).
 TEST(DynRtc, ThreadScalingOnTheRoom) {
   // 128x96 (3,072 packets): at 64x48 the 64 threads share 768 packets and the frame's tail, when

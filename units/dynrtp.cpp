@@ -4,11 +4,15 @@
 #include "units/dynrtp.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <exception>
+#include <limits>
 #include <memory>
 #include <new>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
@@ -19,22 +23,55 @@ namespace {
 
 // The thread table: one thread program per thread, all sharing the DynRTP's float units and the
 // frame sink (their only shared state; both sum order-independently).
+//
+// Programs ahead of the simulation (CycleRunOptions::programs_ahead; docs/cycle-model.md): what a
+// thread computes never depends on timing, and a packet's computation does not depend on the
+// thread that runs it (the mailbox, stack and child packets start afresh with every primary
+// packet, D28). So one program on a second host thread runs the packets in the RGC's order, as
+// the functional model does, and records each packet's request sequence; a simulated thread then
+// replays its packet's sequence, and execute() is a copy. The same requests reach the units, so
+// every figure and result is the same as with a program per thread (tested).
 template <class F, int kLanes>
 class Threads final : public ThreadTable {
  public:
-  Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads)
-      : params_(params), units_(params.mode) {
+  Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads, bool ahead)
+      : params_(params), units_(params.mode), ahead_(ahead) {
     w_ = static_cast<int>(image.registers().width);
     h_ = static_cast<int>(image.registers().height);
     tiling_ = packet_tiling(w_, h_, params.packet);
     sink_.reset(w_, h_);
-    for (int i = 0; i < threads; ++i) {
-      programs_.push_back(
-          std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
-      requests_.push_back(programs_.back()->request());
+    requests_.resize(static_cast<std::size_t>(threads));
+    if (!ahead_) {
+      for (int i = 0; i < threads; ++i) {
+        programs_.push_back(
+            std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
+        requests_[static_cast<std::size_t>(i)] = programs_.back()->request();
+      }
+      return;
     }
+    // Every packet in flight was started after packet k - threads, so with more slots than
+    // threads the slot packet k needs was released before the RGC can ask for packet k.
+    slots_ = std::vector<Slot>(static_cast<std::size_t>(threads) + 192);
+    for (std::size_t i = 0; i < slots_.size(); ++i)
+      slots_[i].released.store(static_cast<std::int64_t>(i) -
+                               static_cast<std::int64_t>(slots_.size()));
+    cursor_.resize(static_cast<std::size_t>(threads));
+    programs_.push_back(std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
+    for (int i = 0; i < threads; ++i)
+      requests_[static_cast<std::size_t>(i)] = programs_.back()->request();
+    worker_ = std::thread([this] { run_ahead(); });
   }
+  ~Threads() override { stop(); }
+  Threads(const Threads&) = delete;
+  Threads& operator=(const Threads&) = delete;
+
   void execute(std::uint32_t t) override {
+    if (ahead_) {
+      Cursor& c = cursor_[t];
+      requests_[t] = slots_[c.slot].trace[++c.next];
+      if (requests_[t].unit == UnitId::kNone) release(c);
+      return;
+    }
     ThreadProgram<F, kLanes>& p = *programs_[t];
     p.execute();
     // Returned straight into the table (guaranteed elision): a copy of the returned temporary
@@ -42,22 +79,111 @@ class Threads final : public ThreadTable {
     ::new (static_cast<void*>(&requests_[t])) Request(p.request());
   }
   void start_primary(std::uint32_t t, int packet) override {
+    if (ahead_) {
+      Cursor& c = cursor_[t];
+      c = {wait_ready(packet), 0, packet};
+      requests_[t] = slots_[c.slot].trace[0];
+      if (requests_[t].unit == UnitId::kNone) release(c);
+      return;
+    }
     programs_[t]->start_primary(packet_pixels(tiling_, w_, h_, packet));
     ::new (static_cast<void*>(&requests_[t])) Request(programs_[t]->request());
   }
   int packets() const override { return tiling_.count(); }
+
+  // Waits for the program thread (it has run every packet once the RGC has retired them all) and
+  // rethrows what it threw; the units and the sink are then complete.
+  void finish() {
+    stop();
+    if (error_) std::rethrow_exception(error_);
+  }
 
   PipelineUnits<F>& units() { return units_; }
   FrameSink& sink() { return sink_; }
   const FunctionalParams& params() const { return params_; }
 
  private:
+  // One packet's request sequence, from the request after start_primary to the final kDone.
+  struct Slot {
+    std::vector<Request> trace;
+    std::atomic<std::int64_t> ready{-1};  // the packet whose trace is complete here
+    std::atomic<std::int64_t> released;   // the last packet the simulation is done with here
+  };
+  struct Cursor {
+    std::size_t slot = 0, next = 0;
+    int packet = 0;
+  };
+
+  // The program thread: packets in order, each into its slot once the slot's previous packet
+  // (threads + 192 packets earlier) is released.
+  void run_ahead() {
+    try {
+      ThreadProgram<F, kLanes>& p = *programs_[0];
+      const int total = tiling_.count();
+      const auto n = static_cast<std::int64_t>(slots_.size());
+      for (int k = 0; k < total; ++k) {
+        Slot& s = slots_[static_cast<std::size_t>(k) % slots_.size()];
+        for (std::int64_t v; (v = s.released.load(std::memory_order_acquire)) < k - n;)
+          s.released.wait(v, std::memory_order_acquire);
+        if (stopping_.load(std::memory_order_relaxed)) return;
+        p.start_primary(packet_pixels(tiling_, w_, h_, k));
+        s.trace.clear();
+        for (;;) {
+          s.trace.push_back(p.request());
+          if (p.done()) break;
+          p.execute();
+        }
+        s.ready.store(k, std::memory_order_release);
+        s.ready.notify_one();
+      }
+    } catch (...) {
+      error_ = std::current_exception();
+      failed_.store(true, std::memory_order_release);
+      for (Slot& s : slots_) {  // wakes the simulation wherever it waits
+        s.ready.store(-2, std::memory_order_release);
+        s.ready.notify_all();
+      }
+    }
+  }
+
+  std::size_t wait_ready(int packet) {
+    const std::size_t i = static_cast<std::size_t>(packet) % slots_.size();
+    std::atomic<std::int64_t>& ready = slots_[i].ready;
+    for (std::int64_t v; (v = ready.load(std::memory_order_acquire)) != packet;) {
+      if (failed_.load(std::memory_order_acquire)) finish();  // rethrows the program's error
+      ready.wait(v, std::memory_order_acquire);
+    }
+    return i;
+  }
+
+  void release(const Cursor& c) {
+    std::atomic<std::int64_t>& released = slots_[c.slot].released;
+    released.store(c.packet, std::memory_order_release);
+    released.notify_one();
+  }
+
+  void stop() {
+    if (!worker_.joinable()) return;
+    stopping_.store(true, std::memory_order_relaxed);
+    for (Slot& s : slots_) {  // wakes the program thread wherever it waits
+      s.released.store(std::numeric_limits<std::int64_t>::max(), std::memory_order_release);
+      s.released.notify_all();
+    }
+    worker_.join();
+  }
+
   FunctionalParams params_;
   PipelineUnits<F> units_;
   FrameSink sink_;
   PacketTiling tiling_;
   int w_ = 0, h_ = 0;
+  bool ahead_ = false;
   std::vector<std::unique_ptr<ThreadProgram<F, kLanes>>> programs_;
+  std::vector<Slot> slots_;
+  std::vector<Cursor> cursor_;
+  std::atomic<bool> stopping_{false}, failed_{false};
+  std::exception_ptr error_;
+  std::thread worker_;
 };
 
 template <class F, int kLanes>
@@ -255,7 +381,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
   // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
   memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
-  Threads<F, kLanes> threads(image, fp, p.threads);
+  Threads<F, kLanes> threads(image, fp, p.threads, opt.programs_ahead);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;
@@ -294,6 +420,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   if (opt.vcd != nullptr) k.finish_trace();
   const Snapshot end = snapshot(k, dyn);
 
+  threads.finish();
   collect(out.frame, threads);
   out.cycles = k.now();
   out.figures = figures(start, end, p.clock_mhz);
@@ -331,6 +458,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
                                          static_cast<double>(steps) / p.packet;
   out.packets_retired = dyn.rgs().packets_retired();
   out.skipped_cycles = k.skipped_cycles();
+  out.host_threads = opt.programs_ahead ? 2 : 1;
   out.module_evaluations = k.module_evaluations();
   out.stats_json = k.stats().json();
   out.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

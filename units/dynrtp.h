@@ -10,6 +10,7 @@
 #include <functional>
 #include <iosfwd>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "memif/image_format.h"
@@ -32,6 +33,10 @@ struct CycleRunOptions {
   std::uint64_t shuffle_seed = 0;  // != 0: random module evaluation order (figures must not move)
   bool idle_skip = true;           // false: evaluate every cycle (figures must not move)
   std::uint64_t max_cycles = 0;    // != 0: stop with an error after this many cycles
+  // The thread programs run on a second host thread ahead of the simulation, which replays their
+  // request sequences (docs/cycle-model.md, "Programs ahead"); false: a program per simulated
+  // thread, run inline. Results and figures are the same either way.
+  bool programs_ahead = std::thread::hardware_concurrency() > 1;
   std::function<void(std::uint64_t cycles, int packets_done, int packets)> progress;
 };
 
@@ -58,7 +63,8 @@ struct CycleFrame {
   RayCounters per_ray_sum;     // all kinds
   double simd_efficiency = 0;  // active rays per traversal packet step / P
   std::uint64_t packets = 0, packets_retired = 0;
-  double host_seconds = 0, sim_cycles_per_s = 0;
+  double host_seconds = 0, sim_cycles_per_s = 0;  // wall clock
+  int host_threads = 1;                           // 2: the thread programs ran ahead
   std::uint64_t skipped_cycles = 0;
   std::uint64_t module_evaluations = 0;  // host work: evaluate() calls (sleeping modules skip)
   std::vector<CycleFigures> series;      // with interval != 0: the figures of each interval
