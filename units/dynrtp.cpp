@@ -4,11 +4,12 @@
 #include "units/dynrtp.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <deque>
 #include <exception>
-#include <limits>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <sstream>
 #include <stdexcept>
@@ -34,8 +35,12 @@ namespace {
 template <class F, int kLanes>
 class Threads final : public ThreadTable {
  public:
-  Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads, bool ahead)
-      : params_(params), units_(params.mode), ahead_(ahead) {
+  // ahead > 0: the programs run on a second host thread, at most `ahead` finished packets ahead.
+  Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads, int ahead)
+      : params_(params),
+        units_(params.mode),
+        ahead_(ahead > 0),
+        max_ahead_(static_cast<std::size_t>(ahead)) {
     w_ = static_cast<int>(image.registers().width);
     h_ = static_cast<int>(image.registers().height);
     tiling_ = packet_tiling(w_, h_, params.packet);
@@ -49,12 +54,10 @@ class Threads final : public ThreadTable {
       }
       return;
     }
-    // Every packet in flight was started after packet k - threads, so with more slots than
-    // threads the slot packet k needs was released before the RGC can ask for packet k.
-    slots_ = std::vector<Slot>(static_cast<std::size_t>(threads) + 192);
+    // Slots for every packet in flight (at most one per thread) and for the finished ones.
+    slots_.resize(static_cast<std::size_t>(threads) + max_ahead_);
     for (std::size_t i = 0; i < slots_.size(); ++i)
-      slots_[i].released.store(static_cast<std::int64_t>(i) -
-                               static_cast<std::int64_t>(slots_.size()));
+      free_.push_back(i);
     cursor_.resize(static_cast<std::size_t>(threads));
     programs_.push_back(std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
     for (int i = 0; i < threads; ++i)
@@ -69,7 +72,7 @@ class Threads final : public ThreadTable {
     if (ahead_) {
       Cursor& c = cursor_[t];
       requests_[t] = slots_[c.slot].trace[++c.next];
-      if (requests_[t].unit == UnitId::kNone) release(c);
+      if (requests_[t].unit == UnitId::kNone) release(c.slot);
       return;
     }
     ThreadProgram<F, kLanes>& p = *programs_[t];
@@ -81,9 +84,9 @@ class Threads final : public ThreadTable {
   void start_primary(std::uint32_t t, int packet) override {
     if (ahead_) {
       Cursor& c = cursor_[t];
-      c = {wait_ready(packet), 0, packet};
+      c = {take(packet), 0};
       requests_[t] = slots_[c.slot].trace[0];
-      if (requests_[t].unit == UnitId::kNone) release(c);
+      if (requests_[t].unit == UnitId::kNone) release(c.slot);
       return;
     }
     programs_[t]->start_primary(packet_pixels(tiling_, w_, h_, packet));
@@ -106,69 +109,96 @@ class Threads final : public ThreadTable {
   // One packet's request sequence, from the request after start_primary to the final kDone.
   struct Slot {
     std::vector<Request> trace;
-    std::atomic<std::int64_t> ready{-1};  // the packet whose trace is complete here
-    std::atomic<std::int64_t> released;   // the last packet the simulation is done with here
+    int packet = -1;
   };
   struct Cursor {
     std::size_t slot = 0, next = 0;
-    int packet = 0;
   };
 
-  // The program thread: packets in order, each into its slot once the slot's previous packet
-  // (threads + 192 packets earlier) is released.
+  // The program thread: packets in the RGC's order, each into a free slot, at most max_ahead_
+  // finished packets ahead of the simulation. The slots in flight (<= threads) and the finished
+  // ones (< max_ahead_ when a slot is taken) never exhaust the pool, so this thread waits only
+  // while max_ahead_ packets are finished and the simulation only while none is: never both.
   void run_ahead() {
     try {
       ThreadProgram<F, kLanes>& p = *programs_[0];
       const int total = tiling_.count();
-      const auto n = static_cast<std::int64_t>(slots_.size());
       for (int k = 0; k < total; ++k) {
-        Slot& s = slots_[static_cast<std::size_t>(k) % slots_.size()];
-        for (std::int64_t v; (v = s.released.load(std::memory_order_acquire)) < k - n;)
-          s.released.wait(v, std::memory_order_acquire);
-        if (stopping_.load(std::memory_order_relaxed)) return;
-        p.start_primary(packet_pixels(tiling_, w_, h_, k));
+        std::size_t id;
+        {
+          std::unique_lock<std::mutex> lock(mutex_);
+          if (finished_.size() >= max_ahead_) {
+            // Full: sleep until half of the window is taken (one wake-up per half window, not
+            // one per packet).
+            programs_waiting_ = true;
+            to_programs_.wait(lock,
+                              [&] { return stopping_ || finished_.size() <= max_ahead_ / 2; });
+            programs_waiting_ = false;
+          }
+          if (stopping_) return;
+          id = free_.back();
+          free_.pop_back();
+        }
+        Slot& s = slots_[id];
+        s.packet = k;
         s.trace.clear();
+        p.start_primary(packet_pixels(tiling_, w_, h_, k));
         for (;;) {
           s.trace.push_back(p.request());
           if (p.done()) break;
           p.execute();
         }
-        s.ready.store(k, std::memory_order_release);
-        s.ready.notify_one();
+        {
+          const std::lock_guard<std::mutex> lock(mutex_);
+          finished_.push_back(id);
+        }
+        to_simulation_.notify_one();
       }
     } catch (...) {
-      error_ = std::current_exception();
-      failed_.store(true, std::memory_order_release);
-      for (Slot& s : slots_) {  // wakes the simulation wherever it waits
-        s.ready.store(-2, std::memory_order_release);
-        s.ready.notify_all();
+      {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        error_ = std::current_exception();
       }
+      to_simulation_.notify_one();
     }
   }
 
-  std::size_t wait_ready(int packet) {
-    const std::size_t i = static_cast<std::size_t>(packet) % slots_.size();
-    std::atomic<std::int64_t>& ready = slots_[i].ready;
-    for (std::int64_t v; (v = ready.load(std::memory_order_acquire)) != packet;) {
-      if (failed_.load(std::memory_order_acquire)) finish();  // rethrows the program's error
-      ready.wait(v, std::memory_order_acquire);
+  // The slot of `packet`, the next in order, once the program thread has finished it; rethrows
+  // the program thread's error when that packet can no longer come.
+  std::size_t take(int packet) {
+    std::size_t id;
+    bool wake = false;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      to_simulation_.wait(lock, [&] { return !finished_.empty() || error_; });
+      if (finished_.empty()) {
+        lock.unlock();
+        finish();  // rethrows
+      }
+      id = finished_.front();
+      finished_.pop_front();
+      wake = programs_waiting_ && finished_.size() <= max_ahead_ / 2;
     }
-    return i;
+    if (wake) to_programs_.notify_one();
+    if (slots_[id].packet != packet)
+      throw std::logic_error("cycle model: the RGC asked for packet " + std::to_string(packet) +
+                             ", the program thread ran packet " +
+                             std::to_string(slots_[id].packet));
+    return id;
   }
 
-  void release(const Cursor& c) {
-    std::atomic<std::int64_t>& released = slots_[c.slot].released;
-    released.store(c.packet, std::memory_order_release);
-    released.notify_one();
+  void release(std::size_t slot) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(slot);
   }
 
   void stop() {
     if (!worker_.joinable()) return;
-    stopping_.store(true, std::memory_order_relaxed);
-    for (Slot& s : slots_) {  // wakes the program thread wherever it waits
-      s.released.store(std::numeric_limits<std::int64_t>::max(), std::memory_order_release);
-      s.released.notify_all();
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
     }
+    to_programs_.notify_one();
     worker_.join();
   }
 
@@ -178,10 +208,16 @@ class Threads final : public ThreadTable {
   PacketTiling tiling_;
   int w_ = 0, h_ = 0;
   bool ahead_ = false;
+  std::size_t max_ahead_ = 0;
   std::vector<std::unique_ptr<ThreadProgram<F, kLanes>>> programs_;
   std::vector<Slot> slots_;
   std::vector<Cursor> cursor_;
-  std::atomic<bool> stopping_{false}, failed_{false};
+  std::mutex mutex_;  // guards the slot lists and the flags below
+  std::condition_variable to_programs_, to_simulation_;
+  std::vector<std::size_t> free_;
+  std::deque<std::size_t> finished_;  // in packet order
+  bool stopping_ = false;
+  bool programs_waiting_ = false;  // the program thread sleeps on a full window
   std::exception_ptr error_;
   std::thread worker_;
 };
@@ -381,7 +417,10 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
   // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
   memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
-  Threads<F, kLanes> threads(image, fp, p.threads, opt.programs_ahead);
+  if (opt.programs_ahead && opt.ahead_packets < 1)
+    throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
+                             std::to_string(opt.ahead_packets) + ")");
+  Threads<F, kLanes> threads(image, fp, p.threads, opt.programs_ahead ? opt.ahead_packets : 0);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;

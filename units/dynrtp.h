@@ -37,6 +37,8 @@ struct CycleRunOptions {
   // request sequences (docs/cycle-model.md, "Programs ahead"); false: a program per simulated
   // thread, run inline. Results and figures are the same either way.
   bool programs_ahead = std::thread::hardware_concurrency() > 1;
+  // How many finished packets the program thread may hold ahead of the simulation (>= 1).
+  int ahead_packets = 192;
   std::function<void(std::uint64_t cycles, int packets_done, int packets)> progress;
 };
 
