@@ -345,6 +345,15 @@ FloatRay primary_ray(const PrimaryBasis32& c, int x, int y) {
   return r;
 }
 
+std::vector<FloatRay> primary_rays(const PrimaryBasis32& camera, int width, int height) {
+  std::vector<FloatRay> rays;
+  rays.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      rays.push_back(primary_ray(camera, x, y));
+  return rays;
+}
+
 // ---- the image's view ---------------------------------------------------------------------------
 
 FloatScene::FloatScene(const BuiltImage& image, InstanceStep step) : step_(step) {

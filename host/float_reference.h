@@ -156,6 +156,9 @@ bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float
 // the host has folded scale and pixel-centre offset into the basis): origin Cp, direction
 // (Cr*x + Cu*y) + (Cd*1 + 0), in binary32.
 FloatRay primary_ray(const PrimaryBasis32& camera, int x, int y);
+// The primary rays of a width x height frame, row-major (what other tracers are handed to trace
+// the same rays, e.g. Embree in the benchmarks).
+std::vector<FloatRay> primary_rays(const PrimaryBasis32& camera, int width, int height);
 
 // Render options (docs/shading.md section 1). The defaults are the paper's Table 3 setting:
 // primary rays and textured shading, no shadow or secondary rays. Resolution, camera, ambient,

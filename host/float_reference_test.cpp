@@ -326,6 +326,11 @@ TEST(FloatTraversal, PrimaryRayUsesTheDatapathOrder) {
   EXPECT_EQ(r.origin, glm::vec3(1, 2, 3));
   EXPECT_EQ(r.direction, glm::vec3(0.5f, 0.0f, 1.0f));
   EXPECT_EQ(r.direction, b.direction(3, 4));
+  // The whole frame, row-major.
+  const std::vector<FloatRay> frame = primary_rays(b, 5, 6);
+  ASSERT_EQ(frame.size(), 30u);
+  EXPECT_EQ(frame[4 * 5 + 3].direction, r.direction);
+  EXPECT_EQ(frame[29].direction, primary_ray(b, 4, 5).direction);
 }
 
 TEST(FloatScene, RefusesMalformedInput) {

@@ -61,10 +61,8 @@ BenchScene& bench_scene(std::size_t index) {
     s.scene = host::load_scene(spec);
     s.built = host::build_fitting_image(s.scene, 512, 384);
     s.float_scene = std::make_unique<host::FloatScene>(s.built);
-    const host::PrimaryBasis32 basis = host::to_float(s.built.basis);
-    for (int y = 0; y < s.built.params.height; ++y)
-      for (int x = 0; x < s.built.params.width; ++x)
-        s.rays.push_back(host::primary_ray(basis, x, y));
+    s.rays = host::primary_rays(host::to_float(s.built.basis), s.built.params.width,
+                                s.built.params.height);
     s.embree = std::make_unique<host::EmbreeOracle>(s.scene, s.built,
                                                     host::EmbreeOracle::Mode::kFlattened, 1, true);
   }

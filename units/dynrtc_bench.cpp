@@ -42,21 +42,18 @@ const Room& room() {
   return r;
 }
 
-// CPU seconds of this thread: the machine is shared, so wall time would measure the neighbours.
-double cpu_seconds() {
+// CPU seconds of this thread (the machine is shared, so wall time would measure the neighbours),
+// or with CLOCK_PROCESS_CPUTIME_ID of every thread (the cycle model with its program thread).
+double cpu_seconds(clockid_t clock = CLOCK_THREAD_CPUTIME_ID) {
   timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  clock_gettime(clock, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
-
+double thread_cpu_seconds() {
+  return cpu_seconds();
+}
 double wall_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-// CPU seconds of every thread of the process (the cycle model with its program thread).
-double process_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 // Per frame kind (hits, shaded): the functional model's best frame time.
 double g_functional_seconds[2] = {0.0, 0.0};
@@ -79,11 +76,8 @@ struct FrameTimes {
 void BM_EmbreeFrame(benchmark::State& state) {
   const Room& r = room();
   const host::EmbreeOracle embree(r.scene, r.built, host::EmbreeOracle::Mode::kFlattened, 1, true);
-  const host::PrimaryBasis32 basis = host::to_float(r.built.basis);
-  std::vector<host::FloatRay> rays;
-  for (int y = 0; y < r.built.params.height; ++y)
-    for (int x = 0; x < r.built.params.width; ++x)
-      rays.push_back(host::primary_ray(basis, x, y));
+  const std::vector<host::FloatRay> rays = host::primary_rays(
+      host::to_float(r.built.basis), r.built.params.width, r.built.params.height);
   FrameTimes times;
   std::uint64_t hits = 0;
   for (auto _ : state) {
@@ -128,14 +122,14 @@ void BM_CycleModelFrame(benchmark::State& state) {
   units::CycleRunOptions options;
   options.shading.shade = shade;
   options.programs_ahead = state.range(2) != 0;
-  const auto clock = options.programs_ahead ? wall_seconds : cpu_seconds;
+  const auto clock = options.programs_ahead ? wall_seconds : thread_cpu_seconds;
   FrameTimes times, cpu;
   units::CycleFrame last;
   for (auto _ : state) {
-    const double t0 = clock(), c0 = process_cpu_seconds();
+    const double t0 = clock(), c0 = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
     last = units::run_cycle(r.built.image, p, options);
     times.add(clock() - t0);
-    cpu.add(process_cpu_seconds() - c0);
+    cpu.add(cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - c0);
   }
   const double functional = g_functional_seconds[shade];
   const double rate = static_cast<double>(last.cycles) / times.best;

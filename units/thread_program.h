@@ -466,16 +466,6 @@ class ThreadProgram {
     Ray<F> world, current, tri;
     HitRecord<F> hit;  // hit.t = t_best (starts at the ray's t_max)
     RayCounters counters;
-    // As *this = Lane{}, member by member: the compiler zeroes a whole Lane with a string store,
-    // whose start-up costs more than these moves (the RGS starts a packet per light).
-    void clear() {
-      valid = done = false;
-      pixel = memif::kNone;
-      weight = 0;
-      world = current = tri = Ray<F>{};
-      hit = HitRecord<F>{};
-      counters = RayCounters{};
-    }
   };
 
   // The traversal unit works on binary64 values (datapath.h, traversal_lane64): O and 1/D per
@@ -666,7 +656,8 @@ class ThreadProgram {
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       const GenLane& g = pk.lanes[static_cast<std::size_t>(i)];
-      l.clear();
+      static const Lane kClear{};
+      l = kClear;  // a copy of the defaults: Lane{} compiles to a string store that costs more
       l.valid = g.valid;
       l.pixel = g.pixel;
       l.weight = g.weight;
@@ -1228,7 +1219,7 @@ class ThreadProgram {
     for (int i = 0; i < p_; ++i) {
       const Lane& l = lane(i);
       Surface& s = surf_[static_cast<std::size_t>(i)];
-      s = kClear;  // as Surface{}, without its string store (see Lane::clear)
+      s = kClear;  // as Surface{}, without its string store (as in begin_packet)
       if (!l.valid) continue;
       s.pixel = l.pixel;
       s.weight = l.weight;
