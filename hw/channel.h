@@ -14,15 +14,22 @@
 //   * At most `width` pushes and `width` pops per cycle (the port width).
 //   * Misuse (push when !can_push, peek/pop when !can_pop) throws std::logic_error naming the
 //     channel: it is a model bug, never bad input.
-// One producer and one consumer per channel; the kernel commits all channels after all modules
-// evaluated.
+// One producer and one consumer per channel.
+//
+// The channel keeps this contract without a commit phase: every item carries the cycle it becomes
+// visible, and the pushes and pops of the current cycle are counted apart from the committed
+// occupancy, so what either end sees cannot depend on whether the other end was evaluated first
+// in the cycle (a commit of every channel that moved cost a third of the kernel's cycle).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "hw/schedule.h"
 
 namespace saarcor::hw {
 
@@ -45,86 +52,125 @@ class ChannelBase {
   int width() const { return width_; }
 
   // Committed state (as of the start of the current cycle); what VCD traces and watchdog dumps.
-  int occupancy() const { return count_; }
-  bool empty() const { return count_ == 0; }
-  bool valid() const { return count_ > 0 && ready_at_[head_] <= *now_; }  // consumer may pop
-  bool ready() const { return count_ < capacity_; }                       // producer may push
+  int occupancy() const {
+    return static_cast<int>(tail_ - head_) - pushes_in(*now_) + pops_in(*now_);
+  }
+  bool empty() const { return occupancy() == 0; }
+  bool valid() const {  // consumer may pop
+    const std::uint64_t front = head_ - static_cast<std::uint64_t>(pops_in(*now_));
+    return occupancy() > 0 && ready_at_[front & mask_] <= *now_;
+  }
+  bool ready() const { return occupancy() < capacity_; }  // producer may push
   // Cycle at which the front item becomes poppable; kNever when empty.
-  std::uint64_t front_ready_cycle() const { return count_ > 0 ? ready_at_[head_] : kNever; }
+  std::uint64_t front_ready_cycle() const {
+    return tail_ != head_ ? ready_at_[head_ & mask_] : kNever;
+  }
 
-  bool can_push() const { return count_ + pushes_ < capacity_ && pushes_ < width_; }
-  // (The hottest test of a model: one compare against a cached cycle, see pop_ready_.)
+  // (The hottest tests of a model: one compare against a cached cycle each, see pop_ready_.)
+  bool can_push() const { return push_ready_ <= *now_; }
   bool can_pop() const { return pop_ready_ <= *now_; }
 
-  // Applies this cycle's pushes and pops (waking the declared consumer when pushed items become
-  // visible and the declared producer when a pop frees room); returns how many there were.
-  // Kernel only.
-  int commit();
   Module* producer() const { return producer_; }
   Module* consumer() const { return consumer_; }
-  std::uint64_t total_pushes() const;
+  std::uint64_t total_pushes() const { return tail_; }
 
  protected:
-  int slot(int k) const { return (head_ + k) & mask_; }
-  // Checks and books a push, returns its slot.
-  int reserve_push() {
+  // This cycle's pushes / pops so far (the counts belong to op_cycle_).
+  int pushes_in(std::uint64_t now) const { return op_cycle_ == now ? pushes_now_ : 0; }
+  int pops_in(std::uint64_t now) const { return op_cycle_ == now ? pops_now_ : 0; }
+  // The first push or pop of a cycle closes the last cycle that had any: its final occupancy is
+  // a committed one (the largest is a statistic), and the port counts start again.
+  void open_cycle(std::uint64_t now) {
+    if (op_cycle_ == now) return;
+    max_count_ = std::max(max_count_, tail_ - head_);
+    op_cycle_ = now;
+    pushes_now_ = pops_now_ = 0;
+  }
+  // Checks and books a push, returns its slot. The consumer is woken for the cycle the item
+  // becomes visible.
+  std::size_t reserve_push() {
     if (!can_push()) misuse("push while !can_push() (full, or port width used up)");
-    const int s = slot(count_ + pushes_);
-    ready_at_[static_cast<std::size_t>(s)] = *now_ + static_cast<std::uint64_t>(latency_);
-    ++pushes_;
-    mark_dirty();
-    return s;
-  }
-  // Checks and books a pop, returns its slot.
-  int reserve_pop() {
-    if (!can_pop()) misuse("pop while !can_pop() (empty, not yet visible, or width used up)");
-    const int s = slot(pops_);
-    ++pops_;
-    // The next item, if committed and visible; a slot past the committed items is empty (kNever)
-    // or holds an item pushed in this cycle (visible later), so no count test is needed.
-    pop_ready_ = pops_ < width_ ? ready_at_[static_cast<std::size_t>(slot(pops_))] : kNever;
-    mark_dirty();
-    return s;
-  }
-  int front_slot() const {
-    if (!can_pop()) misuse("peek while !can_pop()");
-    return slot(pops_);
-  }
-  void mark_dirty() {
-    if (!dirty_) {
-      dirty_ = true;
-      dirty_list_->push_back(this);
+    const std::uint64_t now = *now_;
+    open_cycle(now);
+    const std::uint64_t at = now + static_cast<std::uint64_t>(latency_);
+    const std::size_t s = tail_ & mask_;
+    ready_at_[s] = at;
+    if (tail_ == head_) pop_ready_ = at;  // the new front (never poppable in this cycle)
+    ++tail_;
+    ++pushes_now_;
+    // Full even after this cycle's pops: until a pop; full counting the slots this cycle's pops
+    // free next cycle, or the port width used up: until the next cycle.
+    const int count = static_cast<int>(tail_ - head_);
+    if (count >= capacity_) {
+      push_ready_ = kNever;
+    } else if (pushes_now_ == width_ || count + pops_now_ >= capacity_) {
+      push_ready_ = now + 1;
     }
+    push_cycles_ += now;
+    ++*moves_;
+    schedule_->wake(consumer_slot_, at, now);
+    return s;
+  }
+  // Checks and books a pop, returns its slot. A producer sees its output only through can_push(),
+  // which a pop turns from false to true only when the channel was full (the port width is reset
+  // by the cycle itself, and a producer that filled it in this cycle is evaluated next cycle
+  // anyway): only then is it woken, for the next cycle (a freed slot is reusable from then on).
+  std::size_t reserve_pop() {
+    if (!can_pop()) misuse("pop while !can_pop() (empty, not yet visible, or width used up)");
+    const std::uint64_t now = *now_;
+    open_cycle(now);
+    if (push_ready_ == kNever) {  // full: the freed slot is the producer's next cycle
+      push_ready_ = now + 1;
+      schedule_->wake(producer_slot_, now + 1, now);
+    }
+    const std::size_t s = head_ & mask_;
+    ++head_;
+    ++pops_now_;
+    pop_cycles_ += now;
+    ++*moves_;
+    // The next item, if there is one: one pushed in this cycle is visible later anyway; with the
+    // port width used up, not before the next cycle.
+    if (head_ == tail_) {
+      pop_ready_ = kNever;
+    } else {
+      const std::uint64_t r = ready_at_[head_ & mask_];
+      pop_ready_ = pops_now_ < width_ ? r : std::max(r, now + 1);
+    }
+    return s;
+  }
+  std::size_t front_slot() const {
+    if (!can_pop()) misuse("peek while !can_pop()");
+    return head_ & mask_;
   }
   [[noreturn, gnu::cold, gnu::noinline]] void misuse(const char* what) const;
-  inline int commit_now();  // commit(), inlined into the kernel's cycle (defined in kernel.cpp)
 
-  // Hot fields first (what push, pop and commit touch share the first two cache lines).
-  // The cycle from which can_pop() holds: the next item's ready cycle, kNever when there is none
-  // or the port width is used up. Kept on pop and commit.
+  // Hot fields first (what push and pop touch share the first two cache lines).
+  // The cycle from which can_pop() holds: the front item's ready cycle, kNever when there is none,
+  // at least the next cycle when the port width is used up.
   std::uint64_t pop_ready_ = kNever;
+  // The cycle from which can_push() holds: kNever while full, the next cycle when this cycle's
+  // pushes used up the port width or the room left after this cycle's pops.
+  std::uint64_t push_ready_ = 0;
   const std::uint64_t* now_;
-  // Per slot: the cycle its item becomes poppable; kNever for an empty slot. Slots are a power of
-  // two (>= capacity, which alone limits the occupancy) so that a slot is an index mask.
-  std::vector<std::uint64_t> ready_at_;
-  int mask_ = 0;
-  int head_ = 0, count_ = 0, pushes_ = 0, pops_ = 0;
+  // Per slot: the cycle its item becomes poppable. Slots are a power of two (>= capacity, which
+  // alone limits the occupancy) so that a slot is an index mask of the running counts.
+  std::uint64_t* ready_at_ = nullptr;
+  std::uint64_t head_ = 0, tail_ = 0;  // items popped, items pushed (slot: & mask_)
+  std::uint64_t mask_ = 0;
+  std::uint64_t op_cycle_ = kNever;  // the last cycle with a push or pop; its counts:
+  int pushes_now_ = 0, pops_now_ = 0;
   int capacity_, latency_, width_;
-  bool dirty_ = false;
-  std::vector<ChannelBase*>* dirty_list_;
-  // Where commit() posts wake-ups: the kernel's per-module wake cycles, at the declared ends'
-  // slots (slot 0 is a sink for undeclared ends).
-  std::vector<std::uint64_t>* wakes_;
-  std::size_t producer_slot_ = 0, consumer_slot_ = 0;
-  // Statistics (owned by the kernel's registry; the counts since the last flush_stats() are kept
-  // here, in the lines commit() touches anyway).
-  std::uint64_t pending_pushes_ = 0;
-  int max_count_ = 0;
-  // Occupancy integrated over time.
-  std::uint64_t occupancy_area_ = 0;
-  std::uint64_t last_change_ = 0;
+  Schedule* schedule_;
+  std::uint64_t* moves_;  // the kernel's count of pushes and pops (a cycle's channel activity)
+  std::size_t producer_slot_ = 0, consumer_slot_ = 0;  // 0: an undeclared end (the sink)
+  // Statistics: the sums of the push and pop cycles give the occupancy integrated over time (an
+  // item adds pop cycle - push cycle), the largest committed occupancy is kept by open_cycle().
+  std::uint64_t push_cycles_ = 0, pop_cycles_ = 0;
+  std::uint64_t max_count_ = 0;
   // Cold.
   void flush_stats();
+  std::vector<std::uint64_t> ready_at_store_;
+  std::uint64_t flushed_pushes_ = 0;
   Counter* pushes_stat_ = nullptr;
   Counter* max_occupancy_stat_ = nullptr;
   Module* producer_ = nullptr;  // declared ends (Module::produces/consumes); null: not declared
@@ -143,12 +189,12 @@ class Channel : public ChannelBase {
       : ChannelBase(kernel, std::move(name), capacity, latency, width),
         items_(static_cast<std::size_t>(mask_) + 1) {}
 
-  void push(T item) { items_[static_cast<std::size_t>(reserve_push())] = std::move(item); }
+  void push(T item) { items_[reserve_push()] = std::move(item); }
   // Books a push and returns its slot to be filled in place (an item built field by field is
   // not copied once more on the way in).
-  T& push_slot() { return items_[static_cast<std::size_t>(reserve_push())]; }
-  const T& peek() const { return items_[static_cast<std::size_t>(front_slot())]; }
-  T pop() { return std::move(items_[static_cast<std::size_t>(reserve_pop())]); }
+  T& push_slot() { return items_[reserve_push()]; }
+  const T& peek() const { return items_[front_slot()]; }
+  T pop() { return std::move(items_[reserve_pop()]); }
   // pop() for a consumer that has read what it needs through peek(): the item is not copied.
   void drop() { (void)reserve_pop(); }
 

@@ -19,8 +19,8 @@ ChannelBase::ChannelBase(Kernel& kernel, std::string name, int capacity, int lat
       capacity_(capacity),
       latency_(latency),
       width_(width),
-      dirty_list_(&kernel.dirty_),
-      wakes_(&kernel.wake_),
+      schedule_(&kernel.schedule_),
+      moves_(&kernel.moves_),
       name_(std::move(name)) {
   if (capacity < 1 || latency < 1 || width < 1) {
     throw std::logic_error("channel '" + name_ +
@@ -31,9 +31,9 @@ ChannelBase::ChannelBase(Kernel& kernel, std::string name, int capacity, int lat
   std::size_t slots = 1;
   while (slots < static_cast<std::size_t>(capacity))
     slots *= 2;
-  ready_at_.assign(slots, kNever);
-  mask_ = static_cast<int>(slots - 1);
-  last_change_ = kernel.cycle_;
+  ready_at_store_.assign(slots, kNever);
+  ready_at_ = ready_at_store_.data();
+  mask_ = slots - 1;
   kernel.add_channel(this);
 }
 
@@ -41,61 +41,11 @@ void ChannelBase::misuse(const char* what) const {
   throw std::logic_error("channel '" + name_ + "' at cycle " + std::to_string(*now_) + ": " + what);
 }
 
-// Straight-line on purpose (every moving channel commits every cycle it moves), and inlined into
-// the kernel's cycle.
-[[gnu::always_inline]] inline int ChannelBase::commit_now() {
-  const int pushes = pushes_, pops = pops_;
-  const std::uint64_t now = *now_;
-  // A producer sees its output only through can_push(), which a pop turns from false to true only
-  // when the channel was full (the per-cycle width is reset by the cycle itself, and a producer
-  // that pushed in this cycle is evaluated next cycle anyway).
-  const bool was_full = count_ == capacity_;
-  // The old occupancy held from last_change_ through this cycle; it is integrated when it
-  // changes (the average's formula adds the part since the last change).
-  if (pushes != pops) {
-    occupancy_area_ += static_cast<std::uint64_t>(count_) * (now + 1 - last_change_);
-    last_change_ = now + 1;
-  }
-  // An empty slot is never poppable (the popped ones kept their cycle until now for valid()).
-  if (width_ == 1) {
-    std::uint64_t& front = ready_at_[static_cast<std::size_t>(head_)];
-    front = pops != 0 ? kNever : front;
-  } else {
-    for (int k = 0; k < pops; ++k)
-      ready_at_[static_cast<std::size_t>(slot(k))] = kNever;
-  }
-  head_ = slot(pops);
-  count_ += pushes - pops;
-  pop_ready_ = ready_at_[static_cast<std::size_t>(head_)];  // kNever when empty
-  // The statistics are kept here and handed to the registry when the kernel brings the
-  // statistics up to date (Kernel::account_all).
-  pending_pushes_ += static_cast<std::uint64_t>(pushes);
-  if (pushes > pops) max_count_ = std::max(max_count_, count_);
-  // Event scheduling: the items pushed now become visible after the latency; the slots popped now
-  // are free for the producer next cycle.
-  std::uint64_t* wake = wakes_->data();
-  const std::uint64_t consumer_at =
-      pushes != 0 ? now + static_cast<std::uint64_t>(latency_) : kNever;
-  const std::uint64_t producer_at = pops != 0 && was_full ? now + 1 : kNever;
-  wake[consumer_slot_] = std::min(wake[consumer_slot_], consumer_at);
-  wake[producer_slot_] = std::min(wake[producer_slot_], producer_at);
-  pushes_ = pops_ = 0;
-  dirty_ = false;
-  return pushes + pops;
-}
-
-int ChannelBase::commit() {
-  return commit_now();
-}
-
-std::uint64_t ChannelBase::total_pushes() const {
-  return pushes_stat_->value + pending_pushes_;
-}
-
+// Called between cycles only: the occupancy is a committed one.
 void ChannelBase::flush_stats() {
-  pushes_stat_->value += pending_pushes_;
-  pending_pushes_ = 0;
-  max_occupancy_stat_->set_max(static_cast<std::uint64_t>(max_count_));
+  pushes_stat_->value += tail_ - flushed_pushes_;
+  flushed_pushes_ = tail_;
+  max_occupancy_stat_->set_max(std::max(max_count_, tail_ - head_));
 }
 
 // ---- Module -------------------------------------------------------------------------------------
@@ -140,11 +90,12 @@ void Kernel::add_module(Module* m) {
   m->stall_stat_ = &stats_.counter(m->name() + ".stall_cycles", "cycles",
                                    "cycles in which the module had work but was blocked");
   m->accounted_ = cycle_;
-  // Slots 1.. in registration order, padded with kNever to a multiple of 8 (the due scan).
+  // Slots 1.. in registration order (the order of evaluation).
   m->slot_ = modules_.size() + 1;
-  const std::size_t padded = 1 + (m->slot_ + 7) / 8 * 8;
-  if (wake_.size() < padded) wake_.resize(padded, kNever);
-  wake_[m->slot_] = cycle_;
+  schedule_.resize(m->slot_ + 1);
+  due_.resize(schedule_.words());
+  by_slot_.push_back(m);
+  schedule_.wake(m->slot_, cycle_, cycle_);
   modules_.push_back(m);
   order_.push_back(m);
   awake_.resize(modules_.size());
@@ -154,13 +105,16 @@ void Kernel::add_channel(ChannelBase* c) {
   c->pushes_stat_ = &stats_.counter(c->name() + ".pushes", "items", "items pushed");
   c->max_occupancy_stat_ =
       &stats_.counter(c->name() + ".max_occupancy", "items", "largest committed occupancy");
-  stats_.formula(
-      c->name() + ".avg_occupancy", "items", "committed occupancy averaged over cycles", [this, c] {
-        if (cycle_ == 0) return 0.0;
-        const std::uint64_t area =
-            c->occupancy_area_ + static_cast<std::uint64_t>(c->count_) * (cycle_ - c->last_change_);
-        return static_cast<double>(area) / static_cast<double>(cycle_);
-      });
+  stats_.formula(c->name() + ".avg_occupancy", "items", "committed occupancy averaged over cycles",
+                 [this, c] {
+                   // The occupancy at the start of each cycle so far: an item popped in cycle q
+                   // after its push in cycle p counted in cycles p+1 .. q, one still held in p+1 ..
+                   // cycle_-1.
+                   if (cycle_ == 0) return 0.0;
+                   const std::uint64_t area =
+                       c->pop_cycles_ - c->push_cycles_ + (c->tail_ - c->head_) * (cycle_ - 1);
+                   return static_cast<double>(area) / static_cast<double>(cycle_);
+                 });
   channels_.push_back(c);
 }
 
@@ -173,7 +127,7 @@ int Kernel::step() {
 
 void Kernel::wake_all() {
   for (const Module* m : modules_)
-    wake_[m->slot_] = std::min(wake_[m->slot_], cycle_);
+    schedule_.wake(m->slot_, cycle_, cycle_);
 }
 
 // Counts the cycles a module was not evaluated in (asleep, or jumped over by the idle skip) as
@@ -199,18 +153,18 @@ void Kernel::account_all() {
 
 int Kernel::step_cycle() {
   if (config_.shuffle_seed != 0) std::shuffle(order_.begin(), order_.end(), rng_);
-  // Without idle skipping every module is due every cycle (the reference for the figures).
-  const std::uint64_t due = config_.idle_skip ? cycle_ : kNever;
-  const std::uint64_t next = cycle_ + 1;
-  std::uint64_t* const wake = wake_.data();
+  const std::uint64_t now = cycle_, next = cycle_ + 1;
+  const std::uint64_t moves_before = moves_;
+  std::uint64_t* const due = due_.data();
+  schedule_.take(now, due);
   int progress = 0;
   Module** const busy = awake_.data();  // the modules to commit: those that made progress
   std::size_t busy_count = 0, evaluated = 0;
   // Evaluates one module and settles its cycle at once: statistics, and its next wake cycle (an
-  // idle module's state and committed inputs are final for this cycle: it staged nothing, and
-  // other modules' pushes are not visible before their commit, which may only lower the wake).
+  // idle module's state and inputs are final for this cycle: it staged nothing, and other
+  // modules' pushes and pops can only wake it earlier).
   auto evaluate = [&](Module* m) {
-    if (m->accounted_ != cycle_) account(m);
+    if (m->accounted_ != now) account(m);
     m->stalled_ = false;
     const int p = m->evaluate();
     m->last_progress_ = p;
@@ -220,35 +174,25 @@ int Kernel::step_cycle() {
     ++evaluated;
     if (p > 0) {
       ++m->busy_count_;
-      wake[m->slot_] = next;
+      schedule_.wake(m->slot_, next, now);
       busy[busy_count++] = m;
     } else {
-      wake[m->slot_] = m->sleeps_ ? idle_wakeup(*m) : next;
+      const std::uint64_t at = m->sleeps_ ? idle_wakeup(*m) : next;
+      if (at != kNever) schedule_.wake(m->slot_, at, now);
     }
   };
+  // Without idle skipping every module is due every cycle (the reference for the figures).
+  const bool all = !config_.idle_skip;
   if (config_.shuffle_seed != 0) {
     for (Module* m : order_)
-      if (wake[m->slot_] <= due) evaluate(m);  // else asleep: it would repeat its last cycle
+      if (all || (due[m->slot_ / 64] >> (m->slot_ % 64) & 1) != 0) evaluate(m);
+  } else if (all) {
+    for (Module* m : modules_)
+      evaluate(m);
   } else {
-    // Registration order: the due modules of each group of 64 as a bit mask, taken before any of
-    // them is evaluated (no branch per sleeping module).
-    const std::size_t count = modules_.size();
-    for (std::size_t base = 0; base < count; base += 64) {
-      const std::size_t end = std::min(count, base + 64);
-      std::uint64_t mask = 0;
-      for (std::size_t i = base; i < end; i += 8) {  // 8 at a time over the kNever padding
-        const std::uint64_t* w = wake + 1 + i;
-        std::uint64_t m8 = 0;
-        for (std::size_t j = 0; j < 8; ++j)
-          m8 |= static_cast<std::uint64_t>(w[j] <= due) << j;
-        mask |= m8 << (i - base);
-      }
-      if (end - base < 64) mask &= (std::uint64_t{1} << (end - base)) - 1;  // not the padding
-      while (mask != 0) {
-        evaluate(modules_[base + static_cast<std::size_t>(std::countr_zero(mask))]);
-        mask &= mask - 1;
-      }
-    }
+    for (std::size_t w = 0, words = due_.size(); w < words; ++w)
+      for (std::uint64_t bits = due[w]; bits != 0; bits &= bits - 1)
+        evaluate(by_slot_[w * 64 + static_cast<std::size_t>(std::countr_zero(bits))]);
   }
   evaluations_ += evaluated;
   ++evaluated_;
@@ -257,11 +201,7 @@ int Kernel::step_cycle() {
   // commit, after every evaluation (a module may read another's committed register).
   for (std::size_t i = 0; i < busy_count; ++i)
     if (!busy[i]->commit_is_noop_) busy[i]->commit();
-  int activity = 0;
-  for (ChannelBase* c : dirty_)
-    activity += c->commit_now();  // wakes the declared ends of the channels that moved
-  dirty_.clear();
-  const int total = progress + activity;
+  const int total = progress + static_cast<int>(moves_ - moves_before);
   ++cycle_;
   if (total > 0) progress_mark_ = cycle_;
   if (config_.time_series_period != 0 && cycle_ % config_.time_series_period == 0) {
@@ -296,9 +236,16 @@ std::uint64_t Kernel::next_event() const {
 }
 
 void Kernel::skip_to(std::uint64_t target) {
-  // The jumped-over cycles are counted lazily (account) like a sleeping module's.
+  // The jumped-over cycles are counted lazily (account) like a sleeping module's. Modules that do
+  // not sleep were due in the first skipped cycle: they are due at the target instead.
   skipped_ += target - cycle_;
   cycle_ = target;
+  for (const Module* m : modules_) {
+    if (schedule_.wake_cycle(m->slot_) < target) {
+      schedule_.cancel(m->slot_);
+      schedule_.wake(m->slot_, target, target);
+    }
+  }
   if (config_.time_series_period != 0 && cycle_ % config_.time_series_period == 0) {
     account_all();
     stats_.set_time_series_period(config_.time_series_period);
@@ -328,7 +275,7 @@ RunResult Kernel::run_cycles(const std::function<bool()>& done, std::uint64_t ma
     // Idle cycle: jump to the earliest cycle where anything (or anything we report) can change.
     std::uint64_t target = std::min(next_event(), limit);
     for (const Module* m : modules_)  // a sleeper's pending wake (next_event covers the rest)
-      if (m->sleeps_) target = std::min(target, std::max(wake_[m->slot_], cycle_));
+      if (m->sleeps_) target = std::min(target, schedule_.wake_cycle(m->slot_));
     if (wd != 0) target = std::min(target, progress_mark_ + wd);
     const std::uint64_t period = config_.time_series_period;
     if (period != 0) target = std::min(target, (cycle_ / period + 1) * period);

@@ -7,8 +7,8 @@
 //      shuffle_seed != 0: the figures must not change), except modules that sleep (opt-in,
 //      Module::sleep_when_idle) and have no event due: their cycle would repeat their last one;
 //   2. trace (VCD, start-of-cycle channel state + this cycle's busy/stall);
-//   3. commit every module that made progress, then every channel touched in the cycle (which
-//      wakes the channel's declared consumer / producer);
+//   3. commit every module that made progress (channels need no commit: hw/channel.h; their
+//      pushes and pops wake the declared consumer / producer when they happen);
 //   4. busy/stall statistics, time-series sample, clock advances to c+1;
 //   5. if nothing happened (no progress, no channel activity) and idle skipping is on, jump to the
 //      earliest cycle at which something can happen (a channel item's latency elapses, a module's
@@ -27,6 +27,7 @@
 
 #include "hw/channel.h"
 #include "hw/module.h"
+#include "hw/schedule.h"
 #include "hw/stats.h"
 
 namespace saarcor::hw {
@@ -127,12 +128,15 @@ class Kernel {
   Stats stats_;
   std::vector<Module*> modules_;
   std::vector<Module*> order_;
-  std::vector<Module*> awake_;  // the modules evaluated in the current cycle
+  std::vector<Module*> awake_;  // the modules to commit in the current cycle
   // Per module (at Module::slot_, from 1; slot 0 takes the wake-ups of undeclared channel ends):
-  // the earliest cycle it must be evaluated in. Lowered by channel commits, set after evaluation.
-  std::vector<std::uint64_t> wake_{kNever};
+  // the earliest cycle it must be evaluated in. Lowered by channel pushes and pops, set after
+  // evaluation.
+  Schedule schedule_;
+  std::vector<Module*> by_slot_{nullptr};
+  std::vector<std::uint64_t> due_;  // the current cycle's due modules (Schedule::take)
+  std::uint64_t moves_ = 0;         // channel pushes and pops so far
   std::vector<ChannelBase*> channels_;
-  std::vector<ChannelBase*> dirty_;
   std::mt19937_64 rng_;
   std::unique_ptr<VcdTracer> tracer_;
   // Declared last: destroyed first, while the registry they registered with still exists.
