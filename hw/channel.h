@@ -82,7 +82,8 @@ class ChannelBase {
   // a committed one (the largest is a statistic), and the port counts start again.
   void open_cycle(std::uint64_t now) {
     if (op_cycle_ == now) return;
-    max_count_ = std::max(max_count_, tail_ - head_);
+    // (A cycle that pushed no more than it popped cannot have raised the largest occupancy.)
+    if (pushes_now_ > pops_now_) max_count_ = std::max(max_count_, tail_ - head_);
     op_cycle_ = now;
     pushes_now_ = pops_now_ = 0;
   }
