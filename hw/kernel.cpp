@@ -94,6 +94,7 @@ void Kernel::add_module(Module* m) {
   m->slot_ = modules_.size() + 1;
   schedule_.resize(m->slot_ + 1);
   due_.resize(schedule_.words());
+  always_.resize(schedule_.words());
   by_slot_.push_back(m);
   schedule_.wake(m->slot_, cycle_, cycle_);
   modules_.push_back(m);
@@ -125,9 +126,23 @@ int Kernel::step() {
   return total;
 }
 
+// Also settles who is scheduled: a module's sleeps_ is known only after its constructor, so the
+// modules that do not sleep (evaluated in every evaluated cycle, kept out of the schedule) and the
+// channel ends that post wakes (those of sleepers; the others post to the sink) are fixed here.
 void Kernel::wake_all() {
-  for (const Module* m : modules_)
-    schedule_.wake(m->slot_, cycle_, cycle_);
+  for (ChannelBase* c : channels_) {
+    c->consumer_slot_ = c->consumer_ != nullptr && c->consumer_->sleeps_ ? c->consumer_->slot_ : 0;
+    c->producer_slot_ = c->producer_ != nullptr && c->producer_->sleeps_ ? c->producer_->slot_ : 0;
+  }
+  std::fill(always_.begin(), always_.end(), 0);
+  for (const Module* m : modules_) {
+    if (m->sleeps_) {
+      schedule_.wake(m->slot_, cycle_, cycle_);
+    } else {
+      schedule_.cancel(m->slot_);
+      always_[m->slot_ / 64] |= std::uint64_t{1} << (m->slot_ % 64);
+    }
+  }
 }
 
 // Counts the cycles a module was not evaluated in (asleep, or jumped over by the idle skip) as
@@ -174,10 +189,10 @@ int Kernel::step_cycle() {
     ++evaluated;
     if (p > 0) {
       ++m->busy_count_;
-      schedule_.wake(m->slot_, next, now);
       busy[busy_count++] = m;
-    } else {
-      const std::uint64_t at = m->sleeps_ ? idle_wakeup(*m) : next;
+    }
+    if (m->sleeps_) {
+      const std::uint64_t at = p > 0 ? next : idle_wakeup(*m);
       if (at != kNever) schedule_.wake(m->slot_, at, now);
     }
   };
@@ -185,13 +200,13 @@ int Kernel::step_cycle() {
   const bool all = !config_.idle_skip;
   if (config_.shuffle_seed != 0) {
     for (Module* m : order_)
-      if (all || (due[m->slot_ / 64] >> (m->slot_ % 64) & 1) != 0) evaluate(m);
+      if (all || !m->sleeps_ || (due[m->slot_ / 64] >> (m->slot_ % 64) & 1) != 0) evaluate(m);
   } else if (all) {
     for (Module* m : modules_)
       evaluate(m);
   } else {
     for (std::size_t w = 0, words = due_.size(); w < words; ++w)
-      for (std::uint64_t bits = due[w]; bits != 0; bits &= bits - 1)
+      for (std::uint64_t bits = due[w] | always_[w]; bits != 0; bits &= bits - 1)
         evaluate(by_slot_[w * 64 + static_cast<std::size_t>(std::countr_zero(bits))]);
   }
   evaluations_ += evaluated;
@@ -236,16 +251,9 @@ std::uint64_t Kernel::next_event() const {
 }
 
 void Kernel::skip_to(std::uint64_t target) {
-  // The jumped-over cycles are counted lazily (account) like a sleeping module's. Modules that do
-  // not sleep were due in the first skipped cycle: they are due at the target instead.
+  // The jumped-over cycles are counted lazily (account) like a sleeping module's.
   skipped_ += target - cycle_;
   cycle_ = target;
-  for (const Module* m : modules_) {
-    if (schedule_.wake_cycle(m->slot_) < target) {
-      schedule_.cancel(m->slot_);
-      schedule_.wake(m->slot_, target, target);
-    }
-  }
   if (config_.time_series_period != 0 && cycle_ % config_.time_series_period == 0) {
     account_all();
     stats_.set_time_series_period(config_.time_series_period);

@@ -129,13 +129,14 @@ class Kernel {
   std::vector<Module*> modules_;
   std::vector<Module*> order_;
   std::vector<Module*> awake_;  // the modules to commit in the current cycle
-  // Per module (at Module::slot_, from 1; slot 0 takes the wake-ups of undeclared channel ends):
-  // the earliest cycle it must be evaluated in. Lowered by channel pushes and pops, set after
-  // evaluation.
+  // Per sleeping module (at Module::slot_, from 1; slot 0 takes the wake-ups of channel ends
+  // that are undeclared or belong to modules that do not sleep): the earliest cycle it must be
+  // evaluated in. Lowered by channel pushes and pops, set after evaluation.
   Schedule schedule_;
   std::vector<Module*> by_slot_{nullptr};
-  std::vector<std::uint64_t> due_;  // the current cycle's due modules (Schedule::take)
-  std::uint64_t moves_ = 0;         // channel pushes and pops so far
+  std::vector<std::uint64_t> due_;     // the current cycle's due modules (Schedule::take)
+  std::vector<std::uint64_t> always_;  // the modules that do not sleep (by slot, as due_)
+  std::uint64_t moves_ = 0;            // channel pushes and pops so far
   std::vector<ChannelBase*> channels_;
   std::mt19937_64 rng_;
   std::unique_ptr<VcdTracer> tracer_;
