@@ -61,7 +61,8 @@ class ChannelBase {
     return occupancy() > 0 && ready_at_[front & mask_] <= *now_;
   }
   bool ready() const { return occupancy() < capacity_; }  // producer may push
-  // Cycle at which the front item becomes poppable; kNever when empty.
+  // Cycle at which the current front item (possibly one pushed in this cycle) becomes poppable;
+  // kNever when empty.
   std::uint64_t front_ready_cycle() const {
     return tail_ != head_ ? ready_at_[head_ & mask_] : kNever;
   }

@@ -95,8 +95,6 @@ void Kernel::add_module(Module* m) {
   schedule_.resize(m->slot_ + 1);
   due_.resize(schedule_.words());
   always_.resize(schedule_.words());
-  by_slot_.push_back(m);
-  schedule_.wake(m->slot_, cycle_, cycle_);
   modules_.push_back(m);
   order_.push_back(m);
   awake_.resize(modules_.size());
@@ -207,7 +205,7 @@ int Kernel::step_cycle() {
   } else {
     for (std::size_t w = 0, words = due_.size(); w < words; ++w)
       for (std::uint64_t bits = due[w] | always_[w]; bits != 0; bits &= bits - 1)
-        evaluate(by_slot_[w * 64 + static_cast<std::size_t>(std::countr_zero(bits))]);
+        evaluate(modules_[w * 64 + static_cast<std::size_t>(std::countr_zero(bits)) - 1]);
   }
   evaluations_ += evaluated;
   ++evaluated_;

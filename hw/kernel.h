@@ -133,7 +133,6 @@ class Kernel {
   // that are undeclared or belong to modules that do not sleep): the earliest cycle it must be
   // evaluated in. Lowered by channel pushes and pops, set after evaluation.
   Schedule schedule_;
-  std::vector<Module*> by_slot_{nullptr};
   std::vector<std::uint64_t> due_;     // the current cycle's due modules (Schedule::take)
   std::vector<std::uint64_t> always_;  // the modules that do not sleep (by slot, as due_)
   std::uint64_t moves_ = 0;            // channel pushes and pops so far
