@@ -24,7 +24,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,8 +35,6 @@ namespace saarcor::hw {
 class Kernel;
 class Module;
 struct Counter;
-
-inline constexpr std::uint64_t kNever = std::numeric_limits<std::uint64_t>::max();
 
 class ChannelBase {
  public:
@@ -156,7 +153,7 @@ class ChannelBase {
   const std::uint64_t* now_;
   // Per slot: the cycle its item becomes poppable. Slots are a power of two (>= capacity, which
   // alone limits the occupancy) so that a slot is an index mask of the running counts.
-  std::uint64_t* ready_at_ = nullptr;
+  std::vector<std::uint64_t> ready_at_;
   std::uint64_t head_ = 0, tail_ = 0;  // items popped, items pushed (slot: & mask_)
   std::uint64_t mask_ = 0;
   std::uint64_t op_cycle_ = kNever;  // the last cycle with a push or pop; its counts:
@@ -171,7 +168,6 @@ class ChannelBase {
   std::uint64_t max_count_ = 0;
   // Cold.
   void flush_stats();
-  std::vector<std::uint64_t> ready_at_store_;
   std::uint64_t flushed_pushes_ = 0;
   Counter* pushes_stat_ = nullptr;
   Counter* max_occupancy_stat_ = nullptr;

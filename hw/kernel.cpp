@@ -31,8 +31,7 @@ ChannelBase::ChannelBase(Kernel& kernel, std::string name, int capacity, int lat
   std::size_t slots = 1;
   while (slots < static_cast<std::size_t>(capacity))
     slots *= 2;
-  ready_at_store_.assign(slots, kNever);
-  ready_at_ = ready_at_store_.data();
+  ready_at_.assign(slots, kNever);
   mask_ = slots - 1;
   kernel.add_channel(this);
 }

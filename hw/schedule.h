@@ -21,9 +21,11 @@
 
 namespace saarcor::hw {
 
+// "No cycle": never due, never visible (the kernel's and the channels' sentinel too).
+inline constexpr std::uint64_t kNever = std::numeric_limits<std::uint64_t>::max();
+
 class Schedule {
  public:
-  static constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
   static constexpr std::uint64_t kSpan = 64;  // cycles ahead held in the wheel (a power of two)
 
   // Slot 0 is a sink for the wakes of undeclared channel ends: it is never due.
@@ -40,7 +42,7 @@ class Schedule {
       wheel_ = std::move(wheel);
       words_ = words;
     }
-    wake_.resize(slots, kNone);
+    wake_.resize(slots, kNever);
     wake_[0] = 0;  // the sink: nothing is ever lower, so it is never posted
   }
   std::size_t words() const { return words_; }
@@ -69,7 +71,7 @@ class Schedule {
         const std::uint64_t bit = bits & (~bits + 1);
         bits ^= bit;
         if (wake_[slot] == now) {
-          wake_[slot] = kNone;
+          wake_[slot] = kNever;
           keep |= bit;
         }
       }
@@ -77,18 +79,18 @@ class Schedule {
     }
   }
 
-  // The earliest cycle >= now at which slot `slot` is due (kNone: not scheduled).
+  // The earliest cycle >= now at which slot `slot` is due (kNever: not scheduled).
   std::uint64_t wake_cycle(std::size_t slot) const { return wake_[slot]; }
   // Unschedules `slot` (its wheel bit becomes stale).
-  void cancel(std::size_t slot) { wake_[slot] = kNone; }
+  void cancel(std::size_t slot) { wake_[slot] = kNever; }
 
  private:
   // Puts the far wakes that came within the span into the wheel.
   void enter_far(std::uint64_t now) {
-    far_ = kNone;
+    far_ = kNever;
     for (std::size_t slot = 1; slot < wake_.size(); ++slot) {
       const std::uint64_t at = wake_[slot];
-      if (at == kNone) continue;
+      if (at == kNever) continue;
       if (at - now < kSpan) {
         wheel_[(at & (kSpan - 1)) * words_ + slot / 64] |= std::uint64_t{1} << (slot % 64);
       } else {
@@ -97,10 +99,10 @@ class Schedule {
     }
   }
 
-  std::vector<std::uint64_t> wake_;   // per slot: its wake cycle, kNone when not scheduled
+  std::vector<std::uint64_t> wake_;   // per slot: its wake cycle, kNever when not scheduled
   std::vector<std::uint64_t> wheel_;  // kSpan buckets of words_ words: bucket = cycle % kSpan
   std::size_t words_ = 0;
-  std::uint64_t far_ = kNone;  // the earliest wake not (yet) in the wheel
+  std::uint64_t far_ = kNever;  // the earliest wake not (yet) in the wheel
 };
 
 }  // namespace saarcor::hw

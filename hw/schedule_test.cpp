@@ -64,7 +64,7 @@ TEST(Schedule, RandomWakesMatchAPlainModel) {
   constexpr std::size_t kSlots = 150;
   Schedule s;
   s.resize(kSlots);
-  std::vector<std::uint64_t> model(kSlots, Schedule::kNone);
+  std::vector<std::uint64_t> model(kSlots, kNever);
   std::mt19937_64 rng(7);
   std::vector<std::uint64_t> words(s.words());
   int checked = 0;
@@ -81,7 +81,7 @@ TEST(Schedule, RandomWakesMatchAPlainModel) {
       const bool due = (words[slot / 64] >> (slot % 64) & 1) != 0;
       ASSERT_EQ(due, model[slot] == c) << "slot " << slot << " cycle " << c;
       if (due) {
-        model[slot] = Schedule::kNone;
+        model[slot] = kNever;
         ++checked;
       }
     }
