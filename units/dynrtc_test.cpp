@@ -300,23 +300,34 @@ TEST(DynRtc, OnlyTheFp24ImageRuns) {
   }
 }
 
-// A stuck run stops with a report naming each waiting thread, its unit, phase and item.
+// A stuck run stops with a report naming each waiting thread, its unit, phase, item and rays; the
+// report is the same whether the programs run inline or ahead (a replayed request keeps its ray
+// mask beside the trace the units read).
 TEST(DynRtc, WatchdogNamesStuckThreads) {
   const host::BuiltImage b = build("builtin:room", 16, 12);
   CycleParams p = prototype_params();
   p.threads = 2;
   p.watchdog = 20;      // shorter than one memory round trip:
   p.mem_latency = 200;  // the first misses look like a hang
-  try {
-    run_cycle(b.image, p);
-    ADD_FAILURE() << "the watchdog did not fire";
-  } catch (const std::runtime_error& e) {
-    const std::string m = e.what();
-    EXPECT_NE(m.find("watchdog"), std::string::npos) << m;
-    EXPECT_NE(m.find("thread 0: "), std::string::npos) << m;
-    EXPECT_NE(m.find("thread 1: "), std::string::npos) << m;
-    EXPECT_NE(m.find("dynrtp0.traversal"), std::string::npos) << m;
+  std::string reports[2];
+  for (const bool ahead : {false, true}) {
+    CycleRunOptions opt;
+    opt.programs_ahead = ahead;
+    try {
+      run_cycle(b.image, p, opt);
+      ADD_FAILURE() << "the watchdog did not fire";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("watchdog"), std::string::npos) << m;
+      EXPECT_NE(m.find("thread 0: "), std::string::npos) << m;
+      EXPECT_NE(m.find("thread 1: "), std::string::npos) << m;
+      EXPECT_NE(m.find("dynrtp0.traversal"), std::string::npos) << m;
+      // A primary packet of P = 4 rays, all active at the start: mask 0xf.
+      EXPECT_NE(m.find("mask 0xf\n"), std::string::npos) << m;
+      reports[ahead ? 1 : 0] = m;
+    }
   }
+  EXPECT_EQ(reports[1], reports[0]);
 }
 
 // --interval: the figures of each interval; their cycle-weighted mean is the frame's figure.

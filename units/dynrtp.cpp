@@ -71,8 +71,7 @@ class Threads final : public ThreadTable {
   void execute(std::uint32_t t) override {
     if (ahead_) {
       Cursor& c = cursor_[t];
-      requests_[t] = slots_[c.slot].trace[++c.next];
-      if (requests_[t].unit == UnitId::kNone) release(c.slot);
+      replay(t, slots_[c.slot].trace[++c.next]);
       return;
     }
     ThreadProgram<F, kLanes>& p = *programs_[t];
@@ -85,14 +84,26 @@ class Threads final : public ThreadTable {
     if (ahead_) {
       Cursor& c = cursor_[t];
       c = {take(packet), 0};
-      requests_[t] = slots_[c.slot].trace[0];
-      if (requests_[t].unit == UnitId::kNone) release(c.slot);
+      // The trace was written on the other core: pull all of it towards this one now, while the
+      // thread's first requests wait in the units (its entries are read one per step later).
+      const std::vector<Step>& trace = slots_[c.slot].trace;
+      const char* bytes = reinterpret_cast<const char*>(trace.data());
+      for (std::size_t b = 0; b < trace.size() * sizeof(Step); b += 64)
+        __builtin_prefetch(bytes + b);
+      replay(t, trace[0]);
       return;
     }
     programs_[t]->start_primary(packet_pixels(tiling_, w_, h_, packet));
     ::new (static_cast<void*>(&requests_[t])) Request(programs_[t]->request());
   }
   int packets() const override { return tiling_.count(); }
+  // The rays thread `t`'s current request concerns (for the watchdog's thread report; the units
+  // never read it, so a replayed request carries it only in its slot).
+  std::uint64_t mask(std::uint32_t t) const {
+    if (!ahead_) return requests_[t].mask;
+    const Cursor& c = cursor_[t];
+    return slots_[c.slot].masks[c.next];
+  }
 
   // Waits for the program thread (it has run every packet once the RGC has retired them all) and
   // rethrows what it threw; the units and the sink are then complete.
@@ -106,11 +117,31 @@ class Threads final : public ThreadTable {
   const FunctionalParams& params() const { return params_; }
 
  private:
-  // One packet's request sequence, from the request after start_primary to the final kDone.
+  // A request as the units see it (the mask apart): 8 bytes instead of a Request's 24, so a
+  // packet's trace, written on the program thread's core and read on the simulation's, is a
+  // third of the cache lines to move.
+  struct Step {
+    UnitId unit;
+    Phase phase;
+    std::uint16_t steps;
+    std::uint32_t item;
+  };
+  static_assert(sizeof(Step) == 8);
+  // One packet's request sequence, from the request after start_primary to the final kDone, and
+  // each request's ray mask beside it.
   struct Slot {
-    std::vector<Request> trace;
+    std::vector<Step> trace;
+    std::vector<std::uint64_t> masks;
     int packet = -1;
   };
+  void replay(std::uint32_t t, const Step& s) {
+    Request& r = requests_[t];
+    r.unit = s.unit;
+    r.phase = s.phase;
+    r.item = s.item;
+    r.steps = s.steps;
+    if (s.unit == UnitId::kNone) release(cursor_[t].slot);
+  }
   struct Cursor {
     std::size_t slot = 0, next = 0;
   };
@@ -142,9 +173,15 @@ class Threads final : public ThreadTable {
         Slot& s = slots_[id];
         s.packet = k;
         s.trace.clear();
+        s.masks.clear();
         p.start_primary(packet_pixels(tiling_, w_, h_, k));
         for (;;) {
-          s.trace.push_back(p.request());
+          const Request& r = p.request();
+          if (r.steps < 0 || r.steps > 0xffff)
+            throw std::logic_error("cycle model: a request of " + std::to_string(r.steps) +
+                                   " steps does not fit a trace entry");
+          s.trace.push_back({r.unit, r.phase, static_cast<std::uint16_t>(r.steps), r.item});
+          s.masks.push_back(r.mask);
           if (p.done()) break;
           p.execute();
         }
@@ -399,7 +436,7 @@ std::string thread_report(Threads<F, kLanes>& threads) {
     if (r.unit == UnitId::kNone) continue;
     s << "\n  thread " << t << ": " << unit_name(r.unit) << ", " << phase_name(r.phase);
     if (r.item != memif::kNone) s << ", item " << r.item;
-    s << ", mask 0x" << std::hex << r.mask << std::dec;
+    s << ", mask 0x" << std::hex << threads.mask(static_cast<std::uint32_t>(t)) << std::dec;
   }
   return s.str();
 }
