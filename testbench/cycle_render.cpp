@@ -17,7 +17,8 @@ units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
   units::check_cycle_params(p);
   if (opts.host_threads < 0 || opts.host_threads > 2)
     throw std::runtime_error("bad --host-threads " + std::to_string(opts.host_threads) +
-                             ": 1 (thread programs inline) or 2 (thread programs ahead)");
+                             ": 1 (thread programs on the simulation's thread) or 2 (thread "
+                             "programs ahead on a second thread)");
   if (!opts.vcd.empty() && opts.vcd_to < opts.vcd_from)
     throw std::runtime_error("bad --vcd-to " + std::to_string(opts.vcd_to) +
                              ": before --vcd-from " + std::to_string(opts.vcd_from));
@@ -31,7 +32,9 @@ units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
   units::CycleRunOptions ro;
   ro.shading = shading;
   ro.interval = opts.interval;
-  if (opts.host_threads != 0) ro.programs_ahead = opts.host_threads == 2;
+  if (opts.host_threads != 0)
+    ro.programs =
+        opts.host_threads == 2 ? units::ProgramMode::kAhead : units::ProgramMode::kPacketFirst;
   if (isatty(fileno(stderr)))
     ro.progress = [](std::uint64_t cycles, int done, int total) {
       std::fprintf(stderr, "\r  cycle %llu, packets %d / %d",
@@ -99,6 +102,7 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
   j["host"] = {{"seconds", c.host_seconds},
                {"sim_cycles_per_s", c.sim_cycles_per_s},
                {"threads", c.host_threads},
+               {"programs", units::program_mode_name(c.programs)},
                {"skipped_cycles", c.skipped_cycles}};
   nlohmann::json units;
   for (int i = 0; i < units::kTable4Units; ++i) {

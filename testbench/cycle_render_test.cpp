@@ -53,7 +53,7 @@ TEST(CycleRender, ReportVcdAndTable) {
   o.cycle.vcd = (d / "room.vcd").string();
   o.cycle.vcd_from = 100;
   o.cycle.vcd_to = 200;
-  o.cycle.host_threads = 1;  // the programs inline (the report says so)
+  o.cycle.host_threads = 1;  // the programs on the simulation's thread (the report says so)
   testing::internal::CaptureStdout();
   EXPECT_EQ(run_render(o), 0);
   const std::string out = testing::internal::GetCapturedStdout();
@@ -75,6 +75,7 @@ TEST(CycleRender, ReportVcdAndTable) {
   EXPECT_EQ(j["configuration"]["cycle"]["depth.traversal"].get<int>(), 3 + 12 + 1);
   EXPECT_GE(j["time_series"].size(), 2u);
   EXPECT_EQ(j["host"]["threads"].get<int>(), 1);
+  EXPECT_EQ(j["host"]["programs"].get<std::string>(), "packet-first");
   EXPECT_EQ(j["stats"]["dynrtp0.transformation.issue_cycles"]["value"].get<double>(),
             j["units"]["transformation"]["issue_cycles"].get<double>());
   EXPECT_TRUE(j["stats"].contains("dynrtp0.node_cache.hit_rate_with_merges"));

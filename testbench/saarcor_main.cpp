@@ -92,8 +92,8 @@ int main(int argc, char** argv) {
     sub->add_option("--interval", render_opts.cycle.interval,
                     "cycle model: sample the figures every N cycles into the report");
     sub->add_option("--host-threads", render_opts.cycle.host_threads,
-                    "cycle model: 2 = thread programs on a second host thread, 1 = inline "
-                    "(default: 2 on a multi-core host; same results)");
+                    "cycle model: 2 = thread programs on a second host thread, 1 = on the "
+                    "simulation's thread (default: 2 on a multi-core host; same results)");
     sub->add_option("--vcd", render_opts.cycle.vcd, "cycle model: write a VCD trace");
     sub->add_option("--vcd-from", render_opts.cycle.vcd_from, "first cycle of the VCD trace");
     sub->add_option("--vcd-to", render_opts.cycle.vcd_to, "last cycle of the VCD trace")

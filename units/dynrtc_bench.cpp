@@ -110,10 +110,11 @@ void BM_FunctionalFp24Frame(benchmark::State& state) {
 }
 BENCHMARK(BM_FunctionalFp24Frame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3);
 
-// Args: threads, frame (0 hit sink, 1 shaded), programs ahead (1: the thread programs on a second
-// host thread, the default where the machine has two cores; 0: inline, one host thread). With two
-// host threads a frame is timed by the wall clock (the process CPU time, both threads, is printed
-// beside it); inline frames by this thread's CPU time as the functional model's.
+// Args: threads, frame (0 hit sink, 1 shaded), units::ProgramMode (2 ahead: the thread programs on
+// a second host thread, the default where the machine has two cores; 1 packet-first: one host
+// thread, the default on one core; 0 per-step: a program per simulated thread, the reference).
+// With two host threads a frame is timed by the wall clock (the process CPU time, both threads, is
+// printed beside it); with one by this thread's CPU time as the functional model's.
 void BM_CycleModelFrame(benchmark::State& state) {
   const Room& r = room();
   units::CycleParams p = units::prototype_params();
@@ -121,8 +122,9 @@ void BM_CycleModelFrame(benchmark::State& state) {
   const bool shade = state.range(1) != 0;
   units::CycleRunOptions options;
   options.shading.shade = shade;
-  options.programs_ahead = state.range(2) != 0;
-  const auto clock = options.programs_ahead ? wall_seconds : thread_cpu_seconds;
+  options.programs = static_cast<units::ProgramMode>(state.range(2));
+  const bool ahead = options.programs == units::ProgramMode::kAhead;
+  const auto clock = ahead ? wall_seconds : thread_cpu_seconds;
   FrameTimes times, cpu;
   units::CycleFrame last;
   for (auto _ : state) {
@@ -143,24 +145,26 @@ void BM_CycleModelFrame(benchmark::State& state) {
       static_cast<double>(last.module_evaluations) / static_cast<double>(last.cycles);
   state.counters["process_cpu_s_per_frame"] = cpu.best;
   std::printf(
-      "cycle model, %d threads, %s, %s: %.3f host s per 512x384 frame (best of %d; mean %.3f; "
+      "cycle model, %d threads, %s, programs %s (%s): %.3f host s per 512x384 frame (best of %d; "
+      "mean %.3f; "
       "process CPU %.3f s), %llu "
       "cycles (%.1f fps at %.0f MHz), %.2f M simulated cycles/s (target >= 5: ratio %.2f), %.1fx "
       "the functional fp24 model's %.3f s (target <= 20x: ratio %.2f); yardstick: %.3f simulated "
       "cycles per second per Embree ray per second (Embree %.2f M rays/s on this frame)\n",
       p.threads, shade ? "shaded (Table 3 setting)" : "hit sink (the issue's frame)",
-      options.programs_ahead ? "programs ahead (2 host threads, wall clock)"
-                             : "programs inline (1 host thread, CPU time)",
-      times.best, times.n, times.mean(), cpu.best, static_cast<unsigned long long>(last.cycles),
-      last.fps, p.clock_mhz, rate / 1e6, rate / 5e6, functional > 0 ? times.best / functional : 0.0,
-      functional, functional > 0 ? times.best / functional / 20.0 : 0.0,
-      embree > 0 ? rate / embree : 0.0, embree * 1e-6);
+      units::program_mode_name(options.programs),
+      ahead ? "2 host threads, wall clock" : "1 host thread, CPU time", times.best, times.n,
+      times.mean(), cpu.best, static_cast<unsigned long long>(last.cycles), last.fps, p.clock_mhz,
+      rate / 1e6, rate / 5e6, functional > 0 ? times.best / functional : 0.0, functional,
+      functional > 0 ? times.best / functional / 20.0 : 0.0, embree > 0 ? rate / embree : 0.0,
+      embree * 1e-6);
 }
 BENCHMARK(BM_CycleModelFrame)
+    ->Args({64, 0, 2})
     ->Args({64, 0, 1})
     ->Args({64, 0, 0})
+    ->Args({64, 1, 2})
     ->Args({64, 1, 1})
-    ->Args({64, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 

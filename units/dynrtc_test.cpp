@@ -97,16 +97,22 @@ TEST(DynRtc, ProgramsAheadChangeNothing) {
   const host::BuiltImage b = build("builtin:room", kSanitized ? 16 : 32, kSanitized ? 12 : 24);
   for (const testing::Config& c : configs()) {
     const CycleParams p = testing::params_of(c);
-    CycleRunOptions inline_run;
-    inline_run.shading = testing::shading_of(c);
-    inline_run.programs_ahead = false;
-    const CycleFrame i = run_cycle(b.image, p, inline_run);
-    for (const int window : {192, 1}) {
-      CycleRunOptions ahead = inline_run;
-      ahead.programs_ahead = true;
-      ahead.ahead_packets = window;
-      const CycleFrame a = run_cycle(b.image, p, ahead);
-      const std::string what = std::string(c.name) + ", window " + std::to_string(window);
+    CycleRunOptions per_step;
+    per_step.shading = testing::shading_of(c);
+    per_step.programs = ProgramMode::kPerStep;
+    const CycleFrame i = run_cycle(b.image, p, per_step);
+    EXPECT_EQ(i.programs, ProgramMode::kPerStep);
+    EXPECT_EQ(i.host_threads, 1);
+    // Packet-first, and ahead with the default window and with a one-packet window.
+    for (const int window : {0, 192, 1}) {
+      CycleRunOptions recorded = per_step;
+      recorded.programs = window == 0 ? ProgramMode::kPacketFirst : ProgramMode::kAhead;
+      recorded.ahead_packets = window;
+      const CycleFrame a = run_cycle(b.image, p, recorded);
+      const std::string what = std::string(c.name) + ", " + program_mode_name(recorded.programs) +
+                               ", window " + std::to_string(window);
+      EXPECT_EQ(a.programs, recorded.programs) << what;
+      EXPECT_EQ(a.host_threads, window == 0 ? 1 : 2) << what;
       EXPECT_EQ(a.cycles, i.cycles) << what;
       EXPECT_EQ(a.stats_json, i.stats_json) << what;
       ASSERT_EQ(a.frame.pixels.size(), i.frame.pixels.size()) << what;
@@ -120,26 +126,30 @@ TEST(DynRtc, ProgramsAheadChangeNothing) {
     }
   }
   CycleRunOptions bad;
-  bad.programs_ahead = true;
+  bad.programs = ProgramMode::kAhead;
   bad.ahead_packets = 0;
   EXPECT_THROW(run_cycle(b.image, prototype_params(), bad), std::runtime_error);
 }
 
-// An error of a thread program on the program thread (here the stack overflow of D26) stops the
-// run with the same one-line error as inline, and with fewer threads than packets in flight.
+// An error of a thread program (here the stack overflow of D26) stops the run with the same
+// one-line error in every mode: on the program thread, and with fewer threads than packets in
+// flight.
 TEST(DynRtc, ProgramThreadErrorsReachTheCaller) {
   const host::BuiltImage b = build("builtin:room", 16, 12);
-  for (const int threads : {1, 64}) {
-    CycleParams p = prototype_params();
-    p.stack = 2;
-    p.threads = threads;
-    CycleRunOptions o;
-    o.programs_ahead = true;
-    try {
-      run_cycle(b.image, p, o);
-      ADD_FAILURE() << "a 2-entry stack was enough";
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find("stack overflow"), std::string::npos) << e.what();
+  for (const ProgramMode mode :
+       {ProgramMode::kPerStep, ProgramMode::kPacketFirst, ProgramMode::kAhead}) {
+    for (const int threads : {1, 64}) {
+      CycleParams p = prototype_params();
+      p.stack = 2;
+      p.threads = threads;
+      CycleRunOptions o;
+      o.programs = mode;
+      try {
+        run_cycle(b.image, p, o);
+        ADD_FAILURE() << "a 2-entry stack was enough (" << program_mode_name(mode) << ")";
+      } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("stack overflow"), std::string::npos) << e.what();
+      }
     }
   }
 }
@@ -301,18 +311,19 @@ TEST(DynRtc, OnlyTheFp24ImageRuns) {
 }
 
 // A stuck run stops with a report naming each waiting thread, its unit, phase, item and rays; the
-// report is the same whether the programs run inline or ahead (a replayed request keeps its ray
-// mask beside the trace the units read).
+// report is the same in every program mode (a replayed request keeps its ray mask beside the
+// trace the units read).
 TEST(DynRtc, WatchdogNamesStuckThreads) {
   const host::BuiltImage b = build("builtin:room", 16, 12);
   CycleParams p = prototype_params();
   p.threads = 2;
   p.watchdog = 20;      // shorter than one memory round trip:
   p.mem_latency = 200;  // the first misses look like a hang
-  std::string reports[2];
-  for (const bool ahead : {false, true}) {
+  std::string reports[3];
+  for (const ProgramMode mode :
+       {ProgramMode::kPerStep, ProgramMode::kPacketFirst, ProgramMode::kAhead}) {
     CycleRunOptions opt;
-    opt.programs_ahead = ahead;
+    opt.programs = mode;
     try {
       run_cycle(b.image, p, opt);
       ADD_FAILURE() << "the watchdog did not fire";
@@ -324,10 +335,11 @@ TEST(DynRtc, WatchdogNamesStuckThreads) {
       EXPECT_NE(m.find("dynrtp0.traversal"), std::string::npos) << m;
       // A primary packet of P = 4 rays, all active at the start: mask 0xf.
       EXPECT_NE(m.find("mask 0xf\n"), std::string::npos) << m;
-      reports[ahead ? 1 : 0] = m;
+      reports[static_cast<int>(mode)] = m;
     }
   }
   EXPECT_EQ(reports[1], reports[0]);
+  EXPECT_EQ(reports[2], reports[0]);
 }
 
 // --interval: the figures of each interval; their cycle-weighted mean is the frame's figure.

@@ -25,28 +25,31 @@ namespace {
 // The thread table: one thread program per thread, all sharing the DynRTP's float units and the
 // frame sink (their only shared state; both sum order-independently).
 //
-// Programs ahead of the simulation (CycleRunOptions::programs_ahead; docs/cycle-model.md): what a
+// Recorded programs (CycleRunOptions::programs; docs/cycle-model.md, "Programs ahead"): what a
 // thread computes never depends on timing, and a packet's computation does not depend on the
 // thread that runs it (the mailbox, stack and child packets start afresh with every primary
-// packet, D28). So one program on a second host thread runs the packets in the RGC's order, as
-// the functional model does, and records each packet's request sequence; a simulated thread then
-// replays its packet's sequence, and execute() is a copy. The same requests reach the units, so
-// every figure and result is the same as with a program per thread (tested).
+// packet, D28). So one program runs a packet's whole request sequence at once, as the functional
+// model does, and records it; the simulated thread the RGC hands the packet replays it, and
+// execute() is a copy. The same requests reach the units, so every figure and result is the same
+// as with a program per thread (tested). kPacketFirst records a packet when the RGC hands it out;
+// kAhead records the packets in the RGC's order on a second host thread.
 template <class F, int kLanes>
 class Threads final : public ThreadTable {
  public:
-  // ahead > 0: the programs run on a second host thread, at most `ahead` finished packets ahead.
-  Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads, int ahead)
+  // kAhead: at most `ahead` finished packets ahead of the simulation.
+  Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads,
+          ProgramMode mode, int ahead)
       : params_(params),
         units_(params.mode),
-        ahead_(ahead > 0),
-        max_ahead_(static_cast<std::size_t>(ahead)) {
+        mode_(mode),
+        recorded_(mode != ProgramMode::kPerStep),
+        max_ahead_(mode == ProgramMode::kAhead ? static_cast<std::size_t>(ahead) : 0) {
     w_ = static_cast<int>(image.registers().width);
     h_ = static_cast<int>(image.registers().height);
     tiling_ = packet_tiling(w_, h_, params.packet);
     sink_.reset(w_, h_);
     requests_.resize(static_cast<std::size_t>(threads));
-    if (!ahead_) {
+    if (!recorded_) {
       for (int i = 0; i < threads; ++i) {
         programs_.push_back(
             std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
@@ -62,14 +65,14 @@ class Threads final : public ThreadTable {
     programs_.push_back(std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
     for (int i = 0; i < threads; ++i)
       requests_[static_cast<std::size_t>(i)] = programs_.back()->request();
-    worker_ = std::thread([this] { run_ahead(); });
+    if (mode_ == ProgramMode::kAhead) worker_ = std::thread([this] { run_ahead(); });
   }
   ~Threads() override { stop(); }
   Threads(const Threads&) = delete;
   Threads& operator=(const Threads&) = delete;
 
   void execute(std::uint32_t t) override {
-    if (ahead_) {
+    if (recorded_) {
       Cursor& c = cursor_[t];
       replay(t, slots_[c.slot].trace[++c.next]);
       return;
@@ -81,7 +84,15 @@ class Threads final : public ThreadTable {
     ::new (static_cast<void*>(&requests_[t])) Request(p.request());
   }
   void start_primary(std::uint32_t t, int packet) override {
-    if (ahead_) {
+    if (mode_ == ProgramMode::kPacketFirst) {
+      Cursor& c = cursor_[t];
+      c = {free_.back(), 0};
+      free_.pop_back();
+      record(slots_[c.slot], *programs_[0], packet);
+      replay(t, slots_[c.slot].trace[0]);
+      return;
+    }
+    if (mode_ == ProgramMode::kAhead) {
       Cursor& c = cursor_[t];
       c = {take(packet), 0};
       // The trace was written on the other core: pull all of it towards this one now, while the
@@ -100,7 +111,7 @@ class Threads final : public ThreadTable {
   // The rays thread `t`'s current request concerns (for the watchdog's thread report; the units
   // never read it, so a replayed request carries it only in its slot).
   std::uint64_t mask(std::uint32_t t) const {
-    if (!ahead_) return requests_[t].mask;
+    if (!recorded_) return requests_[t].mask;
     const Cursor& c = cursor_[t];
     return slots_[c.slot].masks[c.next];
   }
@@ -134,6 +145,23 @@ class Threads final : public ThreadTable {
     std::vector<std::uint64_t> masks;
     int packet = -1;
   };
+  // Runs packet `packet` on program `p` and records its request sequence into `s`.
+  void record(Slot& s, ThreadProgram<F, kLanes>& p, int packet) {
+    s.packet = packet;
+    s.trace.clear();
+    s.masks.clear();
+    p.start_primary(packet_pixels(tiling_, w_, h_, packet));
+    for (;;) {
+      const Request& r = p.request();
+      if (r.steps < 0 || r.steps > 0xffff)
+        throw std::logic_error("cycle model: a request of " + std::to_string(r.steps) +
+                               " steps does not fit a trace entry");
+      s.trace.push_back({r.unit, r.phase, static_cast<std::uint16_t>(r.steps), r.item});
+      s.masks.push_back(r.mask);
+      if (p.done()) break;
+      p.execute();
+    }
+  }
   void replay(std::uint32_t t, const Step& s) {
     Request& r = requests_[t];
     r.unit = s.unit;
@@ -170,21 +198,7 @@ class Threads final : public ThreadTable {
           id = free_.back();
           free_.pop_back();
         }
-        Slot& s = slots_[id];
-        s.packet = k;
-        s.trace.clear();
-        s.masks.clear();
-        p.start_primary(packet_pixels(tiling_, w_, h_, k));
-        for (;;) {
-          const Request& r = p.request();
-          if (r.steps < 0 || r.steps > 0xffff)
-            throw std::logic_error("cycle model: a request of " + std::to_string(r.steps) +
-                                   " steps does not fit a trace entry");
-          s.trace.push_back({r.unit, r.phase, static_cast<std::uint16_t>(r.steps), r.item});
-          s.masks.push_back(r.mask);
-          if (p.done()) break;
-          p.execute();
-        }
+        record(slots_[id], p, k);
         {
           const std::lock_guard<std::mutex> lock(mutex_);
           finished_.push_back(id);
@@ -225,6 +239,10 @@ class Threads final : public ThreadTable {
   }
 
   void release(std::size_t slot) {
+    if (mode_ != ProgramMode::kAhead) {  // no other host thread
+      free_.push_back(slot);
+      return;
+    }
     const std::lock_guard<std::mutex> lock(mutex_);
     free_.push_back(slot);
   }
@@ -244,7 +262,8 @@ class Threads final : public ThreadTable {
   FrameSink sink_;
   PacketTiling tiling_;
   int w_ = 0, h_ = 0;
-  bool ahead_ = false;
+  ProgramMode mode_;
+  bool recorded_;  // kPacketFirst or kAhead: the simulated threads replay recorded packets
   std::size_t max_ahead_ = 0;
   std::vector<std::unique_ptr<ThreadProgram<F, kLanes>>> programs_;
   std::vector<Slot> slots_;
@@ -454,10 +473,10 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
   // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
   memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
-  if (opt.programs_ahead && opt.ahead_packets < 1)
+  if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
     throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
                              std::to_string(opt.ahead_packets) + ")");
-  Threads<F, kLanes> threads(image, fp, p.threads, opt.programs_ahead ? opt.ahead_packets : 0);
+  Threads<F, kLanes> threads(image, fp, p.threads, opt.programs, opt.ahead_packets);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;
@@ -534,7 +553,8 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
                                          static_cast<double>(steps) / p.packet;
   out.packets_retired = dyn.rgs().packets_retired();
   out.skipped_cycles = k.skipped_cycles();
-  out.host_threads = opt.programs_ahead ? 2 : 1;
+  out.host_threads = opt.programs == ProgramMode::kAhead ? 2 : 1;
+  out.programs = opt.programs;
   out.module_evaluations = k.module_evaluations();
   out.stats_json = k.stats().json();
   out.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -545,6 +565,18 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
 }
 
 }  // namespace
+
+const char* program_mode_name(ProgramMode m) {
+  switch (m) {
+    case ProgramMode::kPerStep:
+      return "per-step";
+    case ProgramMode::kPacketFirst:
+      return "packet-first";
+    case ProgramMode::kAhead:
+      return "ahead";
+  }
+  return "?";
+}
 
 CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
                      const CycleRunOptions& options) {

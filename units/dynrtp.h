@@ -24,6 +24,16 @@ inline constexpr int kTable4Units = 4;
 inline constexpr const char* kTable4UnitNames[kTable4Units] = {"traversal", "list",
                                                                "transformation", "intersection"};
 
+// Where a simulated thread's requests come from:
+enum class ProgramMode {
+  kPerStep,      // a thread program per simulated thread, each step run when a unit issues it
+                 // (the reference the other modes are tested against)
+  kPacketFirst,  // one program runs a packet's whole request sequence when the RGC hands the
+                 // packet out, the simulated thread replays it (one host thread)
+  kAhead,        // the same sequences recorded on a second host thread, ahead of the simulation
+};
+const char* program_mode_name(ProgramMode m);  // "per-step", "packet-first", "ahead"
+
 struct CycleRunOptions {
   FunctionalParams shading;     // shade / shadows / secondary / max_depth (packet, stack, mailbox,
                                 // shared_origin come from CycleParams)
@@ -33,11 +43,11 @@ struct CycleRunOptions {
   std::uint64_t shuffle_seed = 0;  // != 0: random module evaluation order (figures must not move)
   bool idle_skip = true;           // false: evaluate every cycle (figures must not move)
   std::uint64_t max_cycles = 0;    // != 0: stop with an error after this many cycles
-  // The thread programs run on a second host thread ahead of the simulation, which replays their
-  // request sequences (docs/cycle-model.md, "Programs ahead"); false: a program per simulated
-  // thread, run inline. Results and figures are the same either way.
-  bool programs_ahead = std::thread::hardware_concurrency() > 1;
-  // How many finished packets the program thread may hold ahead of the simulation (>= 1).
+  // How the thread programs run beside the simulation (docs/cycle-model.md, "Programs ahead").
+  // Results and figures are the same in every mode (tested).
+  ProgramMode programs =
+      std::thread::hardware_concurrency() > 1 ? ProgramMode::kAhead : ProgramMode::kPacketFirst;
+  // kAhead: how many finished packets the program thread may hold ahead of the simulation (>= 1).
   int ahead_packets = 192;
   std::function<void(std::uint64_t cycles, int packets_done, int packets)> progress;
 };
@@ -67,6 +77,7 @@ struct CycleFrame {
   std::uint64_t packets = 0, packets_retired = 0;
   double host_seconds = 0, sim_cycles_per_s = 0;  // wall clock
   int host_threads = 1;                           // 2: the thread programs ran ahead
+  ProgramMode programs = ProgramMode::kPerStep;
   std::uint64_t skipped_cycles = 0;
   std::uint64_t module_evaluations = 0;  // host work: evaluate() calls (sleeping modules skip)
   std::vector<CycleFigures> series;      // with interval != 0: the figures of each interval
