@@ -339,11 +339,11 @@ int run_precision(const PrecisionOptions& opts) {
   settings.res = parse_resolution(opts.res);
   settings.bank_mb = opts.bank_mb;
   const auto [lo, hi] = parse_mantissa_range(opts.mantissa);
-  if (opts.out.empty()) throw std::runtime_error("bad --out '': expected a file prefix");
+  const std::string out = output_prefix(opts.out, {".png", ".json"});
   const std::vector<PrecisionRow> rows = run_precision_study(opts.scene, settings, lo, hi);
 
-  const std::string png = opts.out + ".png";
-  const std::string json = opts.out + ".json";
+  const std::string png = out + ".png";
+  const std::string json = out + ".json";
   const std::string name = std::filesystem::path(opts.scene).filename().string();
   write_rgb8(png, plot_precision(rows, name + "  " + std::to_string(settings.res.width) + "x" +
                                            std::to_string(settings.res.height))

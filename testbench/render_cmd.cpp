@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
@@ -313,6 +314,17 @@ void progress(const std::string& line) {
   if (isatty(fileno(stderr))) std::fprintf(stderr, "%s\n", line.c_str());
 }
 
+std::string output_prefix(const std::string& out, std::initializer_list<std::string_view> exts) {
+  for (const std::string_view ext : exts) {
+    if (out.size() > ext.size() && out.ends_with(ext))
+      return out.substr(0, out.size() - ext.size());
+  }
+  if (out.empty() || std::ranges::find(exts, std::string_view(out)) != exts.end()) {
+    throw std::runtime_error("bad --out '" + out + "': expected a file prefix");
+  }
+  return out;
+}
+
 Resolution parse_resolution(const std::string& text) {
   const auto x = text.find('x');
   Resolution r;
@@ -486,15 +498,12 @@ int run_render(const RenderOptions& opts) {
   }
   std::optional<PixelCoord> pixel;
   if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
-  if (opts.out.empty()) throw std::runtime_error("bad --out '': expected a file prefix");
   // Output names are checked before the work, so a bad one costs no render.
-  auto ends_with = [](const std::string& s, const std::string& e) {
-    return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
-  };
-  if (!opts.hits.empty() && !ends_with(opts.hits, ".exr")) {
+  const std::string out = output_prefix(opts.out, {".png", ".exr"});
+  if (!opts.hits.empty() && !opts.hits.ends_with(".exr")) {
     throw std::runtime_error("bad --hits '" + opts.hits + "': a hit EXR file name ends in .exr");
   }
-  if (!opts.report.empty() && !ends_with(opts.report, ".json")) {
+  if (!opts.report.empty() && !opts.report.ends_with(".json")) {
     throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
   }
 
@@ -514,11 +523,11 @@ int run_render(const RenderOptions& opts) {
            std::to_string(settings.res.height) + " with the " + model.name + " model");
   const FrameResult frame = render_model(model, prep, settings);
 
-  const std::string png = opts.out + ".png";
+  const std::string png = out + ".png";
   write_rgb8(png, frame.image);
   std::vector<std::pair<std::string, std::string>> outputs = {{"image", png}};
   if (opts.exr) {
-    const std::string exr = opts.out + ".exr";
+    const std::string exr = out + ".exr";
     write_float_image(exr, to_float_image(frame.image));
     outputs.push_back({"image_exr", exr});
   }

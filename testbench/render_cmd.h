@@ -5,8 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 
 #include "fixedfloat/format.h"
 #include "host/float_reference.h"
@@ -23,6 +25,11 @@ struct Resolution {
 };
 // "WxH" with 1 <= W, H <= 16384; throws "bad --res 'TEXT': ..." otherwise.
 Resolution parse_resolution(const std::string& text);
+
+// --out is a prefix the commands add extensions to; a prefix given with one of the extensions
+// they write ("frame.png") loses it, so it names the file written instead of "frame.png.png".
+// Throws "bad --out '': ..." on an empty prefix.
+std::string output_prefix(const std::string& out, std::initializer_list<std::string_view> exts);
 
 struct PixelCoord {
   int x = 0;

@@ -55,6 +55,20 @@ TEST(RenderArgs, Resolution) {
   }
 }
 
+TEST(RenderArgs, OutputPrefix) {
+  EXPECT_EQ(output_prefix("out/render", {".png", ".exr"}), "out/render");
+  EXPECT_EQ(output_prefix("out/frame.png", {".png", ".exr"}), "out/frame");
+  EXPECT_EQ(output_prefix("frame.exr", {".png", ".exr"}), "frame");
+  EXPECT_EQ(output_prefix("frame.json", {".png", ".exr"}), "frame.json");  // not one it writes
+  EXPECT_EQ(output_prefix("frame.png.png", {".png"}), "frame.png");
+  for (const char* bad : {"", ".png"}) {
+    EXPECT_EQ(error_of([&] {
+                output_prefix(bad, {".png", ".exr"});
+              }),
+              std::string("bad --out '") + bad + "': expected a file prefix");
+  }
+}
+
 TEST(RenderArgs, Pixel) {
   const Resolution r{64, 48};
   EXPECT_EQ(parse_pixel("10,20", r).x, 10);
@@ -238,6 +252,20 @@ TEST(RunRender, WritesEveryOutput) {
   EXPECT_TRUE(j["counters"]["per_ray"]["primary"].contains("traversal_steps"));
   EXPECT_GT(j["counters"]["ops"]["intersection"]["div"].get<std::uint64_t>(), 0u);
   EXPECT_EQ(j["configuration"]["image_format"], "Float<7,16> (e7m16)");
+}
+
+TEST(RunRender, OutWithTheImageExtensionNamesTheImage) {
+  const fs::path d = temp_dir() / "ext";
+  fs::remove_all(d);
+  RenderOptions o;
+  o.scene = "builtin:cube";
+  o.res = "8x8";
+  o.out = (d / "frame.png").string();
+  o.exr = true;
+  ASSERT_EQ(run_render(o), 0);
+  EXPECT_EQ(read_rgb8((d / "frame.png").string()).width, 8);
+  EXPECT_EQ(read_float_image((d / "frame.exr").string()).width, 8);
+  EXPECT_FALSE(fs::exists(d / "frame.png.png"));
 }
 
 TEST(RunRender, BadOutputNamesFailBeforeRendering) {

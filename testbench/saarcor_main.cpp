@@ -74,7 +74,8 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     sub->add_option("--res", render_opts.res, "resolution WxH")->capture_default_str();
     sub->add_option("--time", render_opts.time, "animation time in seconds");
-    sub->add_option("--out", render_opts.out, "output prefix (PREFIX.png, PREFIX.exr)")
+    sub->add_option("--out", render_opts.out,
+                    "output prefix (PREFIX.png, PREFIX.exr; a given .png or .exr is dropped)")
         ->capture_default_str();
     sub->add_flag("--exr", render_opts.exr, "also write PREFIX.exr");
     sub->add_option("--hits", render_opts.hits, "write the per-pixel hit records as a hit EXR");
@@ -108,7 +109,9 @@ int main(int argc, char** argv) {
     sub->add_option("--mantissa", precision_opts.mantissa, "mantissa bits: M or A..B (10..23)")
         ->capture_default_str();
     sub->add_option("--res", precision_opts.res, "resolution WxH")->capture_default_str();
-    sub->add_option("--out", precision_opts.out, "output prefix (PREFIX.png plot, PREFIX.json)")
+    sub->add_option(
+           "--out", precision_opts.out,
+           "output prefix (PREFIX.png plot, PREFIX.json; a given .png or .json is dropped)")
         ->capture_default_str();
     sub->add_option("--bank-mb", precision_opts.bank_mb, "SRAM bank size in MB")
         ->capture_default_str();
