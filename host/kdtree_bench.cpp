@@ -13,12 +13,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <limits>
 #include <map>
 #include <random>
 #include <vector>
 
+#include "host/bench_support.h"
 #include "host/kdtree.h"
 
 namespace {
@@ -109,13 +109,8 @@ const Mesh& mesh(int kind, int size) {
   return it->second;
 }
 
-// CPU time of this process (Embree runs its one build thread under TBB): the machine is shared,
-// so wall time would count other processes.
-double thread_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+// CPU time of this process (Embree runs its one build thread under TBB).
+const auto cpu_seconds = saarcor::host::bench::process_cpu_seconds;
 
 // Embree 3 BVH build, one thread: the reference build rate on the same machine, same run.
 double embree_build_seconds(const Mesh& m) {
@@ -133,44 +128,52 @@ double embree_build_seconds(const Mesh& m) {
     rtcCommitGeometry(geom);
     rtcAttachGeometry(scene, geom);
     rtcReleaseGeometry(geom);
-    const double t0 = thread_seconds();
+    const double t0 = cpu_seconds();
     rtcCommitScene(scene);
-    best = std::min(best, thread_seconds() - t0);
+    best = std::min(best, cpu_seconds() - t0);
     rtcReleaseScene(scene);
   }
   rtcReleaseDevice(device);
   return best;
 }
 
-void BM_KdTreeBuild(benchmark::State& state) {
-  const Mesh& m = mesh(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  const double embree = embree_build_seconds(m);
+// Times one build per benchmark iteration and sets the counters both benchmarks print; returns
+// triangles per CPU second.
+double time_builds(benchmark::State& state, const Mesh& m, const KdBuildParams& params) {
   KdTree tree;
   double total = 0.0;
   std::int64_t builds = 0;
   for (auto _ : state) {
-    const double t0 = thread_seconds();
-    tree = build_kdtree(m.pos, m.tris, {});
-    const double t = thread_seconds() - t0;
+    const double t0 = cpu_seconds();
+    tree = build_kdtree(m.pos, m.tris, {}, params);
+    const double t = cpu_seconds() - t0;
     state.SetIterationTime(t);
     total += t;
     ++builds;
     benchmark::DoNotOptimize(tree.nodes.data());
   }
   const double n = static_cast<double>(m.tris.size());
-  const double rate = n * builds / total;
-  state.SetLabel(state.range(0) == 0 ? "terrain" : "sphere");
+  const double rate = n * static_cast<double>(builds) / total;
   state.counters["triangles"] = n;
   state.counters["tri_per_s"] = rate;
   state.counters["vs_target_1M"] = rate / kTargetTrianglesPerSecond;
-  state.counters["embree_tri_per_s"] = n / embree;
-  state.counters["vs_embree_bvh"] = rate / (n / embree);
   state.counters["nodes"] = tree.stats.nodes;
   state.counters["depth"] = tree.stats.depth;
   state.counters["items_per_leaf"] = tree.stats.items_per_leaf;
   state.counters["sah_cost"] = tree.stats.sah_cost;
   state.counters["exp_steps"] = tree.stats.expected_traversal_steps;
   state.counters["exp_tests"] = tree.stats.expected_item_tests;
+  return rate;
+}
+
+void BM_KdTreeBuild(benchmark::State& state) {
+  const Mesh& m = mesh(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const double embree = embree_build_seconds(m);
+  const double rate = time_builds(state, m, {});
+  const double n = static_cast<double>(m.tris.size());
+  state.SetLabel(state.range(0) == 0 ? "terrain" : "sphere");
+  state.counters["embree_tri_per_s"] = n / embree;
+  state.counters["vs_embree_bvh"] = rate / (n / embree);
 }
 
 // The exact event sweep alone (binned stage off): the same counters, for the quality comparison.
@@ -178,30 +181,8 @@ void BM_KdTreeBuildExact(benchmark::State& state) {
   const Mesh& m = mesh(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   KdBuildParams params;
   params.binned_above = std::numeric_limits<int>::max();
-  KdTree tree;
-  double total = 0.0;
-  std::int64_t builds = 0;
-  for (auto _ : state) {
-    const double t0 = thread_seconds();
-    tree = build_kdtree(m.pos, m.tris, {}, params);
-    const double t = thread_seconds() - t0;
-    state.SetIterationTime(t);
-    total += t;
-    ++builds;
-    benchmark::DoNotOptimize(tree.nodes.data());
-  }
-  const double n = static_cast<double>(m.tris.size());
-  const double rate = n * builds / total;
+  time_builds(state, m, params);
   state.SetLabel(state.range(0) == 0 ? "terrain, exact sweep only" : "sphere, exact sweep only");
-  state.counters["triangles"] = n;
-  state.counters["tri_per_s"] = rate;
-  state.counters["vs_target_1M"] = rate / kTargetTrianglesPerSecond;
-  state.counters["nodes"] = tree.stats.nodes;
-  state.counters["depth"] = tree.stats.depth;
-  state.counters["items_per_leaf"] = tree.stats.items_per_leaf;
-  state.counters["sah_cost"] = tree.stats.sah_cost;
-  state.counters["exp_steps"] = tree.stats.expected_traversal_steps;
-  state.counters["exp_tests"] = tree.stats.expected_item_tests;
 }
 
 // (kind, size): terrain n x n cells (2n^2 triangles), sphere with s stacks (~4 s^2 triangles).

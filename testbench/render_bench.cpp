@@ -12,13 +12,13 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
-#include <ctime>
 #include <limits>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "host/bench_support.h"
 #include "host/embree_oracle.h"
 #include "host/float_reference.h"
 #include "host/image_builder.h"
@@ -29,11 +29,7 @@ namespace {
 
 using namespace saarcor;
 
-double cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+const auto cpu_seconds = host::bench::thread_cpu_seconds;
 
 struct BenchScene {
   std::string label;

@@ -17,11 +17,10 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <vector>
 
+#include "host/bench_support.h"
 #include "host/embree_oracle.h"
 #include "host/float_reference.h"
 #include "host/image_builder.h"
@@ -33,28 +32,12 @@ namespace {
 
 using namespace saarcor;
 
-struct Room {
-  host::Scene scene = host::load_scene("builtin:room");
-  host::BuiltImage built = host::build_image(scene, {});
-};
-const Room& room() {
-  static const Room r;
-  return r;
-}
+using host::bench::process_cpu_seconds;
+using host::bench::Room;
+using host::bench::room;
+using host::bench::thread_cpu_seconds;
+using host::bench::wall_seconds;
 
-// CPU seconds of this thread (the machine is shared, so wall time would measure the neighbours),
-// or with CLOCK_PROCESS_CPUTIME_ID of every thread (the cycle model with its program thread).
-double cpu_seconds(clockid_t clock = CLOCK_THREAD_CPUTIME_ID) {
-  timespec ts{};
-  clock_gettime(clock, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-double thread_cpu_seconds() {
-  return cpu_seconds();
-}
-double wall_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 // Per frame kind (hits, shaded): the functional model's best frame time.
 double g_functional_seconds[2] = {0.0, 0.0};
 // Embree's best single-ray rate on the frame's primary rays (the machine yardstick).
@@ -81,10 +64,10 @@ void BM_EmbreeFrame(benchmark::State& state) {
   FrameTimes times;
   std::uint64_t hits = 0;
   for (auto _ : state) {
-    const double t0 = cpu_seconds();
+    const double t0 = thread_cpu_seconds();
     for (const host::FloatRay& ray : rays)
       hits += embree.intersect(ray).hit ? 1u : 0u;
-    times.add(cpu_seconds() - t0);
+    times.add(thread_cpu_seconds() - t0);
   }
   benchmark::DoNotOptimize(hits);
   g_embree_rays_per_s = static_cast<double>(rays.size()) / times.best;
@@ -99,9 +82,9 @@ void BM_FunctionalFp24Frame(benchmark::State& state) {
   params.shade = shade;
   FrameTimes times;
   for (auto _ : state) {
-    const double t0 = cpu_seconds();
+    const double t0 = thread_cpu_seconds();
     const units::FunctionalFrame f = units::run_functional<ff::fp24>(r.built.image, params);
-    times.add(cpu_seconds() - t0);
+    times.add(thread_cpu_seconds() - t0);
     benchmark::DoNotOptimize(f.rgb.data());
   }
   g_functional_seconds[shade] = times.best;
@@ -128,10 +111,10 @@ void BM_CycleModelFrame(benchmark::State& state) {
   FrameTimes times, cpu;
   units::CycleFrame last;
   for (auto _ : state) {
-    const double t0 = clock(), c0 = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+    const double t0 = clock(), c0 = process_cpu_seconds();
     last = units::run_cycle(r.built.image, p, options);
     times.add(clock() - t0);
-    cpu.add(cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - c0);
+    cpu.add(process_cpu_seconds() - c0);
   }
   const double functional = g_functional_seconds[shade];
   const double rate = static_cast<double>(last.cycles) / times.best;

@@ -5,12 +5,12 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
-#include <ctime>
 #include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
+#include "host/bench_support.h"
 #include "host/float_reference.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
@@ -20,23 +20,13 @@ namespace {
 
 using namespace saarcor;
 
-struct Room {
-  host::Scene scene = host::load_scene("builtin:room");
-  host::BuiltImage built = host::build_image(scene, {});
-};
-const Room& room() {
-  static const Room r;
-  return r;
-}
+using host::bench::Room;
+using host::bench::room;
+// CPU seconds of this thread: the machine is shared, so wall time would measure the neighbours.
+const auto cpu_seconds = host::bench::thread_cpu_seconds;
 
 double g_fp24_rays_per_s = 0.0;
 
-// CPU seconds of this thread: the machine is shared, so wall time would measure the neighbours.
-double cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 double g_float_rays_per_s = 0.0;
 
 void BM_FunctionalFp24Room(benchmark::State& state) {
