@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "testbench/hit_exr.h"
+#include "testbench/testing.h"
 
 namespace saarcor {
 namespace {
@@ -16,9 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  fs::path d = fs::temp_directory_path() / ("saarcor_compare_" + std::to_string(getpid()));
-  fs::create_directories(d);
-  return d;
+  return test_support::scratch_dir("compare");
 }
 
 // 10x10 frame: left half misses, right half hits triangle (instance 3, triangle x+10y) at the

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "testbench/render_cmd.h"
+#include "testbench/testing.h"
 
 namespace saarcor {
 namespace {
@@ -17,9 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  fs::path d = fs::temp_directory_path() / ("saarcor_cycle_" + std::to_string(getpid()));
-  fs::create_directories(d);
-  return d;
+  return test_support::scratch_dir("cycle");
 }
 
 std::string read(const fs::path& p) {

@@ -12,6 +12,7 @@
 #include <random>
 
 #include "testbench/image_io.h"
+#include "testbench/testing.h"
 
 namespace saarcor {
 namespace {
@@ -19,9 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  fs::path d = fs::temp_directory_path() / ("saarcor_hitexr_" + std::to_string(getpid()));
-  fs::create_directories(d);
-  return d;
+  return test_support::scratch_dir("hitexr");
 }
 
 std::uint32_t bits(float f) {

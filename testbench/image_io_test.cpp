@@ -1,5 +1,6 @@
 // Image files through OpenImageIO: round trips, atomic writes, one-line errors naming the file.
 #include "testbench/image_io.h"
+#include "testbench/testing.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,9 +14,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  fs::path d = fs::temp_directory_path() / ("saarcor_imageio_" + std::to_string(getpid()));
-  fs::create_directories(d);
-  return d;
+  return test_support::scratch_dir("imageio");
 }
 
 Rgb8Image gradient(int w, int h) {

@@ -11,20 +11,14 @@
 #include <limits>
 
 #include "testbench/image_io.h"
+#include "testbench/testing.h"
 
 namespace saarcor {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test_support::error_of;
 
 TEST(PrecisionArgs, MantissaRange) {
   EXPECT_EQ(parse_mantissa_range("16"), (std::pair<int, int>{16, 16}));

@@ -17,6 +17,7 @@
 #include "testbench/compare.h"
 #include "testbench/hit_exr.h"
 #include "testbench/image_io.h"
+#include "testbench/testing.h"
 
 namespace saarcor {
 namespace {
@@ -24,19 +25,10 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  fs::path d = fs::temp_directory_path() / ("saarcor_render_" + std::to_string(getpid()));
-  fs::create_directories(d);
-  return d;
+  return test_support::scratch_dir("render");
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test_support::error_of;
 
 std::uint32_t bits(float f) {
   std::uint32_t b;
@@ -281,36 +273,9 @@ TEST(RunRender, BadOutputNamesFailBeforeRendering) {
 
 // ---- the real binary ---------------------------------------------------------------------------
 
-struct CliRun {
-  int status = -1;
-  std::string out, err;
-};
-
-CliRun saarcor(const std::string& args) {
-  const fs::path d = temp_dir();
-  const std::string out = (d / "stdout.txt").string(), err = (d / "stderr.txt").string();
-  const std::string cmd =
-      std::string(SAARCOR_BIN_DIR) + "/saarcor " + args + " >" + out + " 2>" + err + " </dev/null";
-  const int rc = std::system(cmd.c_str());
-  CliRun r;
-  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-  auto slurp = [](const std::string& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-void expect_one_line_error(const CliRun& r, const std::string& contains) {
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_EQ(r.err.rfind("saarcor: error: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(contains), std::string::npos) << r.err;
-}
+using test_support::CliRun;
+using test_support::expect_one_line_error;
+const auto saarcor = test_support::run_saarcor;
 
 TEST(SaarcorBinary, RenderCompareEndToEnd) {
   const fs::path d = temp_dir() / "e2e";
