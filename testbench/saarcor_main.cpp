@@ -13,6 +13,7 @@
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
 #include "testbench/scene_cmd.h"
+#include "testbench/sweep_cmd.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -100,6 +101,28 @@ int main(int argc, char** argv) {
     sub->add_option("--vcd-to", render_opts.cycle.vcd_to, "last cycle of the VCD trace")
         ->capture_default_str();
     sub->callback([&] { status = saarcor::run_render(render_opts); });
+  }
+  saarcor::SweepOptions sweep_opts;
+  {
+    auto* sub = app.add_subcommand(
+        "sweep", "cycle model over a grid of configurations, each checked against fp24");
+    sub->add_option("scene", sweep_opts.scene, "glTF file or builtin:NAME")->required();
+    sub->add_option("--vary", sweep_opts.vary,
+                    "cycle model key and its values KEY=V1,V2,... (repeatable: the product)")
+        ->required();
+    sub->add_option("--res", sweep_opts.res, "resolution WxH")->capture_default_str();
+    sub->add_option("--time", sweep_opts.time, "animation time in seconds");
+    sub->add_flag("--shadows", sweep_opts.shadows, "shadow rays");
+    sub->add_option("--depth", sweep_opts.depth, "secondary-ray depth (0 = primary only)");
+    sub->add_option("--bank-mb", sweep_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
+    sub->add_option("--preset", sweep_opts.preset, "cycle model preset (prototype, table2)")
+        ->capture_default_str();
+    sub->add_option("--set", sweep_opts.set, "cycle model parameter KEY=VALUE for every point");
+    sub->add_option("--host-threads", sweep_opts.host_threads,
+                    "2 = thread programs on a second host thread, 1 = on the simulation's thread");
+    sub->add_option("--report", sweep_opts.report, "write every point's report as JSON");
+    sub->add_option("--csv", sweep_opts.csv, "write the table as CSV");
+    sub->callback([&] { status = saarcor::run_sweep(sweep_opts); });
   }
   saarcor::PrecisionOptions precision_opts;
   {
