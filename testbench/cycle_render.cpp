@@ -112,6 +112,17 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
                                          {"requests", c.requests[k]}};
   }
   j["units"] = units;
+  // Per DynRTP (one in the prototype): the packets the RGC handed it, its units' usage.
+  nlohmann::json pipes = nlohmann::json::array();
+  for (const units::CycleFrame::PipelineCount& pc : c.per_pipeline) {
+    nlohmann::json e;
+    e["packets"] = pc.packets;
+    for (int i = 0; i < units::kTable4Units; ++i)
+      e["usage"][units::kTable4UnitNames[i]] =
+          100.0 * per(pc.issue_cycles[static_cast<std::size_t>(i)], c.cycles);
+    pipes.push_back(e);
+  }
+  j["pipelines"] = pipes;
   nlohmann::json caches;
   for (int i = 0; i < units::kCacheUnits; ++i) {
     const auto& cc = c.caches[static_cast<std::size_t>(i)];
@@ -208,6 +219,13 @@ std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
                 per(c.per_ray_sum.mailbox_skips, c.rays), per(c.per_ray_sum.intersections, c.rays),
                 c.simd_efficiency, per(u.traversal_ops.total(), u.intersection_ops.total()));
   s += buf;
+  if (c.per_pipeline.size() > 1) {
+    s += std::to_string(c.per_pipeline.size()) +
+         " DynRTPs (usage: the mean over them; the paper's row is one DynRTP), packets each:";
+    for (const units::CycleFrame::PipelineCount& pc : c.per_pipeline)
+      s += " " + std::to_string(pc.packets);
+    s += "\n";
+  }
   return s;
 }
 

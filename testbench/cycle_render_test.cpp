@@ -85,6 +85,36 @@ TEST(CycleRender, ReportVcdAndTable) {
   fs::remove_all(d);
 }
 
+// --preset standard: four DynRTPs; the report lists each with its packets and usage, the
+// top-level usage is their mean, the printout says how the packets spread.
+TEST(CycleRender, StandardPresetReportsEveryPipeline) {
+  const fs::path d = temp_dir();
+  RenderOptions o;
+  o.scene = "builtin:room";
+  o.model = "cycle";
+  o.res = "32x24";
+  o.out = (d / "std").string();
+  o.report = (d / "std.json").string();
+  o.cycle.preset = "standard";
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(run_render(o), 0);
+  const std::string out = testing::internal::GetCapturedStdout();
+  EXPECT_NE(out.find("4 DynRTPs (usage: the mean over them"), std::string::npos) << out;
+  const auto j = nlohmann::json::parse(read(d / "std.json"));
+  EXPECT_EQ(j["configuration"]["cycle"]["pipelines"]["value"].get<int>(), 4);
+  ASSERT_EQ(j["pipelines"].size(), 4u);
+  double packets = 0, traversal = 0;
+  for (const auto& p : j["pipelines"]) {
+    EXPECT_GT(p["packets"].get<double>(), 0.0);
+    packets += p["packets"].get<double>();
+    traversal += p["usage"]["traversal"].get<double>();
+  }
+  EXPECT_EQ(packets, j["packets"].get<double>());
+  EXPECT_NEAR(traversal / 4, j["usage"]["traversal"].get<double>(), 1e-9);
+  EXPECT_TRUE(j["stats"].contains("dynrtp3.node_cache.hit_rate_with_merges"));
+  fs::remove_all(d);
+}
+
 TEST(CycleRender, HitsEqualTheFp24Model) {
   RenderSettings s;
   s.res = {24, 16};

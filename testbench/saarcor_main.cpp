@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
     sub->add_option("--bank-mb", render_opts.bank_mb, "SRAM bank size in MB")
         ->capture_default_str();
     // --model cycle (testbench/cycle_render.h)
-    sub->add_option("--preset", render_opts.cycle.preset, "cycle model preset (prototype, table2)")
+    sub->add_option("--preset", render_opts.cycle.preset, "cycle model preset (prototype, table2, standard)")
         ->capture_default_str();
     sub->add_option("--set", render_opts.cycle.set,
                     "cycle model parameter KEY=VALUE (repeatable; docs/cycle-model.md)");
@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
     sub->add_flag("--shadows", sweep_opts.shadows, "shadow rays");
     sub->add_option("--depth", sweep_opts.depth, "secondary-ray depth (0 = primary only)");
     sub->add_option("--bank-mb", sweep_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
-    sub->add_option("--preset", sweep_opts.preset, "cycle model preset (prototype, table2)")
+    sub->add_option("--preset", sweep_opts.preset, "cycle model preset (prototype, table2, standard)")
         ->capture_default_str();
     sub->add_option("--set", sweep_opts.set, "cycle model parameter KEY=VALUE for every point");
     sub->add_option("--host-threads", sweep_opts.host_threads,

@@ -22,6 +22,11 @@ struct Binding {
 
 const std::vector<Binding>& bindings() {
   static const std::vector<Binding> table = {
+      {{"pipelines", 1, "DynRTPs",
+        "dynamic ray tracing pipelines sharing the memory controller; the RGC grants them packets "
+        "round robin, one pipeline per cycle (D44)",
+        1, 16, false},
+       SAARCOR_FIELD(pipelines, int)},
       {{"threads", 64, "threads", "threads (packets in flight) per DynRTP (D24)", 1, 4096, false},
        SAARCOR_FIELD(threads, int)},
       {{"packet", 4, "rays", "rays per packet, a power of two (D24)", 1, 64, true},
@@ -81,6 +86,10 @@ const std::vector<Preset>& presets() {
   static const std::vector<Preset> p = {
       {"prototype", "the paper's FPGA prototype (Table 4): 64 threads, 4-ray packets, 90 MHz", {}},
       {"table2", "Table 2's counted configuration: 32 threads", {{"threads", "32"}}},
+      {"standard",
+       "the 'standard' SaarCOR configuration the paper simulated (section 5): four DynRTPs of the "
+       "prototype's",
+       {{"pipelines", "4"}}},
   };
   return p;
 }
@@ -182,6 +191,12 @@ void check_cycle_params(const CycleParams& p) {
                                ".items=" + std::to_string(cc.items));
   }
   if (p.threads < 1) throw std::runtime_error("bad threads=" + std::to_string(p.threads));
+  if (p.pipelines < 1) throw std::runtime_error("bad pipelines=" + std::to_string(p.pipelines));
+  if (p.pipelines * p.threads > kMaxChipThreads)
+    throw std::runtime_error("bad pipelines=" + std::to_string(p.pipelines) +
+                             " with threads=" + std::to_string(p.threads) + ": " +
+                             std::to_string(p.pipelines * p.threads) + " threads in all, at most " +
+                             std::to_string(kMaxChipThreads));
 }
 
 std::vector<CycleParamInfo> describe(const CycleParams& params) {

@@ -20,6 +20,7 @@ inline const char* cache_unit_name(CacheUnit c) {
 }
 
 struct CycleParams {
+  int pipelines = 0;          // DynRTPs sharing the memory controller (D44)
   int threads = 0;            // threads per DynRTP (D24)
   int packet = 0;             // rays per packet
   int stack = 0;              // traversal stack entries per packet (D26)
@@ -64,7 +65,9 @@ CycleParams cycle_preset(const std::string& name);
 // Applies "KEY=VALUE"; throws std::runtime_error naming the key for an unknown key, a value that
 // is not a number, or one out of range.
 void apply_cycle_setting(CycleParams& params, const std::string& key_value);
-// Cross-parameter checks (cache ways divide items); throws naming the key.
+// Threads of all DynRTPs together at most (pipelines x threads).
+inline constexpr int kMaxChipThreads = 4096;
+// Cross-parameter checks (cache ways divide items, pipelines x threads); throws naming the key.
 void check_cycle_params(const CycleParams& params);
 // The resolved configuration: every parameter with its current value.
 std::vector<CycleParamInfo> describe(const CycleParams& params);

@@ -57,34 +57,85 @@ TEST(DynRtc, SceneCasesCoverEveryBuiltinAndModel) {
   EXPECT_EQ(scene_cases().size(), 27u);  // 6 built-ins + 21 glTF files (MANIFEST glTF table)
 }
 
-// Idle skipping and the evaluation order of modules change no figure.
+// The evaluation order of modules changes no figure; with several DynRTPs too (the RGC's packet
+// count is shared by the pipelines' ray sources).
 TEST(DynRtc, EvaluationOrderChangesNothing) {
   const host::BuiltImage b = build("builtin:room", 32, 24);
-  const CycleParams p = prototype_params();
-  const CycleFrame a = run_cycle(b.image, p);
-  CycleRunOptions o;
-  o.shuffle_seed = 99;
-  const CycleFrame c = run_cycle(b.image, p, o);
-  EXPECT_EQ(a.cycles, c.cycles);
-  EXPECT_EQ(a.issue_cycles, c.issue_cycles);
-  EXPECT_EQ(a.stats_json, c.stats_json);
+  for (const int pipelines : {1, 3}) {
+    CycleParams p = prototype_params();
+    p.pipelines = pipelines;
+    p.threads = 64 / pipelines;
+    const CycleFrame a = run_cycle(b.image, p);
+    for (const std::uint64_t seed : {99u, 5u}) {
+      CycleRunOptions o;
+      o.shuffle_seed = seed;
+      const CycleFrame c = run_cycle(b.image, p, o);
+      EXPECT_EQ(a.cycles, c.cycles) << pipelines;
+      EXPECT_EQ(a.issue_cycles, c.issue_cycles) << pipelines;
+      EXPECT_EQ(a.stats_json, c.stats_json) << pipelines;
+    }
+  }
 }
 
 // The units' next_wakeup() is exact: skipping idle cycles (many with one thread and slow memory)
 // gives the same cycles and statistics as evaluating every cycle.
 TEST(DynRtc, IdleSkipChangesNothing) {
   const host::BuiltImage b = build("builtin:room", 16, 12);
-  CycleParams p = prototype_params();
-  p.threads = 2;
-  p.mem_latency = 30;
-  CycleRunOptions every;
-  every.idle_skip = false;
-  const CycleFrame a = run_cycle(b.image, p);
-  const CycleFrame c = run_cycle(b.image, p, every);
-  EXPECT_GT(a.skipped_cycles, 0u);
-  EXPECT_EQ(c.skipped_cycles, 0u);
-  EXPECT_EQ(a.cycles, c.cycles);
-  EXPECT_EQ(a.stats_json, c.stats_json);
+  // With three DynRTPs a ray source with a free thread sleeps until the RGC's next grant.
+  for (const int pipelines : {1, 3}) {
+    CycleParams p = prototype_params();
+    p.pipelines = pipelines;
+    p.threads = 2;
+    p.mem_latency = 30;
+    CycleRunOptions every;
+    every.idle_skip = false;
+    const CycleFrame a = run_cycle(b.image, p);
+    const CycleFrame c = run_cycle(b.image, p, every);
+    EXPECT_GT(a.skipped_cycles, 0u) << pipelines;
+    EXPECT_EQ(c.skipped_cycles, 0u) << pipelines;
+    EXPECT_EQ(a.cycles, c.cycles) << pipelines;
+    EXPECT_EQ(a.stats_json, c.stats_json) << pipelines;
+  }
+}
+
+// Several DynRTPs (D44): the RGC spreads the packets over the pipelines on demand, each pipeline
+// reads through its own caches, the results stay the functional model's, and the frame takes
+// fewer cycles; usage is per unit (averaged over the pipelines).
+TEST(DynRtc, PipelinesShareTheFrame) {
+  const host::BuiltImage b = build("builtin:room", 64, 48);
+  testing::Config four{"t16x4", {"pipelines=4", "threads=16"}};
+  testing::expect_bit_exact(b, four, "room [t16x4]");
+  CycleParams one = prototype_params();
+  one.threads = 16;
+  CycleParams p = one;
+  p.pipelines = 4;
+  const CycleFrame a = run_cycle(b.image, one);
+  const CycleFrame c = run_cycle(b.image, p);
+  ASSERT_EQ(a.per_pipeline.size(), 1u);
+  EXPECT_EQ(a.per_pipeline[0].packets, a.packets);
+  ASSERT_EQ(c.per_pipeline.size(), 4u);
+  std::uint64_t packets = 0;
+  std::array<std::uint64_t, kTable4Units> issued{};
+  for (const CycleFrame::PipelineCount& pc : c.per_pipeline) {
+    // On demand: no pipeline gets less than half its share.
+    EXPECT_GE(pc.packets, c.packets / 8) << c.stats_json;
+    packets += pc.packets;
+    for (std::size_t u = 0; u < issued.size(); ++u)
+      issued[u] += pc.issue_cycles[u];
+  }
+  EXPECT_EQ(packets, c.packets);
+  EXPECT_EQ(issued, c.issue_cycles);
+  // The same work in all: steps issued per unit equal the one-pipeline run's.
+  EXPECT_EQ(c.issue_cycles, a.issue_cycles);
+  // More than twice as fast (2.2x on this small frame, 3.7x at 256x192: the tail of the frame,
+  // when fewer packets than threads are left, is the same length with four pipelines).
+  EXPECT_LT(c.cycles * 2, a.cycles) << a.cycles << " vs " << c.cycles;
+  EXPECT_NEAR(
+      c.figures.usage[0],
+      100.0 * static_cast<double>(c.issue_cycles[0]) / (4.0 * static_cast<double>(c.cycles)), 1e-9);
+  // Every pipeline's caches and ports are in the statistics.
+  EXPECT_NE(c.stats_json.find("dynrtp3.traversal"), std::string::npos);
+  EXPECT_NE(c.stats_json.find("dynrtp3.rgs.packets_admitted"), std::string::npos);
 }
 
 // The thread programs on a second host thread ahead of the simulation (the default on a
@@ -238,6 +289,9 @@ TEST(DynRtc, ParametersPresetsAndBadSettings) {
   EXPECT_EQ(p.transformation_depth(), 9);
   EXPECT_EQ(p.intersection_depth(), 18);
   EXPECT_EQ(cycle_preset("table2").threads, 32);
+  EXPECT_EQ(p.pipelines, 1);
+  EXPECT_EQ(cycle_preset("standard").pipelines, 4);
+  EXPECT_EQ(cycle_preset("standard").threads, 64);
   CycleParams q = p;
   apply_cycle_setting(q, "cache.list.ways=4");
   apply_cycle_setting(q, "clock_mhz=120.5");
@@ -269,6 +323,20 @@ TEST(DynRtc, ParametersPresetsAndBadSettings) {
   fails("cache.bogus.items=8", "unknown --set key 'cache.bogus.items'");
   fails("threads", "KEY=VALUE");
   fails("=4", "KEY=VALUE");
+  fails("pipelines=0", "pipelines");
+  fails("pipelines=17", "pipelines");
+  // 16 DynRTPs of the prototype's 64 threads: 1024 threads in all, accepted; 128 each: too many.
+  CycleParams many = prototype_params();
+  apply_cycle_setting(many, "pipelines=16");
+  check_cycle_params(many);
+  apply_cycle_setting(many, "threads=512");
+  try {
+    check_cycle_params(many);
+    ADD_FAILURE() << "16 x 512 threads accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "bad pipelines=16 with threads=512: 8192 threads in all, at most 4096");
+  }
   try {
     cycle_preset("asic");
     ADD_FAILURE() << "preset asic accepted";

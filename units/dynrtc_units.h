@@ -53,17 +53,60 @@ class IntersectionUnit : public CycleUnit {
   Fetch fetch(const Request& r) const override;
 };
 
-// Ray source and hit sink (path g in, a out): the RGC hands a new primary packet to a free thread,
-// one per cycle, only while a thread is free; returning packets run their RGS phases one per cycle
-// (shading proper and its memory traffic come with the RGS issue) and free their thread.
+// The ray generation controller (paper section 3: it "schedules screen-space pixels", the dynamic
+// load balancing between DynRTPs): the frame's packets in order, to whichever pipeline asks for
+// one in a cycle it is granted. The grant goes round robin, one pipeline per cycle (D44; with one
+// pipeline every cycle is granted, as in the prototype), so a cycle hands out at most one packet
+// and only the granted pipeline changes the count: what every pipeline sees does not depend on
+// the order the kernel evaluates them in.
+class RayGenerationController {
+ public:
+  RayGenerationController(int packets, int pipelines) : packets_(packets), pipelines_(pipelines) {}
+
+  bool granted(int pipeline, std::uint64_t cycle) const {
+    return pipelines_ == 1 ||  // (no division on the prototype's path)
+           cycle % static_cast<std::uint64_t>(pipelines_) == static_cast<std::uint64_t>(pipeline);
+  }
+  // The first cycle after `now` granted to `pipeline`.
+  std::uint64_t next_grant(int pipeline, std::uint64_t now) const {
+    if (pipelines_ == 1) return now + 1;
+    const auto n = static_cast<std::uint64_t>(pipelines_);
+    const std::uint64_t c = now + 1;
+    return c + (static_cast<std::uint64_t>(pipeline) + n - c % n) % n;
+  }
+  // Whether packets are left as `pipeline` sees them in cycle `now`: the granted pipeline sees
+  // its own hand-out at once, the others the count the cycle began with.
+  bool packets_left(int pipeline, std::uint64_t now) const {
+    const int handed = granted(pipeline, now) || taken_at_ != now ? next_ : next_ - 1;
+    return handed < packets_;
+  }
+  int take(std::uint64_t now) {
+    taken_at_ = now;
+    return next_++;
+  }
+  bool all_handed_out() const { return next_ == packets_; }
+  int packets() const { return packets_; }
+
+ private:
+  int packets_;
+  int pipelines_;
+  int next_ = 0;
+  std::uint64_t taken_at_ = hw::kNever;
+};
+
+// Ray source and hit sink of one DynRTP (path g in, a out): in a cycle the RGC grants it, a new
+// primary packet goes to a free thread of this pipeline; returning packets run their RGS phases
+// one per cycle (shading proper and its memory traffic come with the RGS issue) and free their
+// thread. The pipeline's threads are `count` consecutive ids from `first` in the shared table.
 class RaySource : public CycleUnit {
  public:
-  RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth);
+  RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
+            RayGenerationController& rgc, int pipeline, ThreadToken first, int count);
 
-  // (Checked before every cycle: no call.)
-  bool finished() const { return next_packet_ == packets_ && free_ == threads_.size(); }
-  int packets_started() const { return next_packet_; }
+  // Every thread of this pipeline free (checked between cycles).
+  bool idle() const { return free_ == count_; }
   std::uint64_t packets_retired() const { return retired_->value; }
+  std::uint64_t packets_admitted() const { return admitted_->value; }
 
  protected:
   Fetch fetch(const Request& r) const override;
@@ -73,10 +116,11 @@ class RaySource : public CycleUnit {
   std::uint64_t extra_wakeup(std::uint64_t now) const override;
 
  private:
+  RayGenerationController& rgc_;
+  int pipeline_;
+  int count_;
   Ring<ThreadToken> free_list_;
   int free_;
-  int packets_;
-  int next_packet_ = 0;
   hw::Counter* retired_;
   hw::Counter* admitted_;
 };

@@ -350,26 +350,29 @@ double percent(std::uint64_t a, std::uint64_t b) {
   return b == 0 ? 0.0 : 100.0 * static_cast<double>(a) / static_cast<double>(b);
 }
 
-// The DynRTP: units and paths around a thread table, over one memory system.
+// One DynRTP: its units and the paths a-g between them, over its pipeline's caches in the shared
+// memory system; its threads are ids [pipeline x threads, (pipeline + 1) x threads) of the table.
 class DynRtp {
  public:
-  DynRtp(hw::Kernel& k, memif::MemoryImage& image, const CycleParams& p, ThreadTable& threads)
-      : mi_(k, image, memory_config(p)) {
-    const std::string pre = "dynrtp0.";
-    rgs_ = &k.make<RaySource>(pre + "rgs", threads, 1);
+  DynRtp(hw::Kernel& k, memif::MemorySystem& mi, const CycleParams& p, ThreadTable& threads,
+         RayGenerationController& rgc, int pipeline) {
+    const std::string pre = "dynrtp" + std::to_string(pipeline) + ".";
+    rgs_ = &k.make<RaySource>(pre + "rgs", threads, 1, rgc, pipeline,
+                              static_cast<ThreadToken>(pipeline * p.threads), p.threads);
     units_[unit_index(UnitId::kRgs)] = rgs_;
-    units_[unit_index(UnitId::kTraversal)] = &k.make<TraversalUnit>(
-        pre + "traversal", threads, p.traversal_depth(), mi_.cache(0, memif::ItemType::kNode));
-    units_[unit_index(UnitId::kList)] = &k.make<ListUnit>(pre + "list", threads, p.list_depth(),
-                                                          mi_.cache(0, memif::ItemType::kList));
+    units_[unit_index(UnitId::kTraversal)] =
+        &k.make<TraversalUnit>(pre + "traversal", threads, p.traversal_depth(),
+                               mi.cache(pipeline, memif::ItemType::kNode));
+    units_[unit_index(UnitId::kList)] = &k.make<ListUnit>(
+        pre + "list", threads, p.list_depth(), mi.cache(pipeline, memif::ItemType::kList));
     units_[unit_index(UnitId::kTransformation)] =
         &k.make<TransformationUnit>(pre + "transformation", threads, p.transformation_depth(),
-                                    mi_.cache(0, memif::ItemType::kRow));
+                                    mi.cache(pipeline, memif::ItemType::kRow));
     units_[unit_index(UnitId::kIntersection)] =
         &k.make<IntersectionUnit>(pre + "intersection", threads, p.intersection_depth());
-    // Thread-id queues hold every thread: a full path can never hold a unit (deadlock freedom
-    // by construction); the priorities of D25 decide only the order.
-    const int capacity = threads.size() + 1;
+    // Thread-id queues hold every thread of the pipeline: a full path can never hold a unit
+    // (deadlock freedom by construction); the priorities of D25 decide only the order.
+    const int capacity = p.threads + 1;
     for (int from = 0; from < kUnitCount; ++from)
       for (int to = 0; to < kUnitCount; ++to) {
         const auto f = static_cast<UnitId>(from), t = static_cast<UnitId>(to);
@@ -381,8 +384,28 @@ class DynRtp {
         units_[to]->add_input(paths_[unit_index(from)][to]);
   }
 
+  RaySource& rgs() { return *rgs_; }
+  const RaySource& rgs() const { return *rgs_; }
+  CycleUnit& unit(UnitId u) { return *units_[unit_index(u)]; }
+
+ private:
+  RaySource* rgs_ = nullptr;
+  std::array<CycleUnit*, kUnitCount> units_{};
+  std::array<std::array<ThreadPath*, kUnitCount>, kUnitCount> paths_{};
+};
+
+// The chip of Figure 2: the RGC, `pipelines` DynRTPs and the memory interface they share.
+class Chip {
+ public:
+  Chip(hw::Kernel& k, memif::MemoryImage& image, const CycleParams& p, ThreadTable& threads)
+      : mi_(k, image, memory_config(p)), rgc_(threads.packets(), p.pipelines) {
+    for (int i = 0; i < p.pipelines; ++i)
+      pipes_.push_back(std::make_unique<DynRtp>(k, mi_, p, threads, rgc_, i));
+  }
+
   static memif::MemorySystemConfig memory_config(const CycleParams& p) {
     memif::MemorySystemConfig mc;
+    mc.pipelines = p.pipelines;
     mc.node_cache = cache_config(p, CacheUnit::kTraversal);
     mc.list_cache = cache_config(p, CacheUnit::kList);
     mc.row_cache = cache_config(p, CacheUnit::kTransformation);
@@ -393,15 +416,27 @@ class DynRtp {
     return mc;
   }
 
-  RaySource& rgs() { return *rgs_; }
-  CycleUnit& unit(UnitId u) { return *units_[unit_index(u)]; }
+  // Every packet handed out and every thread free again (checked between cycles).
+  bool finished() const {
+    if (!rgc_.all_handed_out()) return false;
+    for (const auto& d : pipes_)
+      if (!d->rgs().idle()) return false;
+    return true;
+  }
+  std::uint64_t packets_retired() const {
+    std::uint64_t n = 0;
+    for (const auto& d : pipes_)
+      n += d->rgs().packets_retired();
+    return n;
+  }
+  int pipelines() const { return static_cast<int>(pipes_.size()); }
+  DynRtp& pipeline(int i) { return *pipes_[static_cast<std::size_t>(i)]; }
   memif::MemorySystem& memory() { return mi_; }
 
  private:
   memif::MemorySystem mi_;
-  RaySource* rgs_ = nullptr;
-  std::array<CycleUnit*, kUnitCount> units_{};
-  std::array<std::array<ThreadPath*, kUnitCount>, kUnitCount> paths_{};
+  RayGenerationController rgc_;
+  std::vector<std::unique_ptr<DynRtp>> pipes_;
 };
 
 // Cumulative counts the figures are computed from.
@@ -410,21 +445,28 @@ struct Snapshot {
   std::array<std::uint64_t, kTable4Units> issued{};
   std::array<std::uint64_t, kCacheUnits> requests{}, hits{}, bytes{};
   std::uint64_t shading_bytes = 0;
+  int pipelines = 1;  // usage is per unit: issue cycles over cycles x pipelines
 };
 
-Snapshot snapshot(hw::Kernel& k, DynRtp& d) {
+Snapshot snapshot(hw::Kernel& k, Chip& chip) {
   Snapshot s;
   s.cycle = k.now();
-  for (int i = 0; i < kTable4Units; ++i)
-    s.issued[static_cast<std::size_t>(i)] = d.unit(kTable4Unit[i]).issue_cycles();
-  for (int c = 0; c < kCacheUnits; ++c) {
-    const memif::Cache& cache = d.memory().cache(0, kCacheItem[c]);
-    s.requests[static_cast<std::size_t>(c)] = cache.requests_count();
-    s.hits[static_cast<std::size_t>(c)] = cache.hits() + cache.merges();
-    s.bytes[static_cast<std::size_t>(c)] = k.stats().get_counter(cache.name() + ".mem_bytes").value;
+  s.pipelines = chip.pipelines();
+  for (int p = 0; p < chip.pipelines(); ++p) {
+    DynRtp& d = chip.pipeline(p);
+    for (int i = 0; i < kTable4Units; ++i)
+      s.issued[static_cast<std::size_t>(i)] += d.unit(kTable4Unit[i]).issue_cycles();
+    for (int c = 0; c < kCacheUnits; ++c) {
+      const memif::Cache& cache = chip.memory().cache(p, kCacheItem[c]);
+      s.requests[static_cast<std::size_t>(c)] += cache.requests_count();
+      s.hits[static_cast<std::size_t>(c)] += cache.hits() + cache.merges();
+      s.bytes[static_cast<std::size_t>(c)] +=
+          k.stats().get_counter(cache.name() + ".mem_bytes").value;
+    }
+    const std::string pre = "dynrtp" + std::to_string(p) + ".";
+    s.shading_bytes += k.stats().get_counter(pre + "shading.mem_bytes").value +
+                       k.stats().get_counter(pre + "frame.mem_bytes").value;
   }
-  s.shading_bytes = k.stats().get_counter("dynrtp0.shading.mem_bytes").value +
-                    k.stats().get_counter("dynrtp0.frame.mem_bytes").value;
   return s;
 }
 
@@ -433,7 +475,7 @@ CycleFigures figures(const Snapshot& a, const Snapshot& b, double clock_mhz) {
   f.cycle = b.cycle;
   const std::uint64_t n = b.cycle - a.cycle;
   for (std::size_t i = 0; i < kTable4Units; ++i)
-    f.usage[i] = percent(b.issued[i] - a.issued[i], n);
+    f.usage[i] = percent(b.issued[i] - a.issued[i], n * static_cast<std::uint64_t>(b.pipelines));
   std::uint64_t dyn = 0;
   for (std::size_t c = 0; c < kCacheUnits; ++c) {
     const std::uint64_t req = b.requests[c] - a.requests[c];
@@ -476,21 +518,21 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
     throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
                              std::to_string(opt.ahead_packets) + ")");
-  Threads<F, kLanes> threads(image, fp, p.threads, opt.programs, opt.ahead_packets);
+  Threads<F, kLanes> threads(image, fp, p.pipelines * p.threads, opt.programs, opt.ahead_packets);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;
   kc.idle_skip = opt.idle_skip;
   hw::Kernel k(kc);
-  DynRtp dyn(k, image, p, threads);
+  Chip chip(k, image, p, threads);
   if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
 
   CycleFrame out;
   out.params = p;
   out.packets = static_cast<std::uint64_t>(threads.packets());
-  const auto done = [&] { return dyn.rgs().finished(); };
+  const auto done = [&] { return chip.finished(); };
   const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
-  Snapshot start = snapshot(k, dyn), last = start;
+  Snapshot start = snapshot(k, chip), last = start;
   while (!done()) {
     std::uint64_t budget = chunk;
     if (opt.max_cycles != 0) {
@@ -505,41 +547,50 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
                                ": no progress for " + std::to_string(p.watchdog) + " cycles\n" +
                                thread_report(threads) + "\n" + r.report);
     if (opt.interval != 0) {
-      const Snapshot now = snapshot(k, dyn);
+      const Snapshot now = snapshot(k, chip);
       if (now.cycle > last.cycle) out.series.push_back(figures(last, now, p.clock_mhz));
       last = now;
     }
     if (opt.progress)
-      opt.progress(k.now(), static_cast<int>(dyn.rgs().packets_retired()), threads.packets());
+      opt.progress(k.now(), static_cast<int>(chip.packets_retired()), threads.packets());
   }
   if (opt.vcd != nullptr) k.finish_trace();
-  const Snapshot end = snapshot(k, dyn);
+  const Snapshot end = snapshot(k, chip);
 
   threads.finish();
   collect(out.frame, threads);
   out.cycles = k.now();
   out.figures = figures(start, end, p.clock_mhz);
-  for (int i = 0; i < kTable4Units; ++i) {
-    CycleUnit& u = dyn.unit(kTable4Unit[i]);
-    out.issue_cycles[static_cast<std::size_t>(i)] = u.issue_cycles();
-    out.stall_cycles[static_cast<std::size_t>(i)] =
-        k.stats().get_counter(u.name() + ".stall_cycles").value;
-    out.requests[static_cast<std::size_t>(i)] = u.requests_served();
+  std::uint64_t served = 0;
+  out.per_pipeline.resize(static_cast<std::size_t>(chip.pipelines()));
+  for (int pi = 0; pi < chip.pipelines(); ++pi) {
+    DynRtp& d = chip.pipeline(pi);
+    CycleFrame::PipelineCount& pc = out.per_pipeline[static_cast<std::size_t>(pi)];
+    pc.packets = d.rgs().packets_admitted();
+    served += d.rgs().requests_served();
+    for (int i = 0; i < kTable4Units; ++i) {
+      const auto ui = static_cast<std::size_t>(i);
+      CycleUnit& u = d.unit(kTable4Unit[i]);
+      pc.issue_cycles[ui] = u.issue_cycles();
+      out.issue_cycles[ui] += u.issue_cycles();
+      out.stall_cycles[ui] += k.stats().get_counter(u.name() + ".stall_cycles").value;
+      out.requests[ui] += u.requests_served();
+    }
+    for (int c = 0; c < kCacheUnits; ++c) {
+      const memif::Cache& cache = chip.memory().cache(pi, kCacheItem[c]);
+      auto& cc = out.caches[static_cast<std::size_t>(c)];
+      cc.requests += cache.requests_count();
+      cc.hits += cache.hits();
+      cc.misses += cache.misses();
+      cc.merges += cache.merges();
+    }
   }
-  std::uint64_t served = dyn.rgs().requests_served();
   for (std::uint64_t r : out.requests)
     served += r;
   out.frame.units.requests = served;
   out.frame.units.packets = out.packets;
-  for (int c = 0; c < kCacheUnits; ++c) {
-    const memif::Cache& cache = dyn.memory().cache(0, kCacheItem[c]);
-    auto& cc = out.caches[static_cast<std::size_t>(c)];
-    cc.requests = cache.requests_count();
-    cc.hits = cache.hits();
-    cc.misses = cache.misses();
-    cc.merges = cache.merges();
-    cc.mem_bytes = end.bytes[static_cast<std::size_t>(c)];
-  }
+  for (int c = 0; c < kCacheUnits; ++c)
+    out.caches[static_cast<std::size_t>(c)].mem_bytes = end.bytes[static_cast<std::size_t>(c)];
   for (int kd = 0; kd < kRayKinds; ++kd) {
     out.rays += out.frame.rays_issued[static_cast<std::size_t>(kd)];
     out.per_ray_sum += out.frame.by_kind[static_cast<std::size_t>(kd)];
@@ -551,7 +602,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   out.simd_efficiency = steps == 0 ? 0.0
                                    : static_cast<double>(out.per_ray_sum.traversal_steps) /
                                          static_cast<double>(steps) / p.packet;
-  out.packets_retired = dyn.rgs().packets_retired();
+  out.packets_retired = chip.packets_retired();
   out.skipped_cycles = k.skipped_cycles();
   out.host_threads = opt.programs == ProgramMode::kAhead ? 2 : 1;
   out.programs = opt.programs;

@@ -1,8 +1,9 @@
-// The cycle model of one DynRTP (paper section 3.1, Figure 2; DESIGN.md sections 5, 6 and 9 model
+// The cycle model of the DynRTP (paper section 3.1, Figure 2; DESIGN.md sections 5, 6 and 9 model
 // 3): the traversal, mailboxed list, transformation and intersection units, the ray source and
-// hit sink, the thread table and the memory interface, clocked by the hw/ kernel. Bit-identical
-// to the functional fp24 model by construction (the same thread program per thread, executed in
-// the same per-thread order); the timing gives the paper's Table 4 figures.
+// hit sink, the thread table and the memory interface, clocked by the hw/ kernel; one DynRTP as
+// in the prototype, or several sharing the memory controller and fed by one RGC (D44).
+// Bit-identical to the functional fp24 model by construction (the same thread program per thread,
+// executed in the same per-thread order); the timing gives the paper's Table 4 figures.
 #pragma once
 
 #include <array>
@@ -72,6 +73,12 @@ struct CycleFrame {
     std::uint64_t requests = 0, hits = 0, misses = 0, merges = 0, mem_bytes = 0;
   };
   std::array<CacheCount, kCacheUnits> caches{};
+  // Per DynRTP: the packets the RGC handed it and its units' issue cycles (the load balance).
+  struct PipelineCount {
+    std::uint64_t packets = 0;
+    std::array<std::uint64_t, kTable4Units> issue_cycles{};
+  };
+  std::vector<PipelineCount> per_pipeline;
   RayCounters per_ray_sum;     // all kinds
   double simd_efficiency = 0;  // active rays per traversal packet step / P
   std::uint64_t packets = 0, packets_retired = 0;

@@ -5,14 +5,17 @@
 
 namespace saarcor::units {
 
-RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth)
+RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
+                     RayGenerationController& rgc, int pipeline, ThreadToken first, int count)
     : CycleUnit(k, std::move(name), UnitId::kRgs, t, depth, nullptr),
-      free_list_(t.size()),
-      free_(t.size()),
-      packets_(t.packets()) {
+      rgc_(rgc),
+      pipeline_(pipeline),
+      count_(count),
+      free_list_(count),
+      free_(count) {
   has_extra_ = true;
-  for (int i = 0; i < t.size(); ++i)
-    free_list_.push_back(static_cast<ThreadToken>(i));
+  for (int i = 0; i < count; ++i)
+    free_list_.push_back(first + static_cast<ThreadToken>(i));
   retired_ = &stats().counter(this->name() + ".packets_retired", "packets",
                               "primary packets whose thread was freed");
   admitted_ = &stats().counter(this->name() + ".packets_admitted", "packets",
@@ -33,22 +36,25 @@ void RaySource::retire(ThreadToken thread) {
   ++*retired_;
 }
 
-// Admission: the next primary packet goes to the oldest free thread, on path a.
+// Admission: in a cycle the RGC grants this pipeline, the next primary packet goes to the oldest
+// free thread, on path a.
 int RaySource::extra() {
-  if (free_list_.empty() || next_packet_ >= packets_) return 0;
+  if (free_list_.empty() || !rgc_.granted(pipeline_, now()) || !rgc_.packets_left(pipeline_, now()))
+    return 0;
   ThreadPath* a = outputs_[unit_index(UnitId::kTransformation)];
   if (!a->can_push()) return 0;
   const ThreadToken t = free_list_.front();
   free_list_.pop_front();
   --free_;
-  threads_.start_primary(t, next_packet_++);
+  threads_.start_primary(t, rgc_.take(now()));
   a->push(t);
   ++*admitted_;
   return 1;
 }
 
 std::uint64_t RaySource::extra_wakeup(std::uint64_t now) const {
-  return free_list_.empty() || next_packet_ >= packets_ ? hw::kNever : now + 1;
+  if (free_list_.empty() || !rgc_.packets_left(pipeline_, now)) return hw::kNever;
+  return rgc_.next_grant(pipeline_, now);
 }
 
 }  // namespace saarcor::units
