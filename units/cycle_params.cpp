@@ -60,6 +60,11 @@ const std::vector<Binding>& bindings() {
       {{"mem.switch_penalty", 1, "cycles", "bank switch penalty on a shared path (D21)", 0, 100,
         false},
        SAARCOR_FIELD(mem_switch_penalty, int)},
+      {{"mem.scene_paths", 1, "paths",
+        "issue paths over the three scene banks: 1 = one word per cycle from any of them (D21), "
+        "3 = one path per bank",
+        1, 3, false},
+       SAARCOR_FIELD(mem_scene_paths, int)},
       {{"lat.add", 3, "cycles", "fp adder latency (D7)", 1, 64, false},
        SAARCOR_FIELD(lat_add, int)},
       {{"lat.mul", 3, "cycles", "fp multiplier latency (D7)", 1, 64, false},
@@ -191,6 +196,9 @@ void check_cycle_params(const CycleParams& p) {
                                ".items=" + std::to_string(cc.items));
   }
   if (p.threads < 1) throw std::runtime_error("bad threads=" + std::to_string(p.threads));
+  if (p.mem_scene_paths != 1 && p.mem_scene_paths != 3)
+    throw std::runtime_error("bad mem.scene_paths=" + std::to_string(p.mem_scene_paths) +
+                             ": 1 (the banks share one path) or 3 (one path per bank)");
   if (p.pipelines < 1) throw std::runtime_error("bad pipelines=" + std::to_string(p.pipelines));
   if (p.pipelines * p.threads > kMaxChipThreads)
     throw std::runtime_error("bad pipelines=" + std::to_string(p.pipelines) +

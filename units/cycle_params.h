@@ -34,6 +34,7 @@ struct CycleParams {
   int cache_misses = 0;  // outstanding misses per cache (MSHRs)
   int mem_latency = 0;   // SRAM read latency in cycles (D21)
   int mem_switch_penalty = 0;
+  int mem_scene_paths = 0;  // issue paths over the three scene banks: 1 (shared) or 3 (D21)
   int lat_add = 0, lat_mul = 0, lat_div = 0, lat_cmp = 0;  // fp unit latencies (D7)
   double clock_mhz = 0.0;
   std::uint64_t watchdog = 0;  // cycles without progress that stop a run

@@ -133,6 +133,16 @@ TEST(DynRtc, PipelinesShareTheFrame) {
   EXPECT_NEAR(
       c.figures.usage[0],
       100.0 * static_cast<double>(c.issue_cycles[0]) / (4.0 * static_cast<double>(c.cycles)), 1e-9);
+  // Eight DynRTPs wait on the scene banks' one issue path (D21); a path per bank relieves it.
+  CycleParams eight = prototype_params();
+  eight.pipelines = 8;
+  const CycleFrame shared_path = run_cycle(b.image, eight);
+  eight.mem_scene_paths = 3;
+  const CycleFrame three_paths = run_cycle(b.image, eight);
+  EXPECT_LT(three_paths.cycles * 4, shared_path.cycles * 3)
+      << shared_path.cycles << " vs " << three_paths.cycles;  // 24,783 vs 14,678 cycles
+  EXPECT_EQ(three_paths.issue_cycles, shared_path.issue_cycles);
+  EXPECT_NE(three_paths.stats_json.find("mi.ctrl.path5.bank_switches"), std::string::npos);
   // Every pipeline's caches and ports are in the statistics.
   EXPECT_NE(c.stats_json.find("dynrtp3.traversal"), std::string::npos);
   EXPECT_NE(c.stats_json.find("dynrtp3.rgs.packets_admitted"), std::string::npos);
@@ -323,6 +333,8 @@ TEST(DynRtc, ParametersPresetsAndBadSettings) {
   fails("cache.bogus.items=8", "unknown --set key 'cache.bogus.items'");
   fails("threads", "KEY=VALUE");
   fails("=4", "KEY=VALUE");
+  fails("mem.scene_paths=2", "mem.scene_paths=2");
+  fails("mem.scene_paths=4", "mem.scene_paths");
   fails("pipelines=0", "pipelines");
   fails("pipelines=17", "pipelines");
   // 16 DynRTPs of the prototype's 64 threads: 1024 threads in all, accepted; 128 each: too many.

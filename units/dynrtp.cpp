@@ -411,6 +411,7 @@ class Chip {
     mc.row_cache = cache_config(p, CacheUnit::kTransformation);
     mc.controller.latency = p.mem_latency;
     mc.controller.switch_penalty = p.mem_switch_penalty;
+    if (p.mem_scene_paths == 3) mc.controller.bank_path = {0, 1, 2, 3, 4, 5};
     mc.controller.clock_hz = p.clock_mhz * 1e6;
     mc.host.clock_hz = p.clock_mhz * 1e6;
     return mc;
