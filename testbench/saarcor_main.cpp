@@ -14,6 +14,7 @@
 #include "testbench/render_cmd.h"
 #include "testbench/scene_cmd.h"
 #include "testbench/sweep_cmd.h"
+#include "testbench/vectors_cmd.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -87,7 +88,8 @@ int main(int argc, char** argv) {
     sub->add_option("--bank-mb", render_opts.bank_mb, "SRAM bank size in MB")
         ->capture_default_str();
     // --model cycle (testbench/cycle_render.h)
-    sub->add_option("--preset", render_opts.cycle.preset, "cycle model preset (prototype, table2, standard)")
+    sub->add_option("--preset", render_opts.cycle.preset,
+                    "cycle model preset (prototype, table2, standard)")
         ->capture_default_str();
     sub->add_option("--set", render_opts.cycle.set,
                     "cycle model parameter KEY=VALUE (repeatable; docs/cycle-model.md)");
@@ -115,7 +117,8 @@ int main(int argc, char** argv) {
     sub->add_flag("--shadows", sweep_opts.shadows, "shadow rays");
     sub->add_option("--depth", sweep_opts.depth, "secondary-ray depth (0 = primary only)");
     sub->add_option("--bank-mb", sweep_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
-    sub->add_option("--preset", sweep_opts.preset, "cycle model preset (prototype, table2, standard)")
+    sub->add_option("--preset", sweep_opts.preset,
+                    "cycle model preset (prototype, table2, standard)")
         ->capture_default_str();
     sub->add_option("--set", sweep_opts.set, "cycle model parameter KEY=VALUE for every point");
     sub->add_option("--host-threads", sweep_opts.host_threads,
@@ -123,6 +126,25 @@ int main(int argc, char** argv) {
     sub->add_option("--report", sweep_opts.report, "write every point's report as JSON");
     sub->add_option("--csv", sweep_opts.csv, "write the table as CSV");
     sub->callback([&] { status = saarcor::run_sweep(sweep_opts); });
+  }
+  saarcor::VectorsOptions vectors_opts;
+  {
+    auto* sub = app.add_subcommand(
+        "vectors", "unit transaction vectors for RTL verification: write a sample, or --check");
+    sub->add_option("scene", vectors_opts.scene, "glTF file or builtin:NAME (to write vectors)");
+    sub->add_option("--unit", vectors_opts.unit, "traversal | transformation | intersection");
+    sub->add_option("--count", vectors_opts.count, "vectors to keep (a uniform sample)")
+        ->capture_default_str();
+    sub->add_option("--seed", vectors_opts.seed, "sample seed")->capture_default_str();
+    sub->add_option("--res", vectors_opts.res, "resolution WxH of the frame sampled")
+        ->capture_default_str();
+    sub->add_option("--time", vectors_opts.time, "animation time in seconds");
+    sub->add_option("--bank-mb", vectors_opts.bank_mb, "SRAM bank size in MB")
+        ->capture_default_str();
+    sub->add_option("--out", vectors_opts.out, "the vector file to write");
+    sub->add_option("--check", vectors_opts.check,
+                    "check a vector file's outputs against the datapath (exit 2 if any differ)");
+    sub->callback([&] { status = saarcor::run_vectors(vectors_opts); });
   }
   saarcor::PrecisionOptions precision_opts;
   {

@@ -108,13 +108,14 @@ decltype(auto) with_format(const ff::Format& f, Fn&& fn) {
 
 template <class F>
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
-                               const ProgressFn& progress) {
+                               const ProgressFn& progress, UnitTap<F>* tap) {
   const auto t0 = std::chrono::steady_clock::now();
   check_image(image);
   const int w = static_cast<int>(image.registers().width);
   const int h = static_cast<int>(image.registers().height);
   const PacketTiling tiling = packet_tiling(w, h, params.packet);
   PipelineUnits<F> units(params.mode);
+  units.tap = tap;
   FrameSink sink;
   sink.reset(w, h);
   ThreadProgram<F> thread(image, params, units, sink);
@@ -184,9 +185,10 @@ PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& 
   });
 }
 
-#define SAARCOR_INSTANTIATE(E, M)                           \
-  template FunctionalFrame run_functional<ff::Float<E, M>>( \
-      const memif::MemoryImage&, const FunctionalParams&, const ProgressFn&);
+#define SAARCOR_INSTANTIATE(E, M)                                            \
+  template FunctionalFrame run_functional<ff::Float<E, M>>(                  \
+      const memif::MemoryImage&, const FunctionalParams&, const ProgressFn&, \
+      UnitTap<ff::Float<E, M>>*);
 SAARCOR_INSTANTIATE(7, 10)
 SAARCOR_INSTANTIATE(7, 11)
 SAARCOR_INSTANTIATE(7, 12)

@@ -73,9 +73,10 @@ using ProgressFn = std::function<void(int packets_done, int packets_total)>;
 
 // Renders the frame of `image` (FrameRegisters: resolution, camera, lights). F must be the image's
 // format (throws std::runtime_error otherwise). Instantiated for Float<7, 10..23> and Float<8,23>.
+// With `tap`, every unit transaction is also reported to it (units/unit_vectors.h).
 template <class F>
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
-                               const ProgressFn& progress = {});
+                               const ProgressFn& progress = {}, UnitTap<F>* tap = nullptr);
 // The same, choosing F from image.format() (the formats above; others throw).
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
                                const ProgressFn& progress = {});

@@ -138,6 +138,22 @@ struct Request {
   std::uint64_t mask = 0;  // the rays concerned
 };
 
+// Unit transactions as the datapaths see them (units/unit_vectors.h: the vectors an RTL unit is
+// checked against). Null in every model run; the capture sets it on a functional run.
+template <class F>
+class UnitTap {
+ public:
+  virtual ~UnitTap() = default;
+  // One ray's lane of an inner kd-node step (traversal_lane's operands and results).
+  virtual void traversal(F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far,
+                         F near_tf, F far_tn) = 0;
+  // One matrix-vector step of an object or triangle transformation (transform_step).
+  virtual void transformation(const Mat34<F>& m, const Vec3<F>& in, bool translate,
+                              const Vec3<F>& out) = 0;
+  // One ray's unit-triangle intersection (intersect_unit_triangle).
+  virtual void intersection(const Ray<F>& ray, const Candidate<F>& c) = 0;
+};
+
 // The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is
 // DIGEST D10's optional shading helper (cosines: mul, sqrt, div).
 template <class F>
@@ -159,7 +175,8 @@ class PipelineUnits {
   // bulk: every step's op count is fixed by the datapath whatever the mask (D30: a masked lane
   // fires and its result is discarded), so the counts are added where the step is issued.
   RawFp<F> raw;
-  RawFp<F, false> direct;  // without the zero shortcuts: the traversal unit's few zeros
+  RawFp<F, false> direct;     // without the zero shortcuts: the traversal unit's few zeros
+  UnitTap<F>* tap = nullptr;  // unit transaction capture (units/unit_vectors.h)
 
   static void count(ff::OpCounts& c, std::uint64_t add, std::uint64_t mul, std::uint64_t div,
                     std::uint64_t cmp) {
@@ -940,6 +957,15 @@ class ThreadProgram {
       near_tf[s] = value(e.near_tf);
       far_tn[s] = value(e.far_tn);
     }
+    if (u_.tap != nullptr) [[unlikely]]
+      for (std::uint64_t m = active; m != 0; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        const auto s = static_cast<std::size_t>(i);
+        const Lane& l = lane(i);
+        u_.tap->traversal(split, l.current.o[axis], l.current.d[axis], encoding(v_.tn[s]),
+                          encoding(v_.tf[s]), has(near_mask, i), has(far_mask, i),
+                          encoding(near_tf[s]), encoding(far_tn[s]));
+      }
     const std::uint32_t near_child = neg ? node.child_pair + 1 : node.child_pair;
     const std::uint32_t far_child = neg ? node.child_pair : node.child_pair + 1;
     if (far_mask != 0 && near_mask != 0) {
@@ -1085,6 +1111,19 @@ class ThreadProgram {
     transform_masked(
         m, mv, entry_mask_, false, [&](int i) -> const Vec3<F>& { return (lane(i).*in).d; },
         [&](int i) -> Vec3<F>& { return (lane(i).*out).d; });
+    if (u_.tap != nullptr) [[unlikely]]
+      tap_transform(m, in, out);
+  }
+  // The steps as the unit runs them: a shared origin once (lane 0's, which every lane holds),
+  // else each entering lane's origin; each entering lane's direction.
+  void tap_transform(const Mat34<F>& m, Ray<F> Lane::*in, Ray<F> Lane::*out) {
+    if (shared_origin_) u_.tap->transformation(m, (lanes_[0].*in).o, true, (lanes_[0].*out).o);
+    for (int i = 0; i < p_; ++i) {
+      if (!has(entry_mask_, i)) continue;
+      const Lane& l = lane(i);
+      if (!shared_origin_) u_.tap->transformation(m, (l.*in).o, true, (l.*out).o);
+      u_.tap->transformation(m, (l.*in).d, false, (l.*out).d);
+    }
   }
 
   void do_transform_object() {
@@ -1118,6 +1157,8 @@ class ThreadProgram {
       Lane& l = lane(i);
       if (!has(entry_mask_, i)) continue;
       const Candidate<F> c = intersect_unit_triangle(fp, l.tri);
+      if (u_.tap != nullptr) [[unlikely]]
+        u_.tap->intersection(l.tri, c);
       ++l.counters.intersections;
       if (!accepts(c, instance_, triangle_, l.hit)) continue;
       l.hit.t = c.t;

@@ -1,0 +1,45 @@
+// `saarcor vectors`: unit transaction vectors for RTL verification (units/unit_vectors.h,
+// docs/unit-vectors.md). Writes a sample of one unit's transactions from a real frame of the
+// functional fp24 model as a text file, one transaction per line (inputs then outputs, fp24
+// encodings in hex, flags 0/1), or checks such a file, e.g. one an RTL simulation filled in,
+// against the datapath line by line.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "units/unit_vectors.h"
+
+namespace saarcor {
+
+struct VectorsOptions {
+  std::string scene;  // generate: glTF path or builtin:NAME
+  std::string unit;   // traversal | transformation | intersection
+  std::size_t count = 1000;
+  std::uint64_t seed = 1;
+  std::string res = "128x96";
+  double time = 0.0;
+  double bank_mb = 4.0;
+  std::string out;    // generate: the vector file
+  std::string check;  // check this vector file instead of generating
+};
+
+// The file: '#' header lines (the unit, the field names, the source), then one vector per line.
+std::string format_vector_file(units::VectorUnit unit, const units::VectorCapture& capture,
+                               const std::string& source);
+
+struct VectorCheck {
+  units::VectorUnit unit = units::VectorUnit::kTraversal;
+  std::size_t vectors = 0;
+  std::size_t differing = 0;
+  std::vector<std::string> first_differences;  // "line L: field F is X, the datapath gives Y"
+};
+// Checks every line of a vector file's text; throws one line naming the line for a malformed one.
+VectorCheck check_vector_text(const std::string& text);
+
+// Returns 0, or 2 when `--check` finds vectors whose outputs differ from the datapath's (they are
+// listed on stdout); throws std::runtime_error with one line on bad input, before writing anything.
+int run_vectors(const VectorsOptions& opts);
+
+}  // namespace saarcor
