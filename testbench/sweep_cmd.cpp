@@ -18,8 +18,9 @@ namespace {
 // "threads=4 packet=16": a point as the reader wrote it.
 std::string join_settings(const std::vector<std::string>& settings) {
   std::string s;
-  for (const std::string& kv : settings)
+  for (const std::string& kv : settings) {
     s += (s.empty() ? "" : " ") + kv;
+  }
   return s;
 }
 
@@ -30,7 +31,9 @@ SweepAxis parse_sweep_axis(const std::string& text) {
     return std::runtime_error("bad --vary '" + text + "': " + why);
   };
   const auto eq = text.find('=');
-  if (eq == std::string::npos || eq == 0) throw bad("expected KEY=V1,V2,...");
+  if (eq == std::string::npos || eq == 0) {
+    throw bad("expected KEY=V1,V2,...");
+  }
   SweepAxis axis;
   axis.key = text.substr(0, eq);
   std::set<std::string> seen;
@@ -38,10 +41,16 @@ SweepAxis parse_sweep_axis(const std::string& text) {
   while (true) {
     const auto comma = text.find(',', from);
     std::string v = text.substr(from, comma == std::string::npos ? comma : comma - from);
-    if (v.empty()) throw bad("an empty value");
-    if (!seen.insert(v).second) throw bad("the value " + v + " twice");
+    if (v.empty()) {
+      throw bad("an empty value");
+    }
+    if (!seen.insert(v).second) {
+      throw bad("the value " + v + " twice");
+    }
     axis.values.push_back(std::move(v));
-    if (comma == std::string::npos) break;
+    if (comma == std::string::npos) {
+      break;
+    }
     from = comma + 1;
   }
   return axis;
@@ -49,17 +58,21 @@ SweepAxis parse_sweep_axis(const std::string& text) {
 
 std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>& axes,
                                                    const CycleRenderOptions& base) {
-  if (axes.empty()) throw std::runtime_error("sweep needs at least one --vary KEY=V1,V2,...");
+  if (axes.empty()) {
+    throw std::runtime_error("sweep needs at least one --vary KEY=V1,V2,...");
+  }
   resolve_cycle_params(base);  // --preset and --set errors name those options
   std::set<std::string> keys;
   std::size_t count = 1;
   for (const SweepAxis& a : axes) {
-    if (!keys.insert(a.key).second)
+    if (!keys.insert(a.key).second) {
       throw std::runtime_error("bad --vary " + a.key + ": the key is varied twice");
+    }
     count *= a.values.size();
-    if (count > kMaxSweepPoints)
+    if (count > kMaxSweepPoints) {
       throw std::runtime_error("sweep of more than " + std::to_string(kMaxSweepPoints) +
                                " points: vary fewer keys or values");
+    }
   }
   std::vector<std::vector<std::string>> points(count);
   for (std::size_t i = 0; i < count; ++i) {
@@ -78,10 +91,11 @@ std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>&
     } catch (const std::runtime_error& e) {
       // The key table speaks of --set; the value came from --vary (or the combination is bad).
       std::string msg = e.what();
-      if (msg.starts_with("bad --set "))
+      if (msg.starts_with("bad --set ")) {
         msg = "bad --vary " + msg.substr(10);
-      else if (msg.starts_with("unknown --set "))
+      } else if (msg.starts_with("unknown --set ")) {
         msg = "unknown --vary " + msg.substr(14);
+      }
       throw std::runtime_error(msg + " (sweep point " + join_settings(p) + ")");
     }
   }
@@ -101,10 +115,11 @@ void check_sweep_point(const FrameResult& frame, const FrameResult& reference,
                              "functional fp24 model's (" +
                              buf + ")");
   }
-  if (frame.rays != reference.rays)
+  if (frame.rays != reference.rays) {
     throw std::runtime_error("sweep point " + where + ": " + std::to_string(frame.rays) +
                              " rays returned, the functional fp24 model traced " +
                              std::to_string(reference.rays));
+  }
 }
 
 SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedScene& prepared,
@@ -139,8 +154,9 @@ namespace {
 // The point's value of each axis, in axis order ("threads=4" -> "4").
 std::vector<std::string> point_values(const SweepPoint& p) {
   std::vector<std::string> v;
-  for (const std::string& kv : p.settings)
+  for (const std::string& kv : p.settings) {
     v.push_back(kv.substr(kv.find('=') + 1));
+  }
   return v;
 }
 
@@ -222,14 +238,17 @@ std::string sweep_table(const SweepResult& sweep) {
 
 std::string sweep_csv(const SweepResult& sweep) {
   std::string s;
-  for (const SweepAxis& a : sweep.axes)
+  for (const SweepAxis& a : sweep.axes) {
     s += a.key + ",";
-  for (const Column& c : columns())
+  }
+  for (const Column& c : columns()) {
     s += std::string(c.name) + (&c == &columns().back() ? "\n" : ",");
+  }
   char buf[64];
   for (const SweepPoint& p : sweep.points) {
-    for (const std::string& v : point_values(p))
+    for (const std::string& v : point_values(p)) {
       s += v + ",";
+    }
     for (const Column& c : columns()) {
       std::snprintf(buf, sizeof buf, "%.17g", c.get(p));
       s += std::string(buf) + (&c == &columns().back() ? "\n" : ",");
@@ -245,8 +264,9 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
   j["preset"] = opts.preset;
   j["set"] = opts.set;
   nlohmann::json vary = nlohmann::json::object();
-  for (const SweepAxis& a : sweep.axes)
+  for (const SweepAxis& a : sweep.axes) {
     vary[a.key] = a.values;
+  }
   j["vary"] = vary;
   j["bit_identical_to_functional_fp24"] = true;  // run_sweep_points throws otherwise
   j["functional_rays"] = sweep.functional_rays;
@@ -254,8 +274,9 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
   for (const SweepPoint& p : sweep.points) {
     nlohmann::json e;
     const std::vector<std::string> v = point_values(p);
-    for (std::size_t a = 0; a < v.size(); ++a)
+    for (std::size_t a = 0; a < v.size(); ++a) {
       e["values"][sweep.axes[a].key] = v[a];
+    }
     e["speedup"] = p.speedup;
     e["report"] = p.cycle;
     points.push_back(std::move(e));
@@ -275,26 +296,37 @@ int run_sweep(const SweepOptions& opts) {
   settings.cycle.set = opts.set;
   settings.cycle.host_threads = opts.host_threads;
   std::vector<SweepAxis> axes;
-  for (const std::string& v : opts.vary)
+  for (const std::string& v : opts.vary) {
     axes.push_back(parse_sweep_axis(v));
+  }
   // Every bad input fails here, before the scene loads and before any frame runs.
   const std::size_t count = sweep_points(axes, settings.cycle).size();
-  if (!opts.report.empty() && !opts.report.ends_with(".json"))
+  if (!opts.report.empty() && !opts.report.ends_with(".json")) {
     throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
-  if (!opts.csv.empty() && !opts.csv.ends_with(".csv"))
+  }
+  if (!opts.csv.empty() && !opts.csv.ends_with(".csv")) {
     throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
+  }
 
   const PreparedScene prep = prepare_scene(opts.scene, settings);
   const SweepResult sweep = run_sweep_points(axes, prep, settings);
 
-  if (!opts.report.empty()) write_text_file(opts.report, sweep_json(sweep, opts).dump(2) + "\n");
-  if (!opts.csv.empty()) write_text_file(opts.csv, sweep_csv(sweep));
+  if (!opts.report.empty()) {
+    write_text_file(opts.report, sweep_json(sweep, opts).dump(2) + "\n");
+  }
+  if (!opts.csv.empty()) {
+    write_text_file(opts.csv, sweep_csv(sweep));
+  }
   std::printf(
       "saarcor sweep: %s, %dx%d, %zu points, every one bit-identical to the functional "
       "fp24 model (hit records and image, %" PRIu64 " rays)\n",
       opts.scene.c_str(), settings.res.width, settings.res.height, count, sweep.functional_rays);
-  if (!opts.report.empty()) std::printf("  report:    %s\n", opts.report.c_str());
-  if (!opts.csv.empty()) std::printf("  csv:       %s\n", opts.csv.c_str());
+  if (!opts.report.empty()) {
+    std::printf("  report:    %s\n", opts.report.c_str());
+  }
+  if (!opts.csv.empty()) {
+    std::printf("  csv:       %s\n", opts.csv.c_str());
+  }
   std::printf("%s", sweep_table(sweep).c_str());
   return 0;
 }

@@ -47,7 +47,9 @@ struct SweepOptions {
   std::string csv;     // CSV path, optional
 };
 
-struct SweepPoint {
+// (bugprone-exception-escape: nlohmann::json's default constructor is not declared noexcept; a
+// null json allocates nothing.)
+struct SweepPoint {                   // NOLINT(bugprone-exception-escape)
   std::vector<std::string> settings;  // the KEY=VALUE the point adds
   nlohmann::json cycle;               // the frame's cycle report (cycle_report_json)
   double speedup = 1.0;               // the first point's cycles over this point's

@@ -16,17 +16,19 @@ constexpr const char* kMagic = "# saarcor unit vectors 1";
 
 std::string field_text(const std::string& field, std::uint32_t v) {
   char buf[16];
-  if (units::vector_field_is_flag(field))
+  if (units::vector_field_is_flag(field)) {
     std::snprintf(buf, sizeof buf, "%u", v);
-  else
+  } else {
     std::snprintf(buf, sizeof buf, "%06x", v);
+  }
   return buf;
 }
 
 std::string joined(const std::vector<std::string>& names) {
   std::string s;
-  for (const std::string& n : names)
+  for (const std::string& n : names) {
     s += (s.empty() ? "" : " ") + n;
+  }
   return s;
 }
 
@@ -46,10 +48,12 @@ std::string format_vector_file(units::VectorUnit unit, const units::VectorCaptur
        std::to_string(capture.transactions) + " transactions\n";
   for (const units::UnitVector& v : capture.vectors) {
     std::string line;
-    for (std::size_t k = 0; k < v.in.size(); ++k)
+    for (std::size_t k = 0; k < v.in.size(); ++k) {
       line += (k == 0 ? "" : " ") + field_text(ins[k], v.in[k]);
-    for (std::size_t k = 0; k < v.out.size(); ++k)
+    }
+    for (std::size_t k = 0; k < v.out.size(); ++k) {
       line += " " + field_text(outs[k], v.out[k]);
+    }
     s += line + "\n";
   }
   return s;
@@ -66,8 +70,12 @@ VectorCheck check_vector_text(const std::string& text) {
   };
   while (std::getline(in, line)) {
     ++number;
-    if (number == 1 && line != kMagic) throw bad("expected '" + std::string(kMagic) + "'");
-    if (line.empty()) continue;
+    if (number == 1 && line != kMagic) {
+      throw bad("expected '" + std::string(kMagic) + "'");
+    }
+    if (line.empty()) {
+      continue;
+    }
     if (line[0] == '#') {
       if (line.rfind("# unit: ", 0) == 0) {
         r.unit = units::parse_vector_unit(line.substr(8));
@@ -75,7 +83,9 @@ VectorCheck check_vector_text(const std::string& text) {
       }
       continue;
     }
-    if (!have_unit) throw bad("a vector before the '# unit: ' line");
+    if (!have_unit) {
+      throw bad("a vector before the '# unit: ' line");
+    }
     const auto& ins = units::vector_inputs(r.unit);
     const auto& outs = units::vector_outputs(r.unit);
     std::istringstream fields(line);
@@ -94,14 +104,21 @@ VectorCheck check_vector_text(const std::string& text) {
         used = 0;
       }
       const unsigned long limit = units::vector_field_is_flag(name) ? 1u : 0xffffffu;
-      if (used != tok.size() || v > limit)
-        throw bad("field " + name + " '" + tok + "' is not " +
-                  (units::vector_field_is_flag(name) ? "0 or 1" : "a hex fp24 encoding"));
+      if (used != tok.size() || v > limit) {
+        std::string why = "field ";
+        why += name;
+        why += " '";
+        why += tok;
+        why += "' is not ";
+        why += units::vector_field_is_flag(name) ? "0 or 1" : "a hex fp24 encoding";
+        throw bad(why);
+      }
       values.push_back(static_cast<std::uint32_t>(v));
     }
-    if (values.size() != ins.size() + outs.size())
+    if (values.size() != ins.size() + outs.size()) {
       throw bad(std::to_string(values.size()) + " fields, a " + units::vector_unit_name(r.unit) +
                 " vector has " + std::to_string(ins.size() + outs.size()));
+    }
     const std::vector<std::uint32_t> input(values.begin(),
                                            values.begin() + static_cast<long>(ins.size()));
     std::vector<std::uint32_t> expected;
@@ -114,39 +131,56 @@ VectorCheck check_vector_text(const std::string& text) {
     bool differs = false;
     for (std::size_t k = 0; k < outs.size(); ++k) {
       const std::uint32_t got = values[ins.size() + k];
-      if (got == expected[k]) continue;
+      if (got == expected[k]) {
+        continue;
+      }
       differs = true;
-      if (r.first_differences.size() < 5)
+      if (r.first_differences.size() < 5) {
         r.first_differences.push_back("line " + std::to_string(number) + ": " + outs[k] + " is " +
                                       field_text(outs[k], got) + ", the datapath gives " +
                                       field_text(outs[k], expected[k]));
+      }
     }
     r.differing += differs ? 1 : 0;
   }
-  if (number == 0) throw bad("empty file");
-  if (!have_unit) throw bad("no '# unit: ' line");
+  if (number == 0) {
+    throw bad("empty file");
+  }
+  if (!have_unit) {
+    throw bad("no '# unit: ' line");
+  }
   return r;
 }
 
 int run_vectors(const VectorsOptions& opts) {
   if (!opts.check.empty()) {
-    if (!opts.scene.empty() || !opts.out.empty())
+    if (!opts.scene.empty() || !opts.out.empty()) {
       throw std::runtime_error("--check reads a vector file: no SCENE or --out with it");
+    }
     std::ifstream f(opts.check, std::ios::binary);
-    if (!f) throw std::runtime_error("cannot read vector file '" + opts.check + "'");
+    if (!f) {
+      throw std::runtime_error("cannot read vector file '" + opts.check + "'");
+    }
     std::stringstream ss;
     ss << f.rdbuf();
     const VectorCheck r = check_vector_text(ss.str());
     std::printf("saarcor vectors --check %s: %s unit, %zu vectors, %zu differ from the datapath\n",
                 opts.check.c_str(), units::vector_unit_name(r.unit), r.vectors, r.differing);
-    for (const std::string& d : r.first_differences)
+    for (const std::string& d : r.first_differences) {
       std::printf("  %s\n", d.c_str());
+    }
     return r.differing == 0 ? 0 : 2;
   }
-  if (opts.scene.empty()) throw std::runtime_error("vectors needs a SCENE (or --check FILE)");
+  if (opts.scene.empty()) {
+    throw std::runtime_error("vectors needs a SCENE (or --check FILE)");
+  }
   const units::VectorUnit unit = units::parse_vector_unit(opts.unit);
-  if (opts.count == 0) throw std::runtime_error("bad --count 0: at least one vector");
-  if (opts.out.empty()) throw std::runtime_error("vectors needs --out FILE");
+  if (opts.count == 0) {
+    throw std::runtime_error("bad --count 0: at least one vector");
+  }
+  if (opts.out.empty()) {
+    throw std::runtime_error("vectors needs --out FILE");
+  }
   RenderSettings settings;
   settings.res = parse_resolution(opts.res);
   settings.time = opts.time;

@@ -24,24 +24,33 @@ class SamplingTap final : public UnitTap<F> {
 
   void traversal(F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far, F near_tf,
                  F far_tn) override {
-    if (unit_ != VectorUnit::kTraversal || !take()) return;
+    if (unit_ != VectorUnit::kTraversal || !take()) {
+      return;
+    }
     keep({split.bits, o_axis.bits, d_axis.bits, tn.bits, tf.bits},
          {go_near ? 1u : 0u, go_far ? 1u : 0u, near_tf.bits, far_tn.bits});
   }
   void transformation(const Mat34<F>& m, const Vec3<F>& in, bool translate,
                       const Vec3<F>& out) override {
-    if (unit_ != VectorUnit::kTransformation || !take()) return;
+    if (unit_ != VectorUnit::kTransformation || !take()) {
+      return;
+    }
     std::vector<std::uint32_t> v;
-    for (const auto& row : m)
-      for (const F x : row)
+    for (const auto& row : m) {
+      for (const F x : row) {
         v.push_back(x.bits);
-    for (const F x : in)
+      }
+    }
+    for (const F x : in) {
       v.push_back(x.bits);
+    }
     v.push_back(translate ? 1u : 0u);
     keep(std::move(v), {out[0].bits, out[1].bits, out[2].bits});
   }
   void intersection(const Ray<F>& ray, const Candidate<F>& c) override {
-    if (unit_ != VectorUnit::kIntersection || !take()) return;
+    if (unit_ != VectorUnit::kIntersection || !take()) {
+      return;
+    }
     keep({ray.o[0].bits, ray.o[1].bits, ray.o[2].bits, ray.d[0].bits, ray.d[1].bits, ray.d[2].bits},
          {c.t.bits, c.u.bits, c.v.bits, c.c.bits, c.inside ? 1u : 0u});
   }
@@ -62,7 +71,9 @@ class SamplingTap final : public UnitTap<F> {
       return true;
     }
     const std::uint64_t j = std::uniform_int_distribution<std::uint64_t>(0, i)(rng_);
-    if (j >= count_) return false;
+    if (j >= count_) {
+      return false;
+    }
     slot_ = static_cast<std::size_t>(j);
     return true;
   }
@@ -82,13 +93,16 @@ class SamplingTap final : public UnitTap<F> {
 };
 
 F enc(std::uint32_t bits) {
-  if ((bits & ~F::kFormat.bits_mask()) != 0)
+  if ((bits & ~F::kFormat.bits_mask()) != 0) {
     throw std::runtime_error("unit vector: " + std::to_string(bits) +
                              " is not a 24-bit fp24 encoding");
+  }
   return F::from_bits(bits);
 }
 bool flag(std::uint32_t v) {
-  if (v > 1) throw std::runtime_error("unit vector: a flag is 0 or 1, not " + std::to_string(v));
+  if (v > 1) {
+    throw std::runtime_error("unit vector: a flag is 0 or 1, not " + std::to_string(v));
+  }
   return v == 1;
 }
 
@@ -107,8 +121,11 @@ const char* vector_unit_name(VectorUnit u) {
 }
 
 VectorUnit parse_vector_unit(const std::string& name) {
-  for (int i = 0; i < kVectorUnits; ++i)
-    if (name == vector_unit_name(static_cast<VectorUnit>(i))) return static_cast<VectorUnit>(i);
+  for (int i = 0; i < kVectorUnits; ++i) {
+    if (name == vector_unit_name(static_cast<VectorUnit>(i))) {
+      return static_cast<VectorUnit>(i);
+    }
+  }
   throw std::runtime_error("unknown unit '" + name +
                            "' (known: traversal, transformation, intersection)");
 }
@@ -136,19 +153,21 @@ bool vector_field_is_flag(const std::string& field) {
 
 VectorCapture capture_unit_vectors(const memif::MemoryImage& image, const FunctionalParams& params,
                                    VectorUnit unit, std::size_t count, std::uint64_t seed) {
-  if (!(image.format() == F::kFormat))
+  if (!(image.format() == F::kFormat)) {
     throw std::runtime_error("unit vectors: the image is in " + ff::format_name(image.format()) +
                              "; the vectors are the fp24 hardware's (e7m16)");
+  }
   SamplingTap tap(unit, count, seed);
   run_functional<F>(image, params, {}, &tap);
   return std::move(tap).result();
 }
 
 std::vector<std::uint32_t> expected_outputs(VectorUnit unit, const std::vector<std::uint32_t>& in) {
-  if (in.size() != vector_inputs(unit).size())
+  if (in.size() != vector_inputs(unit).size()) {
     throw std::runtime_error("unit vector: " + std::string(vector_unit_name(unit)) + " takes " +
                              std::to_string(vector_inputs(unit).size()) + " inputs, not " +
                              std::to_string(in.size()));
+  }
   const UnitFp<F> fp;  // fp24, round to nearest even, subnormals flushed: the prototype's units
   switch (unit) {
     case VectorUnit::kTraversal: {
@@ -158,8 +177,9 @@ std::vector<std::uint32_t> expected_outputs(VectorUnit unit, const std::vector<s
     }
     case VectorUnit::kTransformation: {
       Mat34<F> m;
-      for (std::size_t k = 0; k < 12; ++k)
+      for (std::size_t k = 0; k < 12; ++k) {
         m[k / 4][k % 4] = enc(in[k]);
+      }
       const Vec3<F> v{enc(in[12]), enc(in[13]), enc(in[14])};
       const Vec3<F> r = transform_step(fp, m, v, flag(in[15]));
       return {r[0].bits, r[1].bits, r[2].bits};
