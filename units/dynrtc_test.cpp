@@ -420,6 +420,16 @@ TEST(DynRtc, WatchdogNamesStuckThreads) {
   }
   EXPECT_EQ(reports[1], reports[0]);
   EXPECT_EQ(reports[2], reports[0]);
+  // With two DynRTPs of two threads each, thread 3 is the second pipeline's.
+  p.pipelines = 2;
+  try {
+    run_cycle(b.image, p);
+    ADD_FAILURE() << "the watchdog did not fire";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("thread 3 (dynrtp1): "), std::string::npos) << m;
+    EXPECT_NE(m.find("dynrtp1.traversal"), std::string::npos) << m;
+  }
 }
 
 // --interval: the figures of each interval; their cycle-weighted mean is the frame's figure.

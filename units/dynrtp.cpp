@@ -489,14 +489,17 @@ CycleFigures figures(const Snapshot& a, const Snapshot& b, double clock_mhz) {
   return f;
 }
 
+// With several DynRTPs each thread also names its pipeline (thread t is pipeline t / threads').
 template <class F, int kLanes>
-std::string thread_report(Threads<F, kLanes>& threads) {
+std::string thread_report(Threads<F, kLanes>& threads, const CycleParams& p) {
   std::ostringstream s;
   s << "threads (id: unit, phase, item, rays):";
   for (int t = 0; t < threads.size(); ++t) {
     const Request r = threads.request(static_cast<std::uint32_t>(t));
     if (r.unit == UnitId::kNone) continue;
-    s << "\n  thread " << t << ": " << unit_name(r.unit) << ", " << phase_name(r.phase);
+    s << "\n  thread " << t;
+    if (p.pipelines > 1) s << " (dynrtp" << t / p.threads << ")";
+    s << ": " << unit_name(r.unit) << ", " << phase_name(r.phase);
     if (r.item != memif::kNone) s << ", item " << r.item;
     s << ", mask 0x" << std::hex << threads.mask(static_cast<std::uint32_t>(t)) << std::dec;
   }
@@ -546,7 +549,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
     if (r.status == hw::RunResult::Status::kWatchdog)
       throw std::runtime_error("cycle model: watchdog at cycle " + std::to_string(r.cycles) +
                                ": no progress for " + std::to_string(p.watchdog) + " cycles\n" +
-                               thread_report(threads) + "\n" + r.report);
+                               thread_report(threads, p) + "\n" + r.report);
     if (opt.interval != 0) {
       const Snapshot now = snapshot(k, chip);
       if (now.cycle > last.cycle) out.series.push_back(figures(last, now, p.clock_mhz));
