@@ -39,14 +39,20 @@ void expect_error(const RenderOptions& o, const std::string& needle) {
   }
 }
 
-TEST(CycleRender, ReportVcdAndTable) {
-  const fs::path d = temp_dir();
+// The room at 32x24 through the cycle model, image and report as d/name.png, d/name.json.
+RenderOptions room_cycle(const fs::path& d, const std::string& name) {
   RenderOptions o;
   o.scene = "builtin:room";
   o.model = "cycle";
   o.res = "32x24";
-  o.out = (d / "room").string();
-  o.report = (d / "room.json").string();
+  o.out = (d / name).string();
+  o.report = (d / (name + ".json")).string();
+  return o;
+}
+
+TEST(CycleRender, ReportVcdAndTable) {
+  const fs::path d = temp_dir();
+  RenderOptions o = room_cycle(d, "room");
   o.cycle.set = {"threads=16", "lat.div=12"};
   o.cycle.interval = 2000;
   o.cycle.vcd = (d / "room.vcd").string();
@@ -89,12 +95,7 @@ TEST(CycleRender, ReportVcdAndTable) {
 // top-level usage is their mean, the printout says how the packets spread.
 TEST(CycleRender, StandardPresetReportsEveryPipeline) {
   const fs::path d = temp_dir();
-  RenderOptions o;
-  o.scene = "builtin:room";
-  o.model = "cycle";
-  o.res = "32x24";
-  o.out = (d / "std").string();
-  o.report = (d / "std.json").string();
+  RenderOptions o = room_cycle(d, "std");
   o.cycle.preset = "standard";
   testing::internal::CaptureStdout();
   EXPECT_EQ(run_render(o), 0);

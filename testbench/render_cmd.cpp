@@ -481,14 +481,21 @@ std::string format_pixel_hit(PixelCoord px, const PixelHit& h) {
   return s;
 }
 
+RenderSettings frame_settings(const std::string& res, double time, bool shadows, int depth,
+                              double bank_mb) {
+  RenderSettings s;
+  s.res = parse_resolution(res);
+  s.time = time;
+  s.shadows = shadows;
+  s.depth = depth;
+  s.bank_mb = bank_mb;
+  return s;
+}
+
 int run_render(const RenderOptions& opts) {
   const ModelSpec model = parse_model(opts.model);
-  RenderSettings settings;
-  settings.res = parse_resolution(opts.res);
-  settings.time = opts.time;
-  settings.shadows = opts.shadows;
-  settings.depth = opts.depth;
-  settings.bank_mb = opts.bank_mb;
+  RenderSettings settings =
+      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
   settings.cycle = opts.cycle;
   if (model.kind == ModelKind::kCycle) {
     resolve_cycle_params(opts.cycle);  // a bad --preset/--set fails before the scene loads

@@ -99,6 +99,11 @@ PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prepared,
                      const RenderSettings& settings, PixelCoord pixel);
 std::string format_pixel_hit(PixelCoord pixel, const PixelHit& hit);
 
+// The frame settings the commands share (--res, --time, --shadows, --depth, --bank-mb); throws
+// for a bad --res.
+RenderSettings frame_settings(const std::string& res, double time, bool shadows, int depth,
+                              double bank_mb);
+
 struct RenderOptions {
   std::string scene;
   std::string model = "fp24";

@@ -286,12 +286,8 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
 }
 
 int run_sweep(const SweepOptions& opts) {
-  RenderSettings settings;
-  settings.res = parse_resolution(opts.res);
-  settings.time = opts.time;
-  settings.shadows = opts.shadows;
-  settings.depth = opts.depth;
-  settings.bank_mb = opts.bank_mb;
+  RenderSettings settings =
+      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
   settings.cycle.preset = opts.preset;
   settings.cycle.set = opts.set;
   settings.cycle.host_threads = opts.host_threads;

@@ -181,10 +181,7 @@ int run_vectors(const VectorsOptions& opts) {
   if (opts.out.empty()) {
     throw std::runtime_error("vectors needs --out FILE");
   }
-  RenderSettings settings;
-  settings.res = parse_resolution(opts.res);
-  settings.time = opts.time;
-  settings.bank_mb = opts.bank_mb;
+  const RenderSettings settings = frame_settings(opts.res, opts.time, false, 0, opts.bank_mb);
   const PreparedScene prep = prepare_scene(opts.scene, settings);
   progress("capturing " + std::string(units::vector_unit_name(unit)) + " transactions");
   const units::VectorCapture cap =
