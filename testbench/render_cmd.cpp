@@ -481,6 +481,15 @@ std::string format_pixel_hit(PixelCoord px, const PixelHit& h) {
   return s;
 }
 
+std::string join_words(const std::vector<std::string>& words) {
+  std::string s;
+  for (const std::string& w : words) {
+    if (!s.empty()) s += ' ';
+    s += w;
+  }
+  return s;
+}
+
 RenderSettings frame_settings(const std::string& res, double time, bool shadows, int depth,
                               double bank_mb) {
   RenderSettings s;

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "fixedfloat/format.h"
 #include "host/float_reference.h"
@@ -98,6 +99,9 @@ FrameResult render_model(const ModelSpec& model, const PreparedScene& prepared,
 PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prepared,
                      const RenderSettings& settings, PixelCoord pixel);
 std::string format_pixel_hit(PixelCoord pixel, const PixelHit& hit);
+
+// The words separated by single spaces ("threads=4 packet=16").
+std::string join_words(const std::vector<std::string>& words);
 
 // The frame settings the commands share (--res, --time, --shadows, --depth, --bank-mb); throws
 // for a bad --res.

@@ -13,19 +13,6 @@
 
 namespace saarcor {
 
-namespace {
-
-// "threads=4 packet=16": a point as the reader wrote it.
-std::string join_settings(const std::vector<std::string>& settings) {
-  std::string s;
-  for (const std::string& kv : settings) {
-    s += (s.empty() ? "" : " ") + kv;
-  }
-  return s;
-}
-
-}  // namespace
-
 SweepAxis parse_sweep_axis(const std::string& text) {
   auto bad = [&](const std::string& why) {
     return std::runtime_error("bad --vary '" + text + "': " + why);
@@ -96,7 +83,7 @@ std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>&
       } else if (msg.starts_with("unknown --set ")) {
         msg = "unknown --vary " + msg.substr(14);
       }
-      throw std::runtime_error(msg + " (sweep point " + join_settings(p) + ")");
+      throw std::runtime_error(msg + " (sweep point " + join_words(p) + ")");
     }
   }
   return points;
@@ -131,7 +118,7 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
   const FrameResult reference = render_model(parse_model("fp24"), prepared, settings);
   r.functional_rays = reference.rays;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::string where = join_settings(points[i]);
+    const std::string where = join_words(points[i]);
     progress("point " + std::to_string(i + 1) + " / " + std::to_string(points.size()) + ": " +
              where);
     RenderSettings s = settings;

@@ -24,14 +24,6 @@ std::string field_text(const std::string& field, std::uint32_t v) {
   return buf;
 }
 
-std::string joined(const std::vector<std::string>& names) {
-  std::string s;
-  for (const std::string& n : names) {
-    s += (s.empty() ? "" : " ") + n;
-  }
-  return s;
-}
-
 }  // namespace
 
 std::string format_vector_file(units::VectorUnit unit, const units::VectorCapture& capture,
@@ -42,8 +34,8 @@ std::string format_vector_file(units::VectorUnit unit, const units::VectorCaptur
   s += std::string("# unit: ") + units::vector_unit_name(unit) + "\n";
   s += "# format: fp24 (e7m16, bias 63), round to nearest even, subnormals flushed; encodings as "
        "6 hex digits, flags 0/1\n";
-  s += "# inputs: " + joined(ins) + "\n";
-  s += "# outputs: " + joined(outs) + "\n";
+  s += "# inputs: " + join_words(ins) + "\n";
+  s += "# outputs: " + join_words(outs) + "\n";
   s += "# source: " + source + ", " + std::to_string(capture.vectors.size()) + " of " +
        std::to_string(capture.transactions) + " transactions\n";
   for (const units::UnitVector& v : capture.vectors) {
