@@ -129,14 +129,6 @@ PixelHit trace_float_pixel(const PreparedScene& prep, const RenderSettings& sett
 
 // ---- functional model --------------------------------------------------------------------------
 
-units::FunctionalParams functional_params(const RenderSettings& s) {
-  units::FunctionalParams p;
-  p.shadows = s.shadows;
-  p.secondary = s.depth > 0;
-  p.max_depth = s.depth > 0 ? s.depth : -1;
-  return p;
-}
-
 // Float<7, m> chosen by an explicit switch: each case is its own template instantiation.
 units::FunctionalFrame run_functional_m(int m, const memif::MemoryImage& image,
                                         const units::FunctionalParams& params,
@@ -479,6 +471,14 @@ std::string format_pixel_hit(PixelCoord px, const PixelHit& h) {
                 h.oy, h.oz, h.dx, h.dy, h.dz);
   s += buf;
   return s;
+}
+
+units::FunctionalParams functional_params(const RenderSettings& s) {
+  units::FunctionalParams p;
+  p.shadows = s.shadows;
+  p.secondary = s.depth > 0;
+  p.max_depth = s.depth > 0 ? s.depth : -1;
+  return p;
 }
 
 std::string join_words(const std::vector<std::string>& words) {

@@ -100,6 +100,9 @@ PixelHit trace_pixel(const ModelSpec& model, const PreparedScene& prepared,
                      const RenderSettings& settings, PixelCoord pixel);
 std::string format_pixel_hit(PixelCoord pixel, const PixelHit& hit);
 
+// The functional model's shading options of a frame (--shadows, --depth).
+units::FunctionalParams functional_params(const RenderSettings& settings);
+
 // The words separated by single spaces ("threads=4 packet=16").
 std::string join_words(const std::vector<std::string>& words);
 

@@ -141,6 +141,8 @@ int main(int argc, char** argv) {
     sub->add_option("--time", vectors_opts.time, "animation time in seconds");
     sub->add_option("--bank-mb", vectors_opts.bank_mb, "SRAM bank size in MB")
         ->capture_default_str();
+    sub->add_flag("--shadows", vectors_opts.shadows, "the frame with shadow rays");
+    sub->add_option("--depth", vectors_opts.depth, "secondary-ray depth (0 = primary only)");
     sub->add_option("--out", vectors_opts.out, "the vector file to write");
     sub->add_option("--check", vectors_opts.check,
                     "check a vector file's outputs against the datapath (exit 2 if any differ)");

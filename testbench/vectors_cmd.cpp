@@ -173,15 +173,17 @@ int run_vectors(const VectorsOptions& opts) {
   if (opts.out.empty()) {
     throw std::runtime_error("vectors needs --out FILE");
   }
-  const RenderSettings settings = frame_settings(opts.res, opts.time, false, 0, opts.bank_mb);
+  const RenderSettings settings =
+      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
   const PreparedScene prep = prepare_scene(opts.scene, settings);
   progress("capturing " + std::string(units::vector_unit_name(unit)) + " transactions");
-  const units::VectorCapture cap =
-      units::capture_unit_vectors(prep.built.image, {}, unit, opts.count, opts.seed);
-  const std::string source = opts.scene + " " + std::to_string(settings.res.width) + "x" +
-                             std::to_string(settings.res.height) +
-                             ", functional fp24 model, uniform sample with seed " +
-                             std::to_string(opts.seed);
+  const units::VectorCapture cap = units::capture_unit_vectors(
+      prep.built.image, functional_params(settings), unit, opts.count, opts.seed);
+  const std::string source =
+      opts.scene + " " + std::to_string(settings.res.width) + "x" +
+      std::to_string(settings.res.height) + (opts.shadows ? " with shadows" : "") +
+      (opts.depth > 0 ? ", depth " + std::to_string(opts.depth) : "") +
+      ", functional fp24 model, uniform sample with seed " + std::to_string(opts.seed);
   write_text_file(opts.out, format_vector_file(unit, cap, source));
   std::printf("saarcor vectors: %s unit, %zu of %llu transactions of %s -> %s\n",
               units::vector_unit_name(unit), cap.vectors.size(),

@@ -21,8 +21,10 @@ struct VectorsOptions {
   std::string res = "128x96";
   double time = 0.0;
   double bank_mb = 4.0;
-  std::string out;    // generate: the vector file
-  std::string check;  // check this vector file instead of generating
+  bool shadows = false;  // the frame's shadow rays (their generation steps, their traversal)
+  int depth = 0;         // secondary rays (reflection, transparency) up to this depth
+  std::string out;       // generate: the vector file
+  std::string check;     // check this vector file instead of generating
 };
 
 // The file: '#' header lines (the unit, the field names, the source), then one vector per line.

@@ -721,6 +721,8 @@ class ThreadProgram {
         lane(i).world.d = transform(g.t, mv, g.rd, false);
       }
     }
+    if (u_.tap != nullptr) [[unlikely]]
+      tap_generate(shared);
     for (int i = 0; i < p_; ++i) {
       Lane& l = lane(i);
       l.current = l.world;
@@ -1113,6 +1115,18 @@ class ThreadProgram {
         [&](int i) -> Vec3<F>& { return (lane(i).*out).d; });
     if (u_.tap != nullptr) [[unlikely]]
       tap_transform(m, in, out);
+  }
+  // Ray generation's steps (R' through the RGS's T), as tap_transform's.
+  void tap_generate(const Vec3<F>& shared) {
+    const GenLane& g0 = gen_.lanes[0];
+    if (shared_origin_) u_.tap->transformation(g0.t, g0.ro, true, shared);
+    for (int i = 0; i < p_; ++i) {
+      const Lane& l = lane(i);
+      if (!l.valid) continue;
+      const GenLane& g = gen_.lanes[static_cast<std::size_t>(i)];
+      if (!shared_origin_) u_.tap->transformation(g.t, g.ro, true, l.world.o);
+      u_.tap->transformation(g.t, g.rd, false, l.world.d);
+    }
   }
   // The steps as the unit runs them: a shared origin once (lane 0's, which every lane holds),
   // else each entering lane's origin; each entering lane's direction.

@@ -76,6 +76,27 @@ TEST_P(UnitVectorsOnScenes, EveryVectorIsTheDatapathsAnswer) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, UnitVectorsOnScenes, ::testing::Range(0, 27));
 
+// With shadow and secondary rays the transformation unit also generates shadow, reflection and
+// transparency rays (the RGS's T, DESIGN.md section 7): those steps are vectors too.
+TEST(UnitVectors, ShadowAndSecondaryRaysToo) {
+  const host::BuiltImage b = build("builtin:dynamic", 32, 24);
+  FunctionalParams shaded;
+  shaded.shadows = true;
+  shaded.secondary = true;
+  shaded.max_depth = 2;
+  const VectorCapture primary =
+      capture_unit_vectors(b.image, {}, VectorUnit::kTransformation, 1, 1);
+  for (int u = 0; u < kVectorUnits; ++u) {
+    const auto unit = static_cast<VectorUnit>(u);
+    const VectorCapture cap = capture_unit_vectors(b.image, shaded, unit, 1000, 5);
+    for (const UnitVector& v : cap.vectors)
+      EXPECT_EQ(expected_outputs(unit, v.in), v.out) << vector_unit_name(unit) << " " << v.index;
+    if (unit == VectorUnit::kTransformation) {
+      EXPECT_GT(cap.transactions, primary.transactions);
+    }
+  }
+}
+
 TEST(UnitVectors, TheSampleIsSeededAndSpreadOverTheFrame) {
   const host::BuiltImage b = build("builtin:room", 32, 24);
   const FunctionalParams p;
