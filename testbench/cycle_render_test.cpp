@@ -116,6 +116,21 @@ TEST(CycleRender, StandardPresetReportsEveryPipeline) {
   fs::remove_all(d);
 }
 
+// --model cycle-e7m23 builds the image in e7m23 and equals the functional model in e7m23.
+TEST(CycleRender, WideModelHitsEqualTheE7m23Model) {
+  RenderSettings s;
+  s.res = {24, 16};
+  const PreparedScene prep = prepare_scene("builtin:dynamic", s, ff::Format{7, 23});
+  const FrameResult c = render_model(parse_model("cycle-e7m23"), prep, s);
+  const FrameResult f = render_model(parse_model("e7m23"), prep, s);
+  EXPECT_EQ(c.hits.pixels, f.hits.pixels);
+  EXPECT_EQ(c.image.rgb, f.image.rgb);
+  EXPECT_EQ(test_support::error_of([&] {
+              render_model(parse_model("cycle"), prep, s);
+            }).rfind("model cycle needs", 0),
+            0u);
+}
+
 TEST(CycleRender, HitsEqualTheFp24Model) {
   RenderSettings s;
   s.res = {24, 16};

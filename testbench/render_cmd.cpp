@@ -365,13 +365,13 @@ ModelSpec parse_model(const std::string& name) {
     m.mantissa = mant;
     return m;
   }
-  if (name == "cycle") {
+  if (name == "cycle" || name == "cycle-e7m23") {
     m.kind = ModelKind::kCycle;
-    m.mantissa = 16;
+    m.mantissa = name == "cycle" ? 16 : 23;
     return m;
   }
   throw std::runtime_error("unknown model '" + name +
-                           "': expected float, fp24, e7m10..e7m23, or cycle");
+                           "': expected float, fp24, e7m10..e7m23, cycle or cycle-e7m23");
 }
 
 PreparedScene prepare_scene(const std::string& spec, const RenderSettings& settings,

@@ -80,8 +80,11 @@ TEST(RenderArgs, Models) {
   EXPECT_EQ(parse_model("e7m23").mantissa, 23);
   EXPECT_EQ(parse_model("cycle").kind, ModelKind::kCycle);  // landed with the cycle model
   EXPECT_EQ(parse_model("cycle").mantissa, 16);
+  EXPECT_EQ(parse_model("cycle-e7m23").kind, ModelKind::kCycle);  // the width study
+  EXPECT_EQ(parse_model("cycle-e7m23").mantissa, 23);
   EXPECT_EQ(error_of([] { parse_model("fp16"); }),
-            "unknown model 'fp16': expected float, fp24, e7m10..e7m23, or cycle");
+            "unknown model 'fp16': expected float, fp24, e7m10..e7m23, cycle or cycle-e7m23");
+  EXPECT_NE(error_of([] { parse_model("cycle-e7m20"); }).find("unknown model"), std::string::npos);
   EXPECT_NE(error_of([] { parse_model("e7m9"); }).find("unknown model 'e7m9'"), std::string::npos);
   EXPECT_NE(error_of([] { parse_model("e7m24"); }).find("unknown model"), std::string::npos);
 }

@@ -375,7 +375,7 @@ TEST(DynRtc, StackOverflowIsAnError) {
   }
 }
 
-TEST(DynRtc, OnlyTheFp24ImageRuns) {
+TEST(DynRtc, OnlyFp24AndE7m23ImagesRun) {
   const host::Scene scene = host::load_scene("builtin:cube");
   host::ImageParams ip;
   ip.width = 8;
@@ -386,8 +386,30 @@ TEST(DynRtc, OnlyTheFp24ImageRuns) {
     run_cycle(b.image, prototype_params());
     ADD_FAILURE() << "e7m20 image accepted";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("fp24"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("fp24 (e7m16) and e7m23"), std::string::npos);
   }
+}
+
+// The width study: the same units 31 bits wide (e7m23) are bit-exact to the functional model in
+// e7m23, under the covering design; a matrix row is four words instead of three, so the
+// transformation cache moves more bytes per miss and holds the same rows.
+TEST(DynRtc, E7m23DatapathIsBitExactAndWider) {
+  const host::Scene scene = host::load_scene("builtin:room");
+  host::ImageParams ip;
+  ip.width = kSanitized ? 16 : 48;
+  ip.height = kSanitized ? 12 : 36;
+  const host::BuiltImage fp24 = host::build_image(scene, ip);
+  ip.format = ff::Format{7, 23};
+  const host::BuiltImage wide = host::build_image(scene, ip);
+  for (const testing::Config& c : configs())
+    testing::expect_bit_exact(wide, c, std::string("room e7m23 [") + c.name + "]");
+  const CycleFrame a = run_cycle(fp24.image, prototype_params());
+  const CycleFrame w = run_cycle(wide.image, prototype_params());
+  const auto row = static_cast<std::size_t>(CacheUnit::kTransformation);
+  // Bytes per transformation-cache miss: 3 words per row item in fp24, 4 in e7m23.
+  EXPECT_EQ(a.caches[row].mem_bytes, 12 * a.caches[row].misses);
+  EXPECT_EQ(w.caches[row].mem_bytes, 16 * w.caches[row].misses);
+  EXPECT_NE(w.stats_json, a.stats_json);
 }
 
 // A stuck run stops with a report naming each waiting thread, its unit, phase, item and rays; the

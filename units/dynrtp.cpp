@@ -641,8 +641,14 @@ CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
     if (params.packet <= 4) return run_cycle_format<ff::Float<7, 16>, 4>(image, params, options);
     return run_cycle_format<ff::Float<7, 16>, kMaxPacket>(image, params, options);
   }
+  // The widest format with fp24's exponent, for the width study (docs/cycle-model.md, "Datapath
+  // width"): 31-bit values, a matrix row in four words instead of three.
+  if (image.format() == ff::Format{7, 23}) {
+    if (params.packet <= 4) return run_cycle_format<ff::Float<7, 23>, 4>(image, params, options);
+    return run_cycle_format<ff::Float<7, 23>, kMaxPacket>(image, params, options);
+  }
   throw std::runtime_error("cycle model: the image is in " + ff::format_name(image.format()) +
-                           "; the cycle model is built for fp24 (e7m16)");
+                           "; the cycle model is built for fp24 (e7m16) and e7m23");
 }
 
 }  // namespace saarcor::units

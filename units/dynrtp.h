@@ -91,8 +91,9 @@ struct CycleFrame {
   std::string stats_json;                // the hw/ statistics registry
 };
 
-// Renders the image's frame. Throws std::runtime_error for a bad configuration or image, and when
-// the watchdog fires (the message names every thread and where it waits).
+// Renders the image's frame: an fp24 image (the prototype), or e7m23 (the same units 31 bits wide,
+// for the width study). Throws std::runtime_error for a bad configuration or image, and when the
+// watchdog fires (the message names every thread and where it waits).
 CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
                      const CycleRunOptions& options = {});
 
