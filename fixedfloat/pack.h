@@ -12,7 +12,9 @@
 namespace saarcor::ff {
 
 // Words occupied by four values of format f: 3 for formats of at most 24 bits, 4 otherwise.
-constexpr int row_words(const Format& f) { return f.bits() <= 24 ? 3 : 4; }
+constexpr int row_words(const Format& f) {
+  return f.bits() <= 24 ? 3 : 4;
+}
 
 // Packs four encodings into row_words(f) words (unused high bits are zero).
 inline std::array<std::uint32_t, 4> pack_row(const std::array<std::uint32_t, 4>& v,

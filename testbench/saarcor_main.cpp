@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
     auto* sub = app.add_subcommand(
         "render", "render one frame with a model; write PNG, EXR, hit EXR, report");
     sub->add_option("scene", render_opts.scene, "glTF file or builtin:NAME")->required();
-    sub->add_option("--model", render_opts.model, "float | fp24 | e7m10..e7m23 | cycle | cycle-e7m23")
+    sub->add_option("--model", render_opts.model,
+                    "float | fp24 | e7m10..e7m23 | cycle | cycle-e7m23")
         ->capture_default_str();
     sub->add_option("--res", render_opts.res, "resolution WxH")->capture_default_str();
     sub->add_option("--time", render_opts.time, "animation time in seconds");
