@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
     sub->add_option("--vary", sweep_opts.vary,
                     "cycle model key and its values KEY=V1,V2,... (repeatable: the product)")
         ->required();
+    sub->add_option("--model", sweep_opts.model, "cycle | cycle-e7m23")->capture_default_str();
     sub->add_option("--res", sweep_opts.res, "resolution WxH")->capture_default_str();
     sub->add_option("--time", sweep_opts.time, "animation time in seconds");
     sub->add_flag("--shadows", sweep_opts.shadows, "shadow rays");

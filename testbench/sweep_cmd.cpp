@@ -99,12 +99,12 @@ void check_sweep_point(const FrameResult& frame, const FrameResult& reference,
                   same_image ? "identical" : "differs");
     throw std::runtime_error("sweep point " + where +
                              ": the cycle model's hit records or image differ from the "
-                             "functional fp24 model's (" +
+                             "functional model's (" +
                              buf + ")");
   }
   if (frame.rays != reference.rays) {
     throw std::runtime_error("sweep point " + where + ": " + std::to_string(frame.rays) +
-                             " rays returned, the functional fp24 model traced " +
+                             " rays returned, the functional model traced " +
                              std::to_string(reference.rays));
   }
 }
@@ -114,8 +114,12 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
   SweepResult r;
   r.axes = axes;
   const std::vector<std::vector<std::string>> points = sweep_points(axes, settings.cycle);
-  progress("functional fp24 model: the reference frame");
-  const FrameResult reference = render_model(parse_model("fp24"), prepared, settings);
+  // The image's format picks the pair: fp24 and the prototype's cycle model, or both in e7m23.
+  const bool wide = prepared.built.params.format == ff::Format{7, 23};
+  r.functional_model = wide ? "e7m23" : "fp24";
+  const ModelSpec cycle = parse_model(wide ? "cycle-e7m23" : "cycle");
+  progress("functional " + r.functional_model + " model: the reference frame");
+  const FrameResult reference = render_model(parse_model(r.functional_model), prepared, settings);
   r.functional_rays = reference.rays;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::string where = join_words(points[i]);
@@ -123,7 +127,7 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
              where);
     RenderSettings s = settings;
     s.cycle.set.insert(s.cycle.set.end(), points[i].begin(), points[i].end());
-    const FrameResult f = render_model(parse_model("cycle"), prepared, s);
+    const FrameResult f = render_model(cycle, prepared, s);
     check_sweep_point(f, reference, where);
     SweepPoint p;
     p.settings = points[i];
@@ -255,7 +259,9 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
     vary[a.key] = a.values;
   }
   j["vary"] = vary;
-  j["bit_identical_to_functional_fp24"] = true;  // run_sweep_points throws otherwise
+  j["model"] = opts.model;
+  j["functional_model"] = sweep.functional_model;
+  j["bit_identical_to_functional_model"] = true;  // run_sweep_points throws otherwise
   j["functional_rays"] = sweep.functional_rays;
   nlohmann::json points = nlohmann::json::array();
   for (const SweepPoint& p : sweep.points) {
@@ -278,6 +284,10 @@ int run_sweep(const SweepOptions& opts) {
   settings.cycle.preset = opts.preset;
   settings.cycle.set = opts.set;
   settings.cycle.host_threads = opts.host_threads;
+  const ModelSpec model = parse_model(opts.model);
+  if (model.kind != ModelKind::kCycle) {
+    throw std::runtime_error("bad --model " + opts.model + ": a sweep runs cycle or cycle-e7m23");
+  }
   std::vector<SweepAxis> axes;
   for (const std::string& v : opts.vary) {
     axes.push_back(parse_sweep_axis(v));
@@ -291,7 +301,7 @@ int run_sweep(const SweepOptions& opts) {
     throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
   }
 
-  const PreparedScene prep = prepare_scene(opts.scene, settings);
+  const PreparedScene prep = prepare_scene(opts.scene, settings, ff::Format{7, model.mantissa});
   const SweepResult sweep = run_sweep_points(axes, prep, settings);
 
   if (!opts.report.empty()) {
@@ -301,9 +311,10 @@ int run_sweep(const SweepOptions& opts) {
     write_text_file(opts.csv, sweep_csv(sweep));
   }
   std::printf(
-      "saarcor sweep: %s, %dx%d, %zu points, every one bit-identical to the functional "
-      "fp24 model (hit records and image, %" PRIu64 " rays)\n",
-      opts.scene.c_str(), settings.res.width, settings.res.height, count, sweep.functional_rays);
+      "saarcor sweep: %s, model %s, %dx%d, %zu points, every one bit-identical to the functional "
+      "%s model (hit records and image, %" PRIu64 " rays)\n",
+      opts.scene.c_str(), opts.model.c_str(), settings.res.width, settings.res.height, count,
+      sweep.functional_model.c_str(), sweep.functional_rays);
   if (!opts.report.empty()) {
     std::printf("  report:    %s\n", opts.report.c_str());
   }

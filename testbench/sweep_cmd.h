@@ -34,6 +34,7 @@ std::vector<std::vector<std::string>> sweep_points(const std::vector<SweepAxis>&
 
 struct SweepOptions {
   std::string scene;
+  std::string model = "cycle";    // or cycle-e7m23 (the image and the reference in e7m23)
   std::vector<std::string> vary;  // --vary KEY=V1,V2,... (repeatable)
   std::string res = "128x96";
   double time = 0.0;
@@ -57,7 +58,8 @@ struct SweepPoint {                   // NOLINT(bugprone-exception-escape)
 struct SweepResult {
   std::vector<SweepAxis> axes;
   std::vector<SweepPoint> points;
-  std::uint64_t functional_rays = 0;  // the functional fp24 model's frame, the reference
+  std::string functional_model;       // the reference: "fp24", or "e7m23" for cycle-e7m23
+  std::uint64_t functional_rays = 0;  // its frame's rays
 };
 
 // Throws "sweep point WHERE: ..." unless the cycle model's frame has the reference's hit records

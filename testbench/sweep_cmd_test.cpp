@@ -127,7 +127,7 @@ TEST(Sweep, APointThatDiffersFromFp24IsAnError) {
   one_bit.hits.pixels[hit].u = std::nextafter(one_bit.hits.pixels[hit].u, 2.0f);
   EXPECT_EQ(error_of([&] { check_sweep_point(one_bit, reference, "threads=64"); }),
             "sweep point threads=64: the cycle model's hit records or image differ from the "
-            "functional fp24 model's (same triangle 100.0000 %, image identical)");
+            "functional model's (same triangle 100.0000 %, image identical)");
   FrameResult image = frame;
   image.image.rgb[7] ^= 1u;
   EXPECT_NE(
@@ -136,7 +136,27 @@ TEST(Sweep, APointThatDiffersFromFp24IsAnError) {
   FrameResult lost = frame;
   --lost.rays;
   EXPECT_EQ(error_of([&] { check_sweep_point(lost, reference, "packet=4"); }),
-            "sweep point packet=4: 3071 rays returned, the functional fp24 model traced 3072");
+            "sweep point packet=4: 3071 rays returned, the functional model traced 3072");
+}
+
+// --model cycle-e7m23: the image and the reference in e7m23, every point equal to the functional
+// model in e7m23.
+TEST(Sweep, WideDatapathAgainstTheE7m23Model) {
+  RenderSettings s;
+  s.res = {32, 24};
+  const PreparedScene wide = prepare_scene("builtin:room", s, ff::Format{7, 23});
+  const SweepResult r = run_sweep_points({parse_sweep_axis("threads=4,32")}, wide, s);
+  EXPECT_EQ(r.functional_model, "e7m23");
+  ASSERT_EQ(r.points.size(), 2u);
+  EXPECT_GT(r.points[1].speedup, 2.0);
+  EXPECT_EQ(error_of([] {
+              SweepOptions o;
+              o.scene = "builtin:cube";
+              o.model = "fp24";
+              o.vary = {"threads=4"};
+              run_sweep(o);
+            }),
+            "bad --model fp24: a sweep runs cycle or cycle-e7m23");
 }
 
 TEST(Sweep, TableCsvAndJson) {
@@ -181,7 +201,8 @@ TEST(Sweep, TableCsvAndJson) {
   ASSERT_EQ(j["points"].size(), 2u);
   EXPECT_EQ(j["points"][1]["values"]["threads"], "16");
   EXPECT_EQ(j["points"][1]["report"]["cycles"], r.points[1].cycle["cycles"]);
-  EXPECT_TRUE(j["bit_identical_to_functional_fp24"].get<bool>());
+  EXPECT_TRUE(j["bit_identical_to_functional_model"].get<bool>());
+  EXPECT_EQ(j["functional_model"], "fp24");
 }
 
 TEST(SaarcorBinary, SweepEndToEndAndBadInput) {
