@@ -147,7 +147,8 @@ class UnitTap {
   // One ray's lane of an inner kd-node step (traversal_lane's operands and results).
   virtual void traversal(F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far,
                          F near_tf, F far_tn) = 0;
-  // One matrix-vector step of an object or triangle transformation (transform_step).
+  // One matrix-vector step of ray generation or of an object or triangle transformation
+  // (transform_step).
   virtual void transformation(const Mat34<F>& m, const Vec3<F>& in, bool translate,
                               const Vec3<F>& out) = 0;
   // One ray's unit-triangle intersection (intersect_unit_triangle).
