@@ -23,14 +23,9 @@ namespace {
 using testing::build;
 using testing::configs;
 using testing::expect_bit_exact;
+using testing::kSanitized;
 using testing::scene_cases;
 using testing::SceneCase;
-
-#ifdef SAARCOR_SANITIZED
-constexpr bool kSanitized = true;  // the ASan/UBSan build: smaller frames, fewer runs
-#else
-constexpr bool kSanitized = false;
-#endif
 
 class BitExact : public ::testing::TestWithParam<int> {};
 

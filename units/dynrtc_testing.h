@@ -16,6 +16,12 @@
 
 namespace saarcor::units::testing {
 
+#ifdef SAARCOR_SANITIZED
+constexpr bool kSanitized = true;  // the ASan/UBSan build: smaller frames, fewer runs
+#else
+constexpr bool kSanitized = false;
+#endif
+
 inline host::BuiltImage build(const std::string& spec, int w, int h, std::uint32_t bank_mb = 4) {
   const host::Scene scene = host::load_scene(spec);
   host::ImageParams ip;

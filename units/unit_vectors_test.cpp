@@ -14,6 +14,7 @@ namespace saarcor::units {
 namespace {
 
 using testing::build;
+using testing::kSanitized;
 
 constexpr std::uint32_t kOne = 0x3F0000;      // 1.0 in fp24 (bias 63)
 constexpr std::uint32_t kQuarter = 0x3D0000;  // 0.25
@@ -45,12 +46,6 @@ TEST(UnitVectors, CapturedVectorsAreTheDatapathsAnswers) {
     }
   }
 }
-
-#ifdef SAARCOR_SANITIZED
-constexpr bool kSanitized = true;  // the ASan/UBSan build: smaller frames, fewer vectors
-#else
-constexpr bool kSanitized = false;
-#endif
 
 // Every scene of the covering design (units/dynrtc_testing.h): 2,000 vectors per unit, each
 // recomputed on encodings, so the functional model's binary64 fast paths and the datapath the
