@@ -294,6 +294,12 @@ void fill_scene_stats(BuiltImage& b) {
 
 // ---- top level -----------------------------------------------------------------------------
 
+// The top level's depth limit: its own (automatic or set), sized for every instance the scene
+// has, so that a per-frame rebuild keeps the budget the bottom trees were built for.
+int top_level_depth(const ImageParams& p, std::size_t instances) {
+  return std::min(kd_max_depth(p.kd, instances), p.stack_entries - 1);
+}
+
 void build_top_level(BuiltImage& b) {
   std::vector<Aabb> boxes;
   std::vector<std::uint32_t> which;
@@ -308,6 +314,7 @@ void build_top_level(BuiltImage& b) {
   } else {
     KdBuildParams top = b.params.kd;
     top.intersection_cost *= b.params.top_item_cost_factor;
+    top.max_depth = top_level_depth(b.params, b.instances.size());
     b.top = build_kdtree(std::span<const Aabb>(boxes), top);
     for (std::uint32_t& item : b.top.items)
       item = which.at(item);
@@ -642,6 +649,9 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
     throw std::runtime_error("top-level item cost factor " +
                              std::to_string(params.top_item_cost_factor) +
                              " must be positive and finite");
+  if (params.stack_entries < 2 || params.stack_entries > 4096)
+    throw std::runtime_error("traversal stack of " + std::to_string(params.stack_entries) +
+                             " entries is outside 2..4096");
   BuiltImage b;
   b.params = params;
   b.params.kd.split_format = params.format;
@@ -704,9 +714,14 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
     if (info.dropped == n) {
       info.tree = empty_tree();
     } else {
+      // Top + bottom must fit the traversal stack (both levels share it).
+      KdBuildParams kd = b.params.kd;
+      kd.max_depth =
+          std::min(kd_max_depth(kd, n - info.dropped),
+                   params.stack_entries - top_level_depth(params, scene.instances.size()));
       info.tree = build_kdtree(std::span<const glm::vec3>(obj.positions),
                                std::span<const glm::uvec3>(obj.triangles),
-                               std::span<const std::uint8_t>(skip), b.params.kd);
+                               std::span<const std::uint8_t>(skip), kd);
     }
     const double secs = seconds_since(t0);
     b.stats.bottom_build_seconds += secs;

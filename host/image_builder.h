@@ -35,6 +35,10 @@ struct ImageParams {
   // visit: a transformation like a triangle test's, a 6-cycle box clip, the bottom tree's descent
   // and its own triangle tests, about 16 triangle tests' worth (docs/kdtree.md, "Top level").
   float top_item_cost_factor = 16.0f;
+  // Traversal stack entries per packet in the hardware (the prototype's 64, shared by both
+  // levels): the top level's depth limit plus every bottom tree's must fit it, so the builder
+  // caps the bottom trees' depth at stack_entries minus the top's (docs/kdtree.md).
+  int stack_entries = 64;
   int width = 512;
   int height = 384;
   int camera = -1;  // index into Scene::cameras; -1 = scene_camera() (first camera, else default)

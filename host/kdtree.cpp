@@ -306,7 +306,7 @@ class Builder {
                  float lhi[3], float rlo[3], float rhi[3]) const;
   void add_clipped(std::uint32_t id, const float lo[3], const float hi[3], std::vector<Key>* out);
 
-  const KdBuildParams& p_;
+  KdBuildParams p_;  // a copy: run() resolves the automatic depth limit
   SplitGrid grid_;
   KdTree& tree_;
 
@@ -339,9 +339,9 @@ const KdBuildParams& Builder::checked(const KdBuildParams& p) {
       !(p.empty_bonus > 0.0f && p.empty_bonus <= 1.0f))
     throw std::runtime_error(
         "kd-tree: cost parameters need traversal >= 0, intersection > 0, 0 < empty bonus <= 1");
-  if (p.max_depth < 0 || p.max_depth > 1000)
+  if ((p.max_depth < 0 && p.max_depth != KdBuildParams::kAutoDepth) || p.max_depth > 1000)
     throw std::runtime_error("kd-tree: max depth " + std::to_string(p.max_depth) +
-                             " outside 0..1000");
+                             " outside 0..1000 (or -1: automatic)");
   if (p.leaf_size < 0)
     throw std::runtime_error("kd-tree: negative leaf size " + std::to_string(p.leaf_size));
   if (p.binned_above < 0)
@@ -459,6 +459,7 @@ void Builder::run() {
   tree_.bounds.lo = glm::vec3(root_.lo[0], root_.lo[1], root_.lo[2]);
   tree_.bounds.hi = glm::vec3(root_.hi[0], root_.hi[1], root_.hi[2]);
   const std::size_t n = items_.top_;
+  p_.max_depth = kd_max_depth(p_, item_count_);
   min_half_area_ = half_area(root_) * kMinAreaShare;
   bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n));
 }
@@ -869,7 +870,7 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
       pending = 0;
       np = 0;
     }
-    face_slabs(box, k, sum, prod, b[k], e[k], n, inv_area, face);
+    if (p_.face_slabs) face_slabs(box, k, sum, prod, b[k], e[k], n, inv_area, face);
   }
   // A face slab wins when it is cheaper, and also when no other plane beats the leaf but the slab
   // lies within the slack (build_node applies the slack to it).
@@ -1367,6 +1368,24 @@ KdTree build_kdtree(std::span<const Aabb> boxes, const KdBuildParams& params) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   tree.stats = compute_kdtree_stats(tree, params);
   return tree;
+}
+
+}  // namespace saarcor::host
+
+namespace saarcor::host {
+
+int kd_auto_max_depth(std::size_t items) {
+  int log2 = 0;
+  while (items > 1) {
+    items >>= 1;
+    ++log2;
+  }
+  return static_cast<int>(std::lround(8.0 + 1.3 * log2));
+}
+
+int kd_max_depth(const KdBuildParams& params, std::size_t items) {
+  return params.max_depth == KdBuildParams::kAutoDepth ? kd_auto_max_depth(items)
+                                                       : params.max_depth;
 }
 
 }  // namespace saarcor::host

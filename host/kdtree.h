@@ -32,12 +32,25 @@ struct Aabb {
 };
 
 struct KdBuildParams {
-  // Wald & Havran's cost model defaults.
-  float traversal_cost = 15.0f;
+  // Costs in the DynRTP's terms (docs/kdtree.md "Costs for this hardware"): a traversal step is a
+  // traversal-unit cycle, a triangle test P + 1 transformation cycles on another unit running
+  // in parallel. 30 : 20 balances the two units' SAH-expected loads on the room and keeps large
+  // meshes under 4 nodes per triangle (Wald & Havran's software defaults were 15 : 20 with an
+  // empty-space bonus of 0.8, which made long chains of empty cuts).
+  float traversal_cost = 30.0f;
   float intersection_cost = 20.0f;
-  float empty_bonus = 0.8f;  // cost factor for a split that cuts off empty space
-  int max_depth = 24;        // per level; top + bottom must fit the 64-entry traversal stack
-  int leaf_size = 0;         // never split a node with this many items or fewer (0: SAH decides)
+  float empty_bonus = 1.0f;  // cost factor for a split that cuts off empty space
+  // Nodes at this depth are leaves (root = depth 0). kAutoDepth: 8 + 1.3 * floor(log2 N) for N
+  // items (pbrt's and Mitsuba's rule), so a small object is not cut down to slivers and a large
+  // one may go deeper. Per level; the image builder caps it so that top + bottom fit the
+  // traversal stack (docs/kdtree.md "Depth and the stack").
+  int max_depth = kAutoDepth;
+  static constexpr int kAutoDepth = -1;
+  int leaf_size = 0;  // never split a node with this many items or fewer (0: SAH decides)
+  // Face slabs (docs/kdtree.md): planes a thin slab inside a node face that peel items lying in
+  // the face (walls) off the interior, so rays crossing the face's leaves do not meet the wall's
+  // triangles in each (the triangle mailbox only saves the repeats within one packet).
+  bool face_slabs = true;
   // Hybrid build (docs/kdtree.md): a node with more than `binned_above` items is split by binned
   // SAH over its items' clipped bounds (`bins` bins per axis, plus the two empty-space planes at
   // the items' bounds); a subtree at or below it by Wald & Havran's exact event sweep. A huge
@@ -96,6 +109,10 @@ KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params
 // flushed): the builder rounds item bounds outward with these, so every candidate plane is a
 // stored plane. KdTree::bounds is rounded outward the same way.
 float kd_split_round_down(float v, const ff::Format& f);
+// The automatic depth limit for `items` items: round(8 + 1.3 * floor(log2 items)), 8 for 0 or 1.
+int kd_auto_max_depth(std::size_t items);
+// The depth limit a build over `items` items uses: params.max_depth, or the automatic one.
+int kd_max_depth(const KdBuildParams& params, std::size_t items);
 float kd_split_round_up(float v, const ff::Format& f);
 
 }  // namespace saarcor::host
