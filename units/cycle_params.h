@@ -20,12 +20,14 @@ inline const char* cache_unit_name(CacheUnit c) {
 }
 
 struct CycleParams {
-  int pipelines = 0;          // DynRTPs sharing the memory controller (D44)
-  int threads = 0;            // threads per DynRTP (D24)
-  int packet = 0;             // rays per packet
-  int stack = 0;              // traversal stack entries per packet (D26)
-  int mailbox = 0;            // object mailbox entries per thread (D28)
-  bool shared_origin = true;  // the n+1 transformation rule (D31)
+  int pipelines = 0;           // DynRTPs sharing the memory controller (D44)
+  int threads = 0;             // threads per DynRTP (D24)
+  int packet = 0;              // rays per packet
+  int stack = 0;               // traversal stack entries per packet (D26)
+  int mailbox = 0;             // object mailbox entries per thread (D28)
+  int triangle_mailbox = 0;    // triangle mailbox entries per thread (the list unit, bottom level)
+  bool shared_origin = true;   // the n+1 transformation rule (D31)
+  bool clip_exit_only = true;  // box clips of packets starting inside the box: exit faces only
   struct Cache {
     int items = 0;
     int ways = 0;

@@ -515,6 +515,8 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   fp.packet = p.packet;
   fp.stack_depth = p.stack;
   fp.mailbox = p.mailbox;
+  fp.triangle_mailbox = p.triangle_mailbox;
+  fp.clip_exit_only = p.clip_exit_only;
   fp.shared_origin = p.shared_origin;
   // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
   // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.

@@ -24,13 +24,16 @@ struct UnitStats {
   std::uint64_t traversal_steps = 0;
   std::uint64_t inner_steps = 0;
   std::uint64_t clip_steps = 0;
+  std::uint64_t clips = 0;            // box clips (scene and object boxes)
+  std::uint64_t exit_only_clips = 0;  // of them, exit faces only (3 steps)
   std::uint64_t list_steps = 0;
   std::uint64_t transformation_steps = 0;
   std::uint64_t shading_transformation_steps = 0;
   std::uint64_t intersection_packets = 0;
   std::uint64_t sub_packets = 0;
-  std::uint64_t packets = 0;   // primary packets handed out by the RGC
-  std::uint64_t requests = 0;  // thread-program requests served (all units)
+  std::uint64_t stack_drops = 0;  // stack entries dropped at the pop (every ray terminated)
+  std::uint64_t packets = 0;      // primary packets handed out by the RGC
+  std::uint64_t requests = 0;     // thread-program requests served (all units)
 };
 
 struct FunctionalFrame {
@@ -103,11 +106,14 @@ void collect_frame(FunctionalFrame& frame, const PipelineUnits<F>& u, FrameSink&
   s.traversal_steps = u.traversal_steps;
   s.inner_steps = u.inner_steps;
   s.clip_steps = u.clip_steps;
+  s.clips = u.clips;
+  s.exit_only_clips = u.exit_only_clips;
   s.list_steps = u.list_steps;
   s.transformation_steps = u.transformation_steps;
   s.shading_transformation_steps = u.shading_transformation_steps;
   s.intersection_packets = u.intersection_packets;
   s.sub_packets = u.sub_packets;
+  s.stack_drops = u.stack_drops;
   frame.by_kind = sink.by_kind;
   frame.rays_issued = sink.rays_issued;
   frame.rays_returned = sink.rays_returned;

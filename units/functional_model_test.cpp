@@ -139,6 +139,9 @@ TEST(FunctionalModel, PacketWidthNeverChangesResults) {
   const host::BuiltImage b = build("builtin:room", kW, kH);
   FunctionalParams p;
   p.packet = 1;
+  // The triangle mailbox holds 8 triangles per packet: a wider packet evicts sooner, so its rays
+  // test some triangles again (results equal, per-ray counters not).
+  p.triangle_mailbox = 0;
   const FunctionalFrame f1 = run_functional<F>(b.image, p);
   for (int packet : {2, 4, 16, 64}) {
     p.packet = packet;
@@ -163,6 +166,7 @@ TEST(FunctionalModel, StackAndMailboxSizesNeverChangeResults) {
   // The mailbox only saves work: without it the rays fetch at least as many list entries.
   q = p;
   q.mailbox = 0;
+  q.triangle_mailbox = 0;
   const FunctionalFrame no_mb = run_functional<F>(b.image, q);
   EXPECT_EQ(no_mb.by_kind[0].mailbox_skips, 0u);
   EXPECT_GE(no_mb.by_kind[0].transformations, ref.by_kind[0].transformations);
@@ -218,11 +222,18 @@ TEST(FunctionalModel, OpCountsPerUnitFollowTable2) {
   const UnitStats& u = fr.units;
   const std::uint64_t P = 4;
   // Traversal: per inner step P add, P div, 3P cmp; leaf/empty steps P cmp (the termination
-  // check); box-face clip steps P add, P div, P cmp, plus P cmp on each box's last face.
+  // check); box-face clip steps P add, P div, P cmp, plus P cmp on each box's last face and 2P
+  // (origin against the box) on the first step of an exit-only clip; P cmp per stack entry
+  // dropped at the pop (its rays' termination test).
   EXPECT_EQ(u.traversal_ops.add, P * (u.inner_steps + u.clip_steps));
   EXPECT_EQ(u.traversal_ops.div, P * (u.inner_steps + u.clip_steps));
   EXPECT_EQ(u.traversal_ops.cmp, 3 * P * u.inner_steps + P * (u.traversal_steps - u.inner_steps) +
-                                     P * u.clip_steps + P * (u.clip_steps / 6));
+                                     P * u.clip_steps + P * u.clips + 2 * P * u.exit_only_clips +
+                                     P * u.stack_drops);
+  // Clip steps: 6 per box, 3 when every ray starts inside it.
+  EXPECT_EQ(u.clip_steps, 6 * u.clips - 3 * u.exit_only_clips);
+  EXPECT_GT(u.exit_only_clips, 0u) << "the room's camera is inside the scene box";
+  EXPECT_GT(u.stack_drops, 0u);
   EXPECT_EQ(u.traversal_ops.mul, 0u);
   // Transformation: 9 mul, 9 add per step.
   EXPECT_EQ(u.transformation_ops.mul, 9 * u.transformation_steps);

@@ -32,13 +32,16 @@ struct FunctionalParams {
   int packet = 4;             // P rays per packet (thread); a power of two, 1..64
   int stack_depth = 64;       // traversal stack entries per packet (D26)
   int mailbox = 8;            // object mailbox entries per thread (D28), 0 = off
-  int triangle_mailbox = 0;   // triangle mailbox entries (D28 option), 0 = off
+  int triangle_mailbox = 8;   // triangle mailbox entries (bottom-level lists), 0 = off
   bool shared_origin = true;  // the n+1 rule for packets with one origin (D31)
-  bool shade = true;          // run the RGS; false leaves the image black (hit records only)
-  bool shadows = false;       // shadow rays (docs/shading.md 6.4); Table 3 setting: off
-  bool secondary = false;     // reflection and transparency rays; Table 3 setting: off
-  int max_depth = -1;         // secondary-ray depth bound, -1 = FrameRegisters::max_depth
-  ff::Mode mode{};            // rounding of every FP unit
+  // Box clips: when every ray of the packet starts inside the box, its entry faces cannot raise
+  // tn above 0, so the traversal unit divides for the three exit faces only (3 steps, not 6).
+  bool clip_exit_only = true;
+  bool shade = true;       // run the RGS; false leaves the image black (hit records only)
+  bool shadows = false;    // shadow rays (docs/shading.md 6.4); Table 3 setting: off
+  bool secondary = false;  // reflection and transparency rays; Table 3 setting: off
+  int max_depth = -1;      // secondary-ray depth bound, -1 = FrameRegisters::max_depth
+  ff::Mode mode{};         // rounding of every FP unit
 };
 
 // Work counted per ray (DESIGN.md section 5; issue 4).
@@ -191,11 +194,14 @@ class PipelineUnits {
   std::uint64_t traversal_steps = 0;       // kd-node steps (inner + leaf + empty)
   std::uint64_t inner_steps = 0;           // steps on inner nodes (P add, P div, 3P cmp)
   std::uint64_t clip_steps = 0;            // box-face steps (P add, P div, P (+P) cmp)
+  std::uint64_t clips = 0;                 // box clips (scene box or object box)
+  std::uint64_t exit_only_clips = 0;       // of them, exit faces only (origins inside the box)
   std::uint64_t list_steps = 0;            // list entries fetched
   std::uint64_t transformation_steps = 0;  // ray transformation steps (generation, object, tri)
   std::uint64_t shading_transformation_steps = 0;  // normal and dot-product steps of the RGS
   std::uint64_t intersection_packets = 0;          // packets intersected (P rays each)
   std::uint64_t sub_packets = 0;  // masked sub-packets from mixed direction signs (D27)
+  std::uint64_t stack_drops = 0;  // stack entries dropped at the pop: every ray terminated
 };
 
 // Where a thread's results go: the frame the RGC hands pixels from.
@@ -775,18 +781,41 @@ class ThreadProgram {
       v_.clip_tn[static_cast<std::size_t>(i)] = 0.0;
       v_.clip_tf[static_cast<std::size_t>(i)] = v_.t_best[static_cast<std::size_t>(i)];
     }
+    // Faces in the order x entry, x exit, y entry, ...: the exit faces alone (odd faces) when every
+    // ray starts inside the box (the comparators decide it with the first step).
+    clip_stride_ = params_.clip_exit_only && origins_inside_box() ? 2 : 1;
+    clip_face_ = clip_stride_ - 1;
+    ++u_.clips;
+    u_.exit_only_clips += clip_stride_ == 2 ? 1 : 0;
+  }
+
+  // True when every ray of the clip mask has its origin in the level's box (closed): its entry
+  // distances are then <= 0 (or NaN, which keeps the bound) and leave tn at 0.
+  bool origins_inside_box() const {
+    for (std::uint64_t m = clip_mask_; m != 0; m &= m - 1) {
+      const Lane& l = lanes_[static_cast<std::size_t>(std::countr_zero(m))];
+      for (std::size_t k = 0; k < 3; ++k) {
+        const double o = value(l.current.o[k]);
+        if (!(o >= value(box_lo_[k]) && o <= value(box_hi_[k]))) return false;
+      }
+    }
+    return true;
   }
 
   void do_clip() {
     ++u_.clip_steps;
     const auto lanes = static_cast<std::uint64_t>(p_);
     // Per lane 1 add, 1 div, 1 cmp; the last face 1 more cmp (the empty-segment test).
-    PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, clip_face_ == 5 ? 2 * lanes : lanes);
-    // The six face steps only change the lanes' clipped segments, which nothing reads before the
-    // last face; so the first step computes all six (per lane in face order, the same results)
-    // and saves five passes over the packet.
-    if (clip_face_ == 0) clip_box();
-    if (++clip_face_ < 6) return;
+    // With exit faces only, 2 more cmp per lane in the first step (origin against the box).
+    const std::uint64_t cmp = (clip_face_ == 5 ? 2 * lanes : lanes) +
+                              (clip_stride_ == 2 && clip_face_ == 1 ? 2 * lanes : 0);
+    PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, cmp);
+    // The face steps only change the lanes' clipped segments, which nothing reads before the
+    // last face; so the first step computes all six (per lane in face order, the same results:
+    // a skipped entry face leaves tn at 0) and saves the other passes over the packet.
+    if (clip_face_ == clip_stride_ - 1) clip_box();
+    clip_face_ += clip_stride_;
+    if (clip_face_ < 6) return;
     // Last face: a ray misses the box when its segment is empty (1 cmp per lane). Sign groups:
     // rays with equal direction signs share one front-to-back order (D27). Groups in increasing
     // sign-pattern order; each is a masked sub-packet traversed to the end.
@@ -1009,6 +1038,16 @@ class ThreadProgram {
       while (stack_size_ > stack_base_ && (stack_mask_[stack_size_ - 1] & ~done) == 0)
         --stack_size_;
     }
+    // Early termination at the pop (paper section 3.1): the entry holds each ray's tn, so the
+    // node-entry test (t_best < tn) runs on the stack's values before any node fetch, and an
+    // entry whose rays have all terminated is dropped without a traversal step. The same lanes
+    // terminate as at node entry, so every result is unchanged; what is saved is one node fetch
+    // and one traversal slot per entry left behind a hit.
+    while (stack_size_ > stack_base_ && entry_terminated(stack_size_ - 1)) {
+      --stack_size_;
+      ++u_.stack_drops;
+    }
+    // The compare of the entry popped below is its node-entry test, counted with its step.
     if (stack_size_ == stack_base_) return finish_group();
     --stack_size_;
     node_ = stack_node_[stack_size_];
@@ -1019,6 +1058,18 @@ class ThreadProgram {
     copy_slots(v_.tn.data(), t);
     copy_slots(v_.tf.data(), t + n);
     phase_ = Phase::kTraverse;
+  }
+
+  // True when every lane of stack entry e has its closest hit before the entry's tn.
+  // 1 cmp per lane, counted with the drop (the stack's comparators, not a traversal step).
+  bool entry_terminated(std::size_t e) {
+    const double* tn = &stack_t_[e * 2u * static_cast<std::size_t>(slots_)];
+    for (std::uint64_t m = stack_mask_[e]; m != 0; m &= m - 1) {
+      const auto k = static_cast<std::size_t>(std::countr_zero(m));
+      if (!(v_.t_best[k] < tn[k])) return false;
+    }
+    PipelineUnits<F>::count(u_.traversal_ops, 0, 0, 0, static_cast<std::uint64_t>(p_));
+    return true;
   }
 
   std::uint64_t done_mask() const {
@@ -1534,6 +1585,7 @@ class ThreadProgram {
 
   Level level_ = Level::kTop;
   int clip_face_ = 0;
+  int clip_stride_ = 1;  // 2: exit faces only (every origin inside the box)
   std::uint64_t clip_mask_ = 0;
   std::array<std::uint64_t, 8> groups_{}, top_groups_{};
   std::size_t n_groups_ = 0, top_n_groups_ = 0, group_ = 0, top_group_ = 0;
