@@ -13,7 +13,7 @@ namespace saarcor {
 units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
   units::CycleParams p = units::cycle_preset(opts.preset);
   for (const std::string& kv : opts.set)
-    units::apply_cycle_setting(p, kv);
+    if (!host::is_tree_setting(kv)) units::apply_cycle_setting(p, kv);  // kd.*: the image's
   units::check_cycle_params(p);
   if (opts.host_threads < 0 || opts.host_threads > 2)
     throw std::runtime_error("bad --host-threads " + std::to_string(opts.host_threads) +

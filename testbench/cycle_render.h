@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "host/tree_settings.h"
+
 #include "memif/image_format.h"
 #include "units/dynrtp.h"
 
@@ -23,8 +25,12 @@ struct CycleRenderOptions {
   // 2: the thread programs run on a second host thread ahead of the simulation; 1: inline. 0: 2
   // where the machine has two cores or more. The results are the same.
   int host_threads = 0;
+  // Any option of the cycle model's own (the kd.* keys of --set build the trees of every model).
   bool any_given() const {
-    return preset != "prototype" || !set.empty() || interval != 0 || !vcd.empty() ||
+    bool cycle_keys = false;
+    for (const std::string& kv : set)
+      cycle_keys = cycle_keys || !host::is_tree_setting(kv);
+    return preset != "prototype" || cycle_keys || interval != 0 || !vcd.empty() ||
            host_threads != 0;
   }
 };

@@ -14,6 +14,7 @@
 
 #include "host/float_reference.h"
 #include "host/primary_rays.h"
+#include "host/tree_settings.h"
 #include "testbench/hit_exr.h"
 #include "testbench/image_io.h"
 #include "units/functional_model.h"
@@ -252,11 +253,14 @@ FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene&
   r.counters["units"] = {{"traversal_steps", u.traversal_steps},
                          {"inner_steps", u.inner_steps},
                          {"clip_steps", u.clip_steps},
+                         {"clips", u.clips},
+                         {"exit_only_clips", u.exit_only_clips},
                          {"list_steps", u.list_steps},
                          {"transformation_steps", u.transformation_steps},
                          {"shading_transformation_steps", u.shading_transformation_steps},
                          {"intersection_packets", u.intersection_packets},
                          {"sub_packets", u.sub_packets},
+                         {"stack_drops", u.stack_drops},
                          {"packets", u.packets},
                          {"requests", u.requests}};
   return r;
@@ -282,6 +286,9 @@ FrameResult render_cycle_frame(const ModelSpec& model, const PreparedScene& prep
   r.image.rgb = c.frame.rgb;
   r.rays = c.rays;
   r.cycle = cycle_report_json(c);
+  // The trees are part of the configuration an architect sweeps (kd.* keys).
+  for (const host::TreeSettingInfo& t : host::describe_tree_settings(prep.built.params))
+    r.cycle["configuration"][t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
   r.table4 = table4_text(c, prep.spec);
   r.counters["per_ray"] = r.cycle["per_ray"];
   r.counters["ops"] = {{"traversal", ops_json(c.frame.units.traversal_ops)},
@@ -405,6 +412,8 @@ void build_prepared_image(PreparedScene& p, const RenderSettings& settings, ff::
   ip.height = settings.res.height;
   ip.max_depth = static_cast<std::uint32_t>(settings.depth);
   ip.bank_words = static_cast<std::uint32_t>(std::llround(settings.bank_mb * 262144.0));
+  for (const std::string& kv : settings.cycle.set)
+    if (host::is_tree_setting(kv)) host::apply_tree_setting(ip, kv);
   const auto t0 = Clock::now();
   progress("building the memory image (" + describe_format(format) + ")");
   p.built = host::build_image(p.scene, ip);
@@ -510,7 +519,8 @@ int run_render(const RenderOptions& opts) {
     resolve_cycle_params(opts.cycle);  // a bad --preset/--set fails before the scene loads
   } else if (opts.cycle.any_given()) {
     throw std::runtime_error(
-        "--preset, --set, --interval, --host-threads and --vcd apply to --model cycle only");
+        "--preset, --set (but kd.* keys), --interval, --host-threads and --vcd apply to --model "
+        "cycle only");
   }
   std::optional<PixelCoord> pixel;
   if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
@@ -532,6 +542,13 @@ int run_render(const RenderOptions& opts) {
     std::printf("saarcor render %s --model %s --res %dx%d --time %g\n%s", opts.scene.c_str(),
                 model.name.c_str(), settings.res.width, settings.res.height, settings.time,
                 format_pixel_hit(*pixel, h).c_str());
+    if (model.kind == ModelKind::kFunctional) {
+      // Every unit request of the pixel's packet, in the order the thread program made them.
+      const units::PixelTrace t =
+          units::trace_pixel(prep.built.image, functional_params(settings), pixel->x, pixel->y);
+      for (const std::string& line : t.log)
+        std::printf("  %s\n", line.c_str());
+    }
     return 0;
   }
 

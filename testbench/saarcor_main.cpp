@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
     sub->add_flag("--json", scene_opts.json, "print one JSON object");
     sub->add_option("--export", scene_opts.export_path, "write the scene as glTF (.glb or .gltf)");
     sub->add_option("--bank-mb", scene_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
+    sub->add_option("--set", scene_opts.set, "kd-tree builder key kd.KEY=VALUE (repeatable)");
     sub->callback([&] { status = saarcor::run_scene(scene_opts); });
   }
   saarcor::FloatInfoOptions float_info_opts;

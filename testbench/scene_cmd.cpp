@@ -3,6 +3,7 @@
 // statistics, build times and bytes per bank (issue 3, "Command line").
 #include "testbench/scene_cmd.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "host/image_builder.h"
 #include "host/kdtree.h"
 #include "host/scene.h"
+#include "host/tree_settings.h"
 
 namespace saarcor {
 
@@ -45,8 +47,10 @@ struct Trees {
 };
 
 // The trees without a memory image (used when the image does not fit its banks): the same
-// builder and parameters the image builder uses.
-Trees build_trees_directly(const host::Scene& scene) {
+// builder and parameters the image builder uses (its depth budget and top-level item cost).
+Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& params) {
+  const int top_depth =
+      std::min(host::kd_max_depth(params.kd, scene.instances.size()), params.stack_entries - 1);
   Trees t;
   std::vector<std::uint8_t> used(scene.objects.size(), 0);
   for (const host::Instance& i : scene.instances)
@@ -60,7 +64,12 @@ Trees build_trees_directly(const host::Scene& scene) {
         local[o].grow(obj.positions[obj.triangles[k][v]]);
     }
     if (!used[o]) continue;
-    const host::KdTree tree = host::build_kdtree(obj.positions, obj.triangles, obj.degenerate);
+    host::KdBuildParams kd = params.kd;
+    std::size_t live = 0;
+    for (std::size_t k = 0; k < obj.triangles.size(); ++k)
+      live += obj.degenerate[k] ? 0 : 1;
+    kd.max_depth = std::min(host::kd_max_depth(kd, live), params.stack_entries - top_depth);
+    const host::KdTree tree = host::build_kdtree(obj.positions, obj.triangles, obj.degenerate, kd);
     t.bottom.emplace_back(static_cast<std::uint32_t>(o), tree.stats);
   }
   std::vector<host::Aabb> boxes;
@@ -76,12 +85,16 @@ Trees build_trees_directly(const host::Scene& scene) {
     }
     boxes.push_back(w);
   }
-  t.top = host::build_kdtree(boxes).stats;
+  host::KdBuildParams top = params.kd;
+  top.intersection_cost *= params.top_item_cost_factor;
+  top.max_depth = top_depth;
+  t.top = host::build_kdtree(boxes, top).stats;
   return t;
 }
 
 json bottom_json(const Trees& t, const host::Scene& scene) {
   KdTreeStats sum;
+  std::uint64_t triangles = 0;
   double leaf_items = 0.0;
   std::uint64_t nonempty = 0;
   json per_object = json::array();
@@ -97,6 +110,9 @@ json bottom_json(const Trees& t, const host::Scene& scene) {
     j["object"] = o;
     j["name"] = scene.objects[o].name;
     j["triangles"] = scene.objects[o].triangles.size();
+    j["nodes_per_triangle"] =
+        static_cast<double>(s.nodes) / std::max<double>(1.0, scene.objects[o].triangles.size());
+    triangles += scene.objects[o].triangles.size();
     per_object.push_back(j);
   }
   return json{{"trees", t.bottom.size()},
@@ -104,6 +120,8 @@ json bottom_json(const Trees& t, const host::Scene& scene) {
               {"leaves", sum.leaves},
               {"empty_leaves", sum.empty_leaves},
               {"max_depth", sum.depth},
+              {"nodes_per_triangle", static_cast<double>(sum.nodes) /
+                                         std::max<double>(1.0, static_cast<double>(triangles))},
               {"items_per_leaf", nonempty ? leaf_items / static_cast<double>(nonempty) : 0.0},
               {"build_seconds", sum.build_seconds},
               {"objects", per_object}};
@@ -129,6 +147,8 @@ int run_scene(const SceneOptions& options) {
   const auto t1 = std::chrono::steady_clock::now();
   host::ImageParams params;
   params.bank_words = static_cast<std::uint32_t>(std::llround(options.bank_mb * 262144.0));
+  for (const std::string& kv : options.set)
+    host::apply_tree_setting(params, kv);
   try {
     built = host::build_image(scene, params);
   } catch (const std::runtime_error& e) {
@@ -141,7 +161,7 @@ int run_scene(const SceneOptions& options) {
       if (built->objects[o].stored)
         trees.bottom.emplace_back(static_cast<std::uint32_t>(o), built->objects[o].tree.stats);
   } else {
-    trees = build_trees_directly(scene);
+    trees = build_trees_directly(scene, params);
   }
   const double image_seconds = seconds_since(t1);
 
@@ -212,12 +232,30 @@ int run_scene(const SceneOptions& options) {
   tree_line("kd-tree top", trees.top);
   const json b = j["kdtree"]["bottom"];
   std::printf(
-      "kd-tree bottom      %zu trees, %llu nodes, %llu leaves (%llu empty), max depth %u, %.2f "
-      "items/leaf, %.3f s\n",
+      "kd-tree bottom      %zu trees, %llu nodes (%.2f per triangle), %llu leaves (%llu empty), "
+      "max depth %u, %.2f items/leaf, %.3f s\n",
       trees.bottom.size(), b["nodes"].get<unsigned long long>(),
-      b["leaves"].get<unsigned long long>(), b["empty_leaves"].get<unsigned long long>(),
-      b["max_depth"].get<unsigned>(), b["items_per_leaf"].get<double>(),
-      b["build_seconds"].get<double>());
+      b["nodes_per_triangle"].get<double>(), b["leaves"].get<unsigned long long>(),
+      b["empty_leaves"].get<unsigned long long>(), b["max_depth"].get<unsigned>(),
+      b["items_per_leaf"].get<double>(), b["build_seconds"].get<double>());
+  // Every tree's expectations, largest first (all of them in --json).
+  std::vector<json> objs(b["objects"].begin(), b["objects"].end());
+  std::stable_sort(objs.begin(), objs.end(), [](const json& x, const json& y) {
+    return x["triangles"].get<std::uint64_t>() > y["triangles"].get<std::uint64_t>();
+  });
+  constexpr std::size_t kShown = 8;
+  for (std::size_t i = 0; i < objs.size() && i < kShown; ++i) {
+    const json& o = objs[i];
+    std::printf(
+        "  object %-10u %llu triangles, %.2f nodes per triangle, depth %u, per ray %.2f steps / "
+        "%.2f leaves / %.2f tests\n",
+        o["object"].get<unsigned>(), o["triangles"].get<unsigned long long>(),
+        o["nodes_per_triangle"].get<double>(), o["depth"].get<unsigned>(),
+        o["expected_traversal_steps"].get<double>(), o["expected_leaf_visits"].get<double>(),
+        o["expected_item_tests"].get<double>());
+  }
+  if (objs.size() > kShown)
+    std::printf("  (%zu smaller trees: --json lists every tree)\n", objs.size() - kShown);
   if (built) {
     std::printf("bytes per bank     ");
     for (std::uint64_t v : built->stats.bytes_per_bank)
