@@ -294,12 +294,6 @@ void fill_scene_stats(BuiltImage& b) {
 
 // ---- top level -----------------------------------------------------------------------------
 
-// The top level's depth limit: its own (automatic or set), sized for every instance the scene
-// has, so that a per-frame rebuild keeps the budget the bottom trees were built for.
-int top_level_depth(const ImageParams& p, std::size_t instances) {
-  return std::min(kd_max_depth(p.kd, instances), p.stack_entries - 1);
-}
-
 void build_top_level(BuiltImage& b) {
   std::vector<Aabb> boxes;
   std::vector<std::uint32_t> which;
@@ -633,6 +627,17 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
 
 }  // namespace
 
+// The top level's depth limit: the automatic one for every instance the scene has (so a per-frame
+// rebuild keeps the budget the bottom trees were built for), at most half the traversal stack;
+// kd.max_depth sets the bottom trees' limit (docs/kdtree.md "Depth and the stack").
+int top_level_depth(const ImageParams& p, std::size_t instances) {
+  return std::min(kd_auto_max_depth(instances), p.stack_entries / 2);
+}
+
+int bottom_level_depth(const ImageParams& p, std::size_t triangles, std::size_t instances) {
+  return std::min(kd_max_depth(p.kd, triangles), p.stack_entries - top_level_depth(p, instances));
+}
+
 std::uint64_t ImageStats::scene_bytes() const {
   std::uint64_t n = 0;
   for (int j = 0; j < memif::kSceneBanks; ++j)
@@ -716,9 +721,7 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
     } else {
       // Top + bottom must fit the traversal stack (both levels share it).
       KdBuildParams kd = b.params.kd;
-      kd.max_depth =
-          std::min(kd_max_depth(kd, n - info.dropped),
-                   params.stack_entries - top_level_depth(params, scene.instances.size()));
+      kd.max_depth = bottom_level_depth(params, n - info.dropped, scene.instances.size());
       info.tree = build_kdtree(std::span<const glm::vec3>(obj.positions),
                                std::span<const glm::uvec3>(obj.triangles),
                                std::span<const std::uint8_t>(skip), kd);

@@ -125,6 +125,11 @@ struct BuiltImage {
 // std::runtime_error with one line for a scene that does not fit (naming the bank, the region
 // and the overflow in bytes), a singular or non-affine instance transform, a material or texture
 // index out of range, a non-finite texture coordinate, or a bad camera.
+// The depth limits the builder gives the two levels: the top level's for `instances` instances,
+// and a bottom tree's over `triangles` triangles; their sum fits params.stack_entries.
+int top_level_depth(const ImageParams& params, std::size_t instances);
+int bottom_level_depth(const ImageParams& params, std::size_t triangles, std::size_t instances);
+
 BuiltImage build_image(const Scene& scene, const ImageParams& params = {});
 
 // Bytes a full upload writes: every data word of the scene banks and the shading bank.

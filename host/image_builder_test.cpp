@@ -8,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace saarcor::host {
 namespace {
@@ -276,6 +277,32 @@ TEST(ImageBuilder, GridWithTwoInstances) {
       for (std::uint32_t i : d.leaf_items(n))
         seen.insert(i);
   EXPECT_EQ(seen, (std::set<std::uint32_t>{0, 1}));
+}
+
+// Both levels share the traversal stack (64 entries in the prototype): the top level's depth
+// limit plus every bottom tree's fit it, whatever depth is asked for, so a packet can never
+// overflow the stack (DynRtc's stack overflow error stays unreachable for built images).
+TEST(ImageBuilder, TopAndBottomDepthsFitTheTraversalStack) {
+  const Scene s = grid_two_instances(16);
+  ImageParams p = small_params();
+  const BuiltImage automatic = build_image(s, p);
+  // 512 triangles: 8 + 1.3 * 9 = 19.7, so at most 20 levels below the root.
+  EXPECT_LE(automatic.objects[0].tree.stats.depth, 20u);
+  EXPECT_GT(automatic.objects[0].tree.stats.depth, 6u);
+  std::vector<std::uint32_t> bottom;
+  for (int stack : {4, 9, 12}) {
+    p.stack_entries = stack;
+    p.kd.max_depth = 1000;  // asked for more than the stack holds
+    const BuiltImage b = build_image(s, p);
+    EXPECT_LE(b.top.stats.depth + b.objects[0].tree.stats.depth, static_cast<std::uint32_t>(stack))
+        << stack;
+    bottom.push_back(b.objects[0].tree.stats.depth);
+  }
+  // The stack bounds the trees: a larger one lets the bottom tree go deeper.
+  EXPECT_LT(bottom[0], bottom[1]);
+  EXPECT_LT(bottom[1], bottom[2]);
+  p.stack_entries = 1;
+  EXPECT_THROW(build_image(s, p), std::runtime_error);
 }
 
 TEST(ImageBuilder, BytesPerBankAccounting) {

@@ -1106,3 +1106,22 @@ TEST(KdTree, BadInputIsRefusedWithOneClearLine) {
 
 }  // namespace
 }  // namespace saarcor::host
+
+namespace saarcor::host {
+namespace {
+
+// pbrt's and Mitsuba's depth rule, 8 + 1.3 log2 N, rounded; an explicit limit wins.
+TEST(KdTree, AutomaticDepthLimitFollowsTheItemCount) {
+  EXPECT_EQ(kd_auto_max_depth(0), 8);
+  EXPECT_EQ(kd_auto_max_depth(1), 8);
+  EXPECT_EQ(kd_auto_max_depth(2), 9);
+  EXPECT_EQ(kd_auto_max_depth(806), 20);       // the room: log2 = 9
+  EXPECT_EQ(kd_auto_max_depth(1u << 20), 34);  // a 1M-triangle mesh: 8 + 26
+  KdBuildParams p;
+  EXPECT_EQ(kd_max_depth(p, 806), 20);
+  p.max_depth = 5;
+  EXPECT_EQ(kd_max_depth(p, 806), 5);
+}
+
+}  // namespace
+}  // namespace saarcor::host

@@ -12,8 +12,13 @@ namespace saarcor {
 
 units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
   units::CycleParams p = units::cycle_preset(opts.preset);
-  for (const std::string& kv : opts.set)
-    if (!host::is_tree_setting(kv)) units::apply_cycle_setting(p, kv);  // kd.*: the image's
+  host::ImageParams trees;  // kd.* keys build the image; checked here so they fail early too
+  for (const std::string& kv : opts.set) {
+    if (host::is_tree_setting(kv))
+      host::apply_tree_setting(trees, kv);
+    else
+      units::apply_cycle_setting(p, kv);
+  }
   units::check_cycle_params(p);
   if (opts.host_threads < 0 || opts.host_threads > 2)
     throw std::runtime_error("bad --host-threads " + std::to_string(opts.host_threads) +

@@ -49,8 +49,6 @@ struct Trees {
 // The trees without a memory image (used when the image does not fit its banks): the same
 // builder and parameters the image builder uses (its depth budget and top-level item cost).
 Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& params) {
-  const int top_depth =
-      std::min(host::kd_max_depth(params.kd, scene.instances.size()), params.stack_entries - 1);
   Trees t;
   std::vector<std::uint8_t> used(scene.objects.size(), 0);
   for (const host::Instance& i : scene.instances)
@@ -68,7 +66,7 @@ Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& pa
     std::size_t live = 0;
     for (std::size_t k = 0; k < obj.triangles.size(); ++k)
       live += obj.degenerate[k] ? 0 : 1;
-    kd.max_depth = std::min(host::kd_max_depth(kd, live), params.stack_entries - top_depth);
+    kd.max_depth = host::bottom_level_depth(params, live, scene.instances.size());
     const host::KdTree tree = host::build_kdtree(obj.positions, obj.triangles, obj.degenerate, kd);
     t.bottom.emplace_back(static_cast<std::uint32_t>(o), tree.stats);
   }
@@ -87,7 +85,7 @@ Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& pa
   }
   host::KdBuildParams top = params.kd;
   top.intersection_cost *= params.top_item_cost_factor;
-  top.max_depth = top_depth;
+  top.max_depth = host::top_level_depth(params, scene.instances.size());
   t.top = host::build_kdtree(boxes, top).stats;
   return t;
 }

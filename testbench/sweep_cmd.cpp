@@ -3,9 +3,11 @@
 
 #include <cinttypes>
 #include <cstdio>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
+#include "host/tree_settings.h"
 #include "testbench/compare.h"
 #include "testbench/cycle_render.h"
 #include "testbench/image_io.h"
@@ -119,15 +121,31 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
   r.functional_model = wide ? "e7m23" : "fp24";
   const ModelSpec cycle = parse_model(wide ? "cycle-e7m23" : "cycle");
   progress("functional " + r.functional_model + " model: the reference frame");
-  const FrameResult reference = render_model(parse_model(r.functional_model), prepared, settings);
+  FrameResult reference = render_model(parse_model(r.functional_model), prepared, settings);
   r.functional_rays = reference.rays;
+  // A point that varies kd.* keys has its own trees: its image is rebuilt, and its functional
+  // reference frame rendered on it (points in a row with the same trees share both).
+  std::optional<PreparedScene> rebuilt;
+  std::string trees_of_rebuilt;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::string where = join_words(points[i]);
     progress("point " + std::to_string(i + 1) + " / " + std::to_string(points.size()) + ": " +
              where);
     RenderSettings s = settings;
     s.cycle.set.insert(s.cycle.set.end(), points[i].begin(), points[i].end());
-    const FrameResult f = render_model(cycle, prepared, s);
+    std::string trees;
+    for (const std::string& kv : points[i])
+      if (host::is_tree_setting(kv)) trees += kv + " ";
+    if (!trees.empty() && (!rebuilt || trees != trees_of_rebuilt)) {
+      if (!rebuilt) rebuilt = prepared;
+      build_prepared_image(*rebuilt, s, prepared.built.params.format);
+      trees_of_rebuilt = trees;
+      reference = render_model(parse_model(r.functional_model), *rebuilt, s);
+    } else if (trees.empty() && rebuilt) {
+      rebuilt.reset();
+      reference = render_model(parse_model(r.functional_model), prepared, settings);
+    }
+    const FrameResult f = render_model(cycle, rebuilt ? *rebuilt : prepared, s);
     check_sweep_point(f, reference, where);
     SweepPoint p;
     p.settings = points[i];

@@ -114,6 +114,32 @@ TEST(Sweep, EveryPointBitIdenticalToFp24AndTimingFollowsTheThreads) {
   EXPECT_EQ(r.points[1].cycle["rays"], 64 * 48);
 }
 
+// kd.* keys build the trees: a point that varies one gets its own image and its own functional
+// reference frame, and its figures show the other tree (here a deeper one and a shallower one).
+TEST(Sweep, TreeKeysRebuildThePointsImage) {
+  RenderSettings s;
+  s.res = {64, 48};
+  const SweepResult r = run_sweep_points(
+      {parse_sweep_axis("kd.traversal_cost=10,60"), parse_sweep_axis("threads=16,64")}, room(), s);
+  ASSERT_EQ(r.points.size(), 4u);
+  auto steps = [&](std::size_t i) {
+    return r.points[i].cycle["per_ray"]["traversal_steps"].get<double>();
+  };
+  auto tests = [&](std::size_t i) {
+    return r.points[i].cycle["per_ray"]["intersections"].get<double>();
+  };
+  // Cheap steps: a deep tree with few triangle tests; dear steps: the other way round.
+  EXPECT_GT(steps(0), steps(2) + 2.0);
+  EXPECT_LT(tests(0) + 2.0, tests(2));
+  EXPECT_EQ(steps(0), steps(1));  // threads change the timing, not the work
+  EXPECT_EQ(r.points[2].cycle["configuration"]["kd.traversal_cost"]["value"], 60.0);
+  EXPECT_EQ(r.points[0].cycle["configuration"]["kd.traversal_cost"]["value"], 10.0);
+  // A bad tree value fails before any frame, named as the --vary it came from.
+  EXPECT_EQ(
+      error_of([&] { run_sweep_points({parse_sweep_axis("kd.max_depth=12,-5")}, room(), s); }),
+      "bad --vary kd.max_depth=-5: expected -1..1000 levels (sweep point kd.max_depth=-5)");
+}
+
 TEST(Sweep, APointThatDiffersFromFp24IsAnError) {
   RenderSettings s;
   s.res = {64, 48};
