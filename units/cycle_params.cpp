@@ -70,9 +70,9 @@ const std::vector<Binding>& bindings() {
       {{"mem.switch_penalty", 1, "cycles", "bank switch penalty on a shared path (D21)", 0, 100,
         false},
        SAARCOR_FIELD(mem_switch_penalty, int)},
-      {{"mem.scene_paths", 1, "paths",
-        "issue paths over the three scene banks: 1 = one word per cycle from any of them (D21), "
-        "3 = one path per bank",
+      {{"mem.scene_paths", 3, "paths",
+        "issue paths over the three scene banks: 3 = one path per bank, as the prototype's six "
+        "independent SRAM banks (D21), 1 = one word per cycle from any of them",
         1, 3, false},
        SAARCOR_FIELD(mem_scene_paths, int)},
       {{"lat.add", 3, "cycles", "fp adder latency (D7)", 1, 64, false},

@@ -131,6 +131,7 @@ TEST(DynRtc, PipelinesShareTheFrame) {
   // Eight DynRTPs wait on the scene banks' one issue path (D21); a path per bank relieves it.
   CycleParams eight = prototype_params();
   eight.pipelines = 8;
+  eight.mem_scene_paths = 1;
   const CycleFrame shared_path = run_cycle(b.image, eight);
   eight.mem_scene_paths = 3;
   const CycleFrame three_paths = run_cycle(b.image, eight);

@@ -53,7 +53,7 @@ inline const std::vector<Config>& configs() {
        {"pipelines=3", "threads=4", "packet=16", "cache.traversal.items=8",
         "cache.traversal.ways=2", "cache.list.items=8", "cache.list.ways=2",
         "cache.transformation.items=8", "cache.transformation.ways=2"}},
-      {"t16x2-p4-random-lat-3paths", {"pipelines=2", "threads=16", "mem.scene_paths=3"}, false, 7},
+      {"t16x2-p4-random-lat-1path", {"pipelines=2", "threads=16", "mem.scene_paths=1"}, false, 7},
       {"t64-p16-tiny",
        {"packet=16", "cache.traversal.items=8", "cache.list.items=8",
         "cache.transformation.items=8", "mailbox=2"}},
