@@ -178,7 +178,10 @@ const std::vector<Table4Row>& paper_table4() {
 }
 
 const Table4Row* paper_row_for(const std::string& scene) {
-  const std::string name = scene == "builtin:room"      ? "Scene6"
+  // The room is the built-in or its glTF export (scenes/room.glb), wherever it is given from.
+  const bool room =
+      scene == "builtin:room" || std::filesystem::path(scene).filename() == "room.glb";
+  const std::string name = room                         ? "Scene6"
                            : scene == "builtin:suncor"  ? "SunCOR"
                            : scene == "builtin:terrain" ? "Terrain"
                                                         : "";

@@ -10,6 +10,7 @@
 // [subcommand headers]
 #include "testbench/compare.h"
 #include "testbench/float_tools.h"
+#include "testbench/paper_cmd.h"
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
 #include "testbench/scene_cmd.h"
@@ -105,6 +106,22 @@ int main(int argc, char** argv) {
     sub->add_option("--vcd-to", render_opts.cycle.vcd_to, "last cycle of the VCD trace")
         ->capture_default_str();
     sub->callback([&] { status = saarcor::run_render(render_opts); });
+  }
+  saarcor::PaperOptions paper_opts;
+  {
+    auto* sub = app.add_subcommand(
+        "paper", "the paper's Tables 3 and 4: each stand-in's cycle-model row beside the paper's");
+    sub->add_option("--table", paper_opts.table, "3 or 4 (default: both)");
+    sub->add_option("--scale", paper_opts.scale, "divide the tables' resolutions (quick looks)")
+        ->capture_default_str();
+    sub->add_option("--scene", paper_opts.scenes, "only this paper scene (repeatable)");
+    sub->add_option("--references", paper_opts.references,
+                    "folder of the reference glTF models ('' = none)")
+        ->capture_default_str();
+    sub->add_option("--set", paper_opts.set, "cycle model or kd.* key KEY=VALUE (repeatable)");
+    sub->add_option("--csv", paper_opts.csv, "write the rows as CSV");
+    sub->add_option("--json", paper_opts.json, "write the rows and every cycle report as JSON");
+    sub->callback([&] { status = saarcor::run_paper(paper_opts); });
   }
   saarcor::SweepOptions sweep_opts;
   {

@@ -1,0 +1,67 @@
+// `saarcor paper`: the paper's Tables 3 and 4 reproduced side by side. Each stand-in scene runs
+// through the cycle model at the table's setting (Table 3: 512x384, Table 4: 1024x768; primary
+// rays, textured shading, the prototype configuration) and its row is printed beside the paper's
+// with a ratio (model / paper) for every column (docs/fidelity.md).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace saarcor {
+
+// One scene of the paper and what the model runs for it.
+struct PaperScene {
+  std::string paper;       // the paper's name ("Scene6")
+  std::string spec;        // the scene the model renders ("builtin:room", a glTF path)
+  double bank_mb = 4.0;    // SRAM bank size the stand-in needs
+  bool reference = false;  // a model nearest in size, shown for reference, not a stand-in
+};
+
+// The stand-ins (room, terrain, suncor) and, when `references_dir` names a folder holding them,
+// the reference models nearest in size to Office, Quake3 and Conference.
+std::vector<PaperScene> paper_scenes(const std::string& references_dir);
+
+// The paper's Table 3 row for a scene name: SaarCOR and OpenRT fps at 512x384; nullptr if absent.
+struct Table3Row {
+  const char* scene;
+  double triangles;
+  int objects;
+  double saarcor_fps;
+  double openrt_fps;
+};
+const Table3Row* paper_table3_row(const std::string& paper_scene);
+
+// The figures compared, in column order, with their names (JSON/CSV keys).
+struct PaperFigure {
+  const char* key;
+  double model = 0.0;
+  double paper = 0.0;
+};
+// Model figures from a cycle report (cycle_report_json) beside the paper's Table 4 row, whose
+// cycles per packet and Mrays/s follow from its fps at width x height and 4-ray packets.
+std::vector<PaperFigure> table4_figures(const nlohmann::json& cycle, const std::string& paper,
+                                        int width, int height);
+std::vector<PaperFigure> table3_figures(const nlohmann::json& cycle, const std::string& paper,
+                                        int width, int height);
+
+struct PaperOptions {
+  int table = 0;  // 3 or 4; 0 = both
+  int scale = 1;  // divide the tables' resolutions by this (quick looks; the output says so)
+  std::string references = "../shared/scenes";  // folder of the reference models ("" = none)
+  std::vector<std::string> scenes;              // only these paper names (empty = all)
+  std::vector<std::string> set;                 // cycle model --set keys for every run
+  std::string csv;
+  std::string json;
+};
+
+// The result: one entry per table and scene, with the model's whole cycle report.
+nlohmann::json run_paper_tables(const PaperOptions& opts);
+// The side-by-side text (model, paper and ratio lines per scene) and the CSV of a result.
+std::string paper_text(const nlohmann::json& result);
+std::string paper_csv(const nlohmann::json& result);
+
+// Prints the tables; returns 0. Bad input throws std::runtime_error with one line.
+int run_paper(const PaperOptions& opts);
+
+}  // namespace saarcor
