@@ -137,6 +137,10 @@ void put_tree(MemoryImage& im, const KdTree& tree, std::uint32_t node_base, std:
     } else {
       n.axis = h.axis;
       n.child_pair = node_base + h.child;
+      const KdTreeNode& left = tree.nodes[h.child];
+      const KdTreeNode& right = tree.nodes[h.child + 1];
+      n.empty_left = left.leaf && left.count == 0;
+      n.empty_right = right.leaf && right.count == 0;
       n.split = ff::from_double(static_cast<double>(h.split), f, ff::Mode{});
       if (ff::decode(n.split, f, ff::Subnormals::kFlush) != static_cast<double>(h.split))
         throw std::runtime_error("kd-tree split " + std::to_string(h.split) +
@@ -875,6 +879,13 @@ DecodedTree extract_tree(const DecodedImage& d, std::uint32_t root) {
     if (n.axis > 2 || std::uint64_t{n.child_pair} + 1 >= d.nodes.size() || n.child_pair <= k)
       throw std::runtime_error("corrupt image: node " + std::to_string(k) + " has child pair " +
                                std::to_string(n.child_pair) + " outside the tree");
+    for (int side = 0; side < 2; ++side) {
+      const memif::KdNode& c = d.nodes[n.child_pair + static_cast<std::uint32_t>(side)];
+      if ((side == 0 ? n.empty_left : n.empty_right) != (c.leaf && c.count == 0))
+        throw std::runtime_error("corrupt image: node " + std::to_string(k) +
+                                 "'s empty flag of its " + (side == 0 ? "left" : "right") +
+                                 " child disagrees with the child");
+    }
     stack.push_back(n.child_pair + 1);
     stack.push_back(n.child_pair);
   }

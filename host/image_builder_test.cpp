@@ -703,7 +703,7 @@ TEST(DecodeImage, CorruptImagesAreRefused) {
   memif::MemoryImage im = b.image;
   // Point the root's child pair beyond the node region.
   const memif::WordLocation l = im.locate(ItemType::kNode, 0, 0);
-  im.set_word(l.bank, l.offset, 0u | (100000u << 2));
+  im.set_word(l.bank, l.offset, 0u | (100000u << 4));
   try {
     decode_image(im);
     FAIL() << "no error";
@@ -714,6 +714,51 @@ TEST(DecodeImage, CorruptImagesAreRefused) {
   memif::MemoryImage im2 = b.image;
   im2.registers().instance_count = 1000;
   EXPECT_THROW(decode_image(im2), std::runtime_error);
+  // An empty-child flag on a child with items: the traversal would skip geometry.
+  const std::uint32_t root = b.objects[0].node_root;
+  memif::MemoryImage im3 = b.image;
+  memif::KdNode n = im3.node(root);
+  ASSERT_FALSE(n.leaf);
+  const memif::KdNode left = im3.node(n.child_pair);
+  ASSERT_FALSE(left.leaf && left.count == 0);
+  n.empty_left = true;
+  const memif::WordLocation l3 = im3.locate(ItemType::kNode, root, 0);
+  im3.set_word(l3.bank, l3.offset, memif::encode_node(n)[0]);
+  try {
+    decode_image(im3);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("empty flag of its left child disagrees"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// Inner nodes flag their empty children (the traversal never steps into them).
+TEST(ImageBuilder, InnerNodesFlagTheirEmptyChildren) {
+  const BuiltImage b = build_image(grid_two_instances(16), small_params());
+  const DecodedImage d = decode_image(b.image);
+  int flagged = 0;
+  for (const memif::KdNode& n : d.nodes) {
+    if (n.leaf) continue;
+    const memif::KdNode& l = d.nodes[n.child_pair];
+    const memif::KdNode& r = d.nodes[n.child_pair + 1];
+    EXPECT_EQ(n.empty_left, l.leaf && l.count == 0);
+    EXPECT_EQ(n.empty_right, r.leaf && r.count == 0);
+    flagged += n.empty_left + n.empty_right;
+  }
+  EXPECT_GT(flagged, 0);
+  // The encoding keeps the flags apart from the axis and the child pair.
+  memif::KdNode x;
+  x.axis = 2;
+  x.empty_right = true;
+  x.child_pair = memif::kMaxNodeIndex;
+  x.split = 0x123456u;
+  const auto w = memif::encode_node(x);
+  EXPECT_EQ(memif::decode_node(w[0], w[1]), x);
+  x.empty_right = false;
+  x.empty_left = true;
+  EXPECT_EQ(memif::decode_node(memif::encode_node(x)[0], w[1]), x);
 }
 
 }  // namespace

@@ -63,24 +63,30 @@ inline const char* item_type_name(ItemType t) {
   return "?";
 }
 
-// ---- kd-nodes (64 bits, DIGEST D16) ---------------------------------------------------------
-// inner: word0 = axis (0..2) | child_pair << 2 (left child = child_pair, right = child_pair + 1)
-//        word1 = split position (float encoding of the image format)
+// ---- kd-nodes (64 bits, D16) ----------------------------------------------------------------
+// inner: word0 = axis (0..2) | empty_left << 2 | empty_right << 3 | child_pair << 4
+//        (left child = child_pair, right = child_pair + 1), word1 = split position (float
+//        encoding of the image format). The empty flags mark a child that is a leaf without
+//        items: the traversal unit learns it with the parent's fetch and never steps into it.
 // leaf:  word0 = 3 | count << 2, word1 = index of the first list entry
 struct KdNode {
   bool leaf = false;
   std::uint32_t axis = 0;        // inner
+  bool empty_left = false;       // inner: the left child is an empty leaf
+  bool empty_right = false;      // inner: the right child is an empty leaf
   std::uint32_t child_pair = 0;  // inner
   std::uint32_t split = 0;       // inner: float encoding
   std::uint32_t count = 0;       // leaf
   std::uint32_t first = 0;       // leaf: list entry index
   friend bool operator==(const KdNode&, const KdNode&) = default;
 };
-inline constexpr std::uint32_t kMaxNodeIndex = (1u << 30) - 1u;
+inline constexpr std::uint32_t kMaxNodeIndex = (1u << 28) - 1u;
 
 inline std::array<std::uint32_t, 2> encode_node(const KdNode& n) {
   if (n.leaf) return {3u | (n.count << 2), n.first};
-  return {n.axis | (n.child_pair << 2), n.split};
+  return {n.axis | (std::uint32_t{n.empty_left} << 2) | (std::uint32_t{n.empty_right} << 3) |
+              (n.child_pair << 4),
+          n.split};
 }
 inline KdNode decode_node(std::uint32_t w0, std::uint32_t w1) {
   KdNode n;
@@ -90,7 +96,9 @@ inline KdNode decode_node(std::uint32_t w0, std::uint32_t w1) {
     n.first = w1;
   } else {
     n.axis = w0 & 3u;
-    n.child_pair = w0 >> 2;
+    n.empty_left = ((w0 >> 2) & 1u) != 0;
+    n.empty_right = ((w0 >> 3) & 1u) != 0;
+    n.child_pair = w0 >> 4;
     n.split = w1;
   }
   return n;

@@ -261,6 +261,7 @@ FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene&
                          {"intersection_packets", u.intersection_packets},
                          {"sub_packets", u.sub_packets},
                          {"stack_drops", u.stack_drops},
+                         {"empty_leaf_steps", u.empty_leaf_steps},
                          {"packets", u.packets},
                          {"requests", u.requests}};
   return r;

@@ -28,6 +28,7 @@ struct CycleParams {
   int triangle_mailbox = 0;    // triangle mailbox entries per thread (the list unit, bottom level)
   bool shared_origin = true;   // the n+1 transformation rule (D31)
   bool clip_exit_only = true;  // box clips of packets starting inside the box: exit faces only
+  bool skip_empty = true;      // empty children flagged in their parent are never stepped into
   struct Cache {
     int items = 0;
     int ways = 0;

@@ -31,9 +31,10 @@ struct UnitStats {
   std::uint64_t shading_transformation_steps = 0;
   std::uint64_t intersection_packets = 0;
   std::uint64_t sub_packets = 0;
-  std::uint64_t stack_drops = 0;  // stack entries dropped at the pop (every ray terminated)
-  std::uint64_t packets = 0;      // primary packets handed out by the RGC
-  std::uint64_t requests = 0;     // thread-program requests served (all units)
+  std::uint64_t stack_drops = 0;       // stack entries dropped at the pop (every ray terminated)
+  std::uint64_t empty_leaf_steps = 0;  // of traversal_steps, on leaves without items
+  std::uint64_t packets = 0;           // primary packets handed out by the RGC
+  std::uint64_t requests = 0;          // thread-program requests served (all units)
 };
 
 struct FunctionalFrame {
@@ -114,6 +115,7 @@ void collect_frame(FunctionalFrame& frame, const PipelineUnits<F>& u, FrameSink&
   s.intersection_packets = u.intersection_packets;
   s.sub_packets = u.sub_packets;
   s.stack_drops = u.stack_drops;
+  s.empty_leaf_steps = u.empty_leaf_steps;
   frame.by_kind = sink.by_kind;
   frame.rays_issued = sink.rays_issued;
   frame.rays_returned = sink.rays_returned;

@@ -172,6 +172,25 @@ TEST(FunctionalModel, StackAndMailboxSizesNeverChangeResults) {
   EXPECT_GE(no_mb.by_kind[0].transformations, ref.by_kind[0].transformations);
 }
 
+// Empty children flagged in their parent (memif::KdNode) are never stepped into: the same hits
+// and image, and the steps saved are at least the empty-leaf steps the frame took without it.
+TEST(FunctionalModel, SkippingEmptyChildrenSavesTheirStepsOnly) {
+  for (const char* spec : {"builtin:room", "builtin:dynamic"}) {
+    const host::BuiltImage b = build(spec, kW, kH);
+    FunctionalParams on;
+    FunctionalParams off = on;
+    off.skip_empty = false;
+    const FunctionalFrame a = run_functional<F>(b.image, on);
+    const FunctionalFrame c = run_functional<F>(b.image, off);
+    expect_same_frames(c, a, false, std::string(spec) + " skip_empty");
+    EXPECT_EQ(a.units.empty_leaf_steps, 0u) << spec;  // roots are never empty here
+    EXPECT_GT(c.units.empty_leaf_steps, 0u) << spec;
+    EXPECT_GE(c.units.traversal_steps - a.units.traversal_steps, c.units.empty_leaf_steps) << spec;
+    EXPECT_EQ(c.units.inner_steps, a.units.inner_steps) << spec;
+    EXPECT_EQ(c.units.transformation_steps, a.units.transformation_steps) << spec;
+  }
+}
+
 class BruteForce : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(BruteForce, KdTreeHitsWhatTheScanHits) {

@@ -37,6 +37,9 @@ struct FunctionalParams {
   // Box clips: when every ray of the packet starts inside the box, its entry faces cannot raise
   // tn above 0, so the traversal unit divides for the three exit faces only (3 steps, not 6).
   bool clip_exit_only = true;
+  // Children an inner node flags empty (memif::KdNode) are not stepped into: the traversal unit
+  // sees the flags with the parent's fetch, so an empty leaf costs no traversal step.
+  bool skip_empty = true;
   bool shade = true;       // run the RGS; false leaves the image black (hit records only)
   bool shadows = false;    // shadow rays (docs/shading.md 6.4); Table 3 setting: off
   bool secondary = false;  // reflection and transparency rays; Table 3 setting: off
@@ -200,8 +203,9 @@ class PipelineUnits {
   std::uint64_t transformation_steps = 0;  // ray transformation steps (generation, object, tri)
   std::uint64_t shading_transformation_steps = 0;  // normal and dot-product steps of the RGS
   std::uint64_t intersection_packets = 0;          // packets intersected (P rays each)
-  std::uint64_t sub_packets = 0;  // masked sub-packets from mixed direction signs (D27)
-  std::uint64_t stack_drops = 0;  // stack entries dropped at the pop: every ray terminated
+  std::uint64_t sub_packets = 0;       // masked sub-packets from mixed direction signs (D27)
+  std::uint64_t stack_drops = 0;       // stack entries dropped at the pop: every ray terminated
+  std::uint64_t empty_leaf_steps = 0;  // of traversal_steps, on leaves without items
 };
 
 // Where a thread's results go: the frame the RGC hands pixels from.
@@ -936,7 +940,10 @@ class ThreadProgram {
       traversal_steps_[static_cast<std::size_t>(i)] += (active >> i) & 1u;
     if (active == 0) return pop();
     if (node.leaf) {
-      if (node.count == 0) return pop();
+      if (node.count == 0) {
+        ++u_.empty_leaf_steps;
+        return pop();
+      }
       for (std::uint32_t k = 0; k < node.count && k < 8u; ++k)
         scene_.prefetch_list(node.first + k);
       ListCursor& c = level_ == Level::kTop ? top_list_ : bottom_list_;
@@ -1000,6 +1007,11 @@ class ThreadProgram {
       }
     const std::uint32_t near_child = neg ? node.child_pair + 1 : node.child_pair;
     const std::uint32_t far_child = neg ? node.child_pair : node.child_pair + 1;
+    // An empty child is dropped here: its lanes are done with it (same results, no step).
+    const bool skip_near = params_.skip_empty && (neg ? node.empty_right : node.empty_left);
+    const bool skip_far = params_.skip_empty && (neg ? node.empty_left : node.empty_right);
+    if (skip_near) near_mask = 0;
+    if (skip_far) far_mask = 0;
     if (far_mask != 0 && near_mask != 0) {
       push(far_child, far_mask, far_tn);
       // Lanes outside near_mask leave the mask: their tf is not read (LaneValues).
@@ -1007,11 +1019,16 @@ class ThreadProgram {
       node_ = near_child;
       mask_ = near_mask;
     } else if (near_mask != 0) {
+      // A skipped far child: the near segment ends at the plane, as when both are visited.
+      if (skip_far) copy_slots(v_.tf.data(), near_tf.data());
       node_ = near_child;
       mask_ = near_mask;
-    } else {
+    } else if (far_mask != 0) {
+      if (skip_near) copy_slots(v_.tn.data(), far_tn.data());
       node_ = far_child;
       mask_ = far_mask;
+    } else {
+      pop();
     }
   }
 
