@@ -297,7 +297,65 @@ std::string paper_csv(const nlohmann::json& result) {
   return s;
 }
 
+nlohmann::json run_thread_curve(const PaperOptions& opts) {
+  check_options(opts);
+  RenderSettings s = frame_settings("512x384", 0.0, false, 0, 4.0);
+  s.res = {512 / opts.scale, 384 / opts.scale};
+  progress("thread curve: loading builtin:room");
+  const PreparedScene prep = prepare_scene("builtin:room", s);
+  nlohmann::json rows = nlohmann::json::array();
+  double first = 0.0, last = 0.0;
+  for (int t = 1; t <= 64; t *= 2) {
+    RenderSettings st = s;
+    st.cycle.set = opts.set;
+    st.cycle.set.push_back("threads=" + std::to_string(t));
+    progress("thread curve: " + std::to_string(t) + " threads");
+    const FrameResult f = render_model(parse_model("cycle"), prep, st);
+    const double fps = f.cycle["fps"].get<double>();
+    if (t == 1) first = fps;
+    // The paper: nearly linear up to 32 threads, about +10 % from 32 to 64.
+    const double paper_step = t == 1 ? 1.0 : t <= 32 ? 2.0 : 1.10;
+    const double step = t == 1 ? 1.0 : fps / last;
+    rows.push_back({{"threads", t},
+                    {"fps", fps},
+                    {"speedup", fps / first},
+                    {"step", step},
+                    {"paper_step", paper_step},
+                    {"ratio", step / paper_step},
+                    {"usage", f.cycle["usage"]}});
+    last = fps;
+  }
+  return {{"scene", "builtin:room"},
+          {"resolution", std::to_string(s.res.width) + "x" + std::to_string(s.res.height)},
+          {"rows", rows}};
+}
+
+std::string thread_curve_text(const nlohmann::json& curve) {
+  std::string s =
+      "Threads per DynRTP on the room, " + curve["resolution"].get<std::string>() +
+      " (paper section 5: nearly linear speed-up up to 32 threads, about +10 % from 32 to 64)\n"
+      "threads      fps  speed-up  x per doubling  paper  ratio  busiest unit %\n";
+  char buf[160];
+  for (const nlohmann::json& r : curve["rows"]) {
+    double busiest = 0.0;
+    for (const auto& [unit, u] : r["usage"].items())
+      busiest = std::max(busiest, u.get<double>());
+    std::snprintf(buf, sizeof buf, "%7d %8.1f %9.2f %15.2f %6.2f %6.2f %15.0f\n",
+                  r["threads"].get<int>(), r["fps"].get<double>(), r["speedup"].get<double>(),
+                  r["step"].get<double>(), r["paper_step"].get<double>(), r["ratio"].get<double>(),
+                  busiest);
+    s += buf;
+  }
+  return s;
+}
+
 int run_paper(const PaperOptions& opts) {
+  if (opts.threads) {
+    const nlohmann::json curve = run_thread_curve(opts);
+    if (!opts.json.empty()) write_text_file(opts.json, curve.dump(2) + "\n");
+    std::printf("%s", thread_curve_text(curve).c_str());
+    return 0;
+  }
   const nlohmann::json result = run_paper_tables(opts);
   if (!opts.json.empty()) write_text_file(opts.json, result.dump(2) + "\n");
   if (!opts.csv.empty()) write_text_file(opts.csv, paper_csv(result));

@@ -46,8 +46,9 @@ std::vector<PaperFigure> table3_figures(const nlohmann::json& cycle, const std::
                                         int width, int height);
 
 struct PaperOptions {
-  int table = 0;  // 3 or 4; 0 = both
-  int scale = 1;  // divide the tables' resolutions by this (quick looks; the output says so)
+  int table = 0;         // 3 or 4; 0 = both (and the thread curve with `threads`)
+  bool threads = false;  // the room's thread curve 1..64 beside the paper's (section 5)
+  int scale = 1;         // divide the tables' resolutions by this (quick looks; the output says so)
   std::string references = "../shared/scenes";  // folder of the reference models ("" = none)
   std::vector<std::string> scenes;              // only these paper names (empty = all)
   std::vector<std::string> set;                 // cycle model --set keys for every run
@@ -57,6 +58,12 @@ struct PaperOptions {
 
 // The result: one entry per table and scene, with the model's whole cycle report.
 nlohmann::json run_paper_tables(const PaperOptions& opts);
+// The room at the Table 3 setting with 1, 2, 4, ..., 64 threads: fps, speed-up over one thread,
+// and the speed-up of each doubling beside the paper's (x2 up to 32 threads, about x1.10 from 32
+// to 64). `scale` divides the resolution as for the tables.
+nlohmann::json run_thread_curve(const PaperOptions& opts);
+std::string thread_curve_text(const nlohmann::json& curve);
+
 // The side-by-side text (model, paper and ratio lines per scene) and the CSV of a result.
 std::string paper_text(const nlohmann::json& result);
 std::string paper_csv(const nlohmann::json& result);

@@ -101,6 +101,27 @@ TEST(Paper, RoomRowsBesideThePapers) {
   EXPECT_NE(csv.find("4,Scene6,builtin:room,stand-in,64x48,usage_list,"), std::string::npos);
 }
 
+// The thread curve: seven frames, speed-ups over one thread, and the paper's doubling steps.
+TEST(Paper, ThreadCurveBesideThePapers) {
+  PaperOptions o;
+  o.scale = 16;
+  const nlohmann::json c = run_thread_curve(o);
+  ASSERT_EQ(c["rows"].size(), 7u);
+  EXPECT_EQ(c["resolution"], "32x24");
+  const nlohmann::json& rows = c["rows"];
+  EXPECT_EQ(rows[0]["speedup"], 1.0);
+  // One thread to two: latency-bound, so close to twice as fast.
+  EXPECT_GT(rows[1]["step"].get<double>(), 1.8);
+  EXPECT_EQ(rows[5]["paper_step"], 2.0);   // 16 -> 32 threads
+  EXPECT_EQ(rows[6]["paper_step"], 1.10);  // 32 -> 64
+  EXPECT_DOUBLE_EQ(rows[6]["ratio"].get<double>(), rows[6]["step"].get<double>() / 1.10);
+  EXPECT_DOUBLE_EQ(rows[6]["speedup"].get<double>(),
+                   rows[6]["fps"].get<double>() / rows[0]["fps"].get<double>());
+  const std::string text = thread_curve_text(c);
+  EXPECT_NE(text.find("nearly linear speed-up up to 32 threads"), std::string::npos) << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2 + 7);
+}
+
 TEST(Paper, BadInputFailsBeforeAnyFrame) {
   PaperOptions o;
   o.table = 5;

@@ -112,6 +112,8 @@ int main(int argc, char** argv) {
     auto* sub = app.add_subcommand(
         "paper", "the paper's Tables 3 and 4: each stand-in's cycle-model row beside the paper's");
     sub->add_option("--table", paper_opts.table, "3 or 4 (default: both)");
+    sub->add_flag("--threads", paper_opts.threads,
+                  "the room's thread curve 1..64 beside the paper's instead of the tables");
     sub->add_option("--scale", paper_opts.scale, "divide the tables' resolutions (quick looks)")
         ->capture_default_str();
     sub->add_option("--scene", paper_opts.scenes, "only this paper scene (repeatable)");
