@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <stdexcept>
 
+#include "host/aff_loader.h"
 #include "host/builtin_scenes.h"
 #include "host/gltf_loader.h"
 
@@ -263,6 +264,8 @@ Scene load_scene(const std::string& spec) {
   const std::string prefix = "builtin:";
   if (spec.rfind(prefix, 0) == 0) {
     scene = make_builtin_scene(spec.substr(prefix.size()));
+  } else if (spec.ends_with(".aff") || spec.ends_with(".AFF")) {
+    scene = load_aff(spec);
   } else {
     scene = load_gltf(spec);
   }
