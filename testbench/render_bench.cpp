@@ -9,6 +9,12 @@
 //   - Embree: rtcIntersect1 (single ray) on the float reference's world rays, world-space
 //     triangles, high-quality BVH.
 // Targets (issue 4): float reference >= 0.25x Embree's single-ray rate; fp24 >= 0.1x.
+//
+// BM_PaperTable3: the paper's Table 3 compares the prototype (one DynRTP at 90 MHz) with OpenRT
+// on a 2.66 GHz Pentium 4. Its software column becomes Embree's single-ray rate on this host, on
+// the same primary rays of each stand-in (room, terrain, suncor) at 512x384, in the same run as
+// the cycle model's frame: the printout sets the model's speed-up over Embree beside the paper's
+// speed-up over OpenRT (testbench/paper_cmd.h has the tables).
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -23,6 +29,8 @@
 #include "host/float_reference.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "testbench/paper_cmd.h"
+#include "testbench/render_cmd.h"
 #include "units/functional_model.h"
 
 namespace {
@@ -150,12 +158,69 @@ BENCHMARK(BM_Fp24)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);  // like Embree's rate, a mean over frames (one frame alone is the cold one)
 
+// Model fps (simulated, 90 MHz) and Embree single-ray fps (this host, one core) per stand-in.
+struct Table3Measure {
+  std::string paper;
+  double model_fps = 0.0;
+  double embree_fps = 0.0;
+};
+std::vector<Table3Measure> g_table3;
+
+void BM_PaperTable3(benchmark::State& state) {
+  const std::vector<PaperScene> scenes = paper_scenes("");
+  const PaperScene& ps = scenes.at(static_cast<std::size_t>(state.range(0)));
+  state.SetLabel(ps.paper + " (" + ps.spec + ")");
+  RenderSettings settings = frame_settings("512x384", 0.0, false, 0, ps.bank_mb);
+  const PreparedScene prep = prepare_scene(ps.spec, settings);
+  const FrameResult frame = render_model(parse_model("cycle"), prep, settings);
+  const std::vector<host::FloatRay> rays =
+      host::primary_rays(host::to_float(prep.built.basis), 512, 384);
+  // Instanced: SunCOR's 187M triangles cannot be flattened; Embree transforms the rays itself.
+  const host::EmbreeOracle embree(prep.scene, prep.built, host::EmbreeOracle::Mode::kInstanced, 1,
+                                  true);
+  double seconds = 0.0, frames = 0.0;
+  std::uint64_t hits = 0;
+  for (auto _ : state) {
+    const double t0 = cpu_seconds();
+    for (const host::FloatRay& r : rays)
+      hits += embree.intersect(r).hit ? 1u : 0u;
+    seconds += cpu_seconds() - t0;
+    frames += 1.0;
+  }
+  benchmark::DoNotOptimize(hits);
+  Table3Measure m{ps.paper, frame.cycle["fps"].get<double>(), frames / seconds};
+  state.counters["model_fps"] = m.model_fps;
+  state.counters["embree_fps"] = m.embree_fps;
+  g_table3.push_back(m);
+}
+
+BENCHMARK(BM_PaperTable3)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+void print_table3() {
+  if (g_table3.empty()) return;
+  std::printf(
+      "Table 3, 512x384 primary rays: the paper's prototype (90 MHz) over OpenRT (P4 2.66 GHz) "
+      "beside the model (90 MHz) over Embree rtcIntersect1 (this host, one core)\n");
+  std::printf("%-10s %9s %9s %8s | %9s %10s %8s | %s\n", "scene", "SaarCOR", "OpenRT", "speed-up",
+              "model", "Embree", "speed-up", "ratio of speed-ups");
+  for (const Table3Measure& m : g_table3) {
+    const Table3Row* p = paper_table3_row(m.paper);
+    if (p == nullptr) continue;
+    const double paper_up = p->saarcor_fps / p->openrt_fps;
+    const double model_up = m.model_fps / m.embree_fps;
+    std::printf("%-10s %9.1f %9.1f %8.2f | %9.1f %10.1f %8.2f | %.2f\n", m.paper.c_str(),
+                p->saarcor_fps, p->openrt_fps, paper_up, m.model_fps, m.embree_fps, model_up,
+                model_up / paper_up);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
+  print_table3();
   for (const auto& [label, r] : g_rates) {
     const auto get = [&](const char* k) {
       const auto it = r.find(k);
