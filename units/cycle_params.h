@@ -29,6 +29,7 @@ struct CycleParams {
   bool shared_origin = true;   // the n+1 transformation rule (D31)
   bool clip_exit_only = true;  // box clips of packets starting inside the box: exit faces only
   bool skip_empty = true;      // empty children flagged in their parent are never stepped into
+  int clip_faces_per_step = 1;  // box faces divided per clip step (dividers per ray)
   struct Cache {
     int items = 0;
     int ways = 0;

@@ -518,6 +518,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   fp.triangle_mailbox = p.triangle_mailbox;
   fp.clip_exit_only = p.clip_exit_only;
   fp.skip_empty = p.skip_empty;
+  fp.clip_faces_per_step = p.clip_faces_per_step;
   fp.shared_origin = p.shared_origin;
   // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
   // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.

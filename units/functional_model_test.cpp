@@ -191,6 +191,28 @@ TEST(FunctionalModel, SkippingEmptyChildrenSavesTheirStepsOnly) {
   }
 }
 
+// A traversal unit with k dividers per ray clips k faces per step: ceil(6 / k) steps for a whole
+// box, ceil(3 / k) for the exit faces; the same divisions in all, the same results.
+TEST(FunctionalModel, ClipFacesPerStepSetsTheClipSteps) {
+  const host::BuiltImage b = build("builtin:room", kW, kH);
+  const FunctionalFrame one = run_functional<F>(b.image, FunctionalParams{});
+  for (int k : {2, 3, 6}) {
+    FunctionalParams p;
+    p.clip_faces_per_step = k;
+    const FunctionalFrame f = run_functional<F>(b.image, p);
+    expect_same_frames(one, f, false, "clip faces per step " + std::to_string(k));
+    const std::uint64_t full = f.units.clips - f.units.exit_only_clips;
+    const auto steps = [&](int faces) { return static_cast<std::uint64_t>((faces + k - 1) / k); };
+    EXPECT_EQ(f.units.clip_steps, full * steps(6) + f.units.exit_only_clips * steps(3)) << k;
+    EXPECT_EQ(f.units.traversal_ops.div, one.units.traversal_ops.div) << k;
+    EXPECT_EQ(f.units.traversal_ops.cmp, one.units.traversal_ops.cmp) << k;
+    EXPECT_EQ(one.units.traversal_steps, f.units.traversal_steps) << k;  // node steps alike
+  }
+  FunctionalParams bad;
+  bad.clip_faces_per_step = 7;
+  EXPECT_THROW(run_functional<F>(b.image, bad), std::runtime_error);
+}
+
 class BruteForce : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(BruteForce, KdTreeHitsWhatTheScanHits) {

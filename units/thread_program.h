@@ -40,6 +40,9 @@ struct FunctionalParams {
   // Children an inner node flags empty (memif::KdNode) are not stepped into: the traversal unit
   // sees the flags with the parent's fetch, so an empty leaf costs no traversal step.
   bool skip_empty = true;
+  // Box faces a clip step divides for: 1 = one divider per ray (Table 2's 4 dividers for a 4-ray
+  // packet); k > 1 models a traversal unit with k dividers per ray (1..6).
+  int clip_faces_per_step = 1;
   bool shade = true;       // run the RGS; false leaves the image black (hit records only)
   bool shadows = false;    // shadow rays (docs/shading.md 6.4); Table 3 setting: off
   bool secondary = false;  // reflection and transparency rays; Table 3 setting: off
@@ -315,6 +318,9 @@ class ThreadProgram {
     if (p_ > kLanes) throw std::logic_error("thread program: packet wider than its lane capacity");
     if (params.stack_depth < 1)
       throw std::runtime_error("functional model: stack depth must be at least 1");
+    if (params.clip_faces_per_step < 1 || params.clip_faces_per_step > 6)
+      throw std::runtime_error("functional model: clip faces per step " +
+                               std::to_string(params.clip_faces_per_step) + " outside 1..6");
     lanes_.resize(static_cast<std::size_t>(p_));
     surf_.resize(static_cast<std::size_t>(p_));
     stack_node_.resize(static_cast<std::size_t>(params.stack_depth));
@@ -809,17 +815,23 @@ class ThreadProgram {
   void do_clip() {
     ++u_.clip_steps;
     const auto lanes = static_cast<std::uint64_t>(p_);
-    // Per lane 1 add, 1 div, 1 cmp; the last face 1 more cmp (the empty-segment test).
+    // The faces this step divides for: clip_faces_per_step of the sequence (all six, or the
+    // three exit faces), fewer in the last step.
+    const int left = (6 - clip_face_ + clip_stride_ - 1) / clip_stride_;
+    const auto faces = static_cast<std::uint64_t>(std::min(left, params_.clip_faces_per_step));
+    const bool first = clip_face_ == clip_stride_ - 1;
+    const bool last = faces == static_cast<std::uint64_t>(left);
+    // Per lane and face 1 add, 1 div, 1 cmp; the last face 1 more cmp (the empty-segment test).
     // With exit faces only, 2 more cmp per lane in the first step (origin against the box).
-    const std::uint64_t cmp = (clip_face_ == 5 ? 2 * lanes : lanes) +
-                              (clip_stride_ == 2 && clip_face_ == 1 ? 2 * lanes : 0);
-    PipelineUnits<F>::count(u_.traversal_ops, lanes, 0, lanes, cmp);
+    const std::uint64_t cmp =
+        faces * lanes + (last ? lanes : 0) + (clip_stride_ == 2 && first ? 2 * lanes : 0);
+    PipelineUnits<F>::count(u_.traversal_ops, faces * lanes, 0, faces * lanes, cmp);
     // The face steps only change the lanes' clipped segments, which nothing reads before the
     // last face; so the first step computes all six (per lane in face order, the same results:
     // a skipped entry face leaves tn at 0) and saves the other passes over the packet.
-    if (clip_face_ == clip_stride_ - 1) clip_box();
-    clip_face_ += clip_stride_;
-    if (clip_face_ < 6) return;
+    if (first) clip_box();
+    clip_face_ += clip_stride_ * static_cast<int>(faces);
+    if (!last) return;
     // Last face: a ray misses the box when its segment is empty (1 cmp per lane). Sign groups:
     // rays with equal direction signs share one front-to-back order (D27). Groups in increasing
     // sign-pattern order; each is a masked sub-packet traversed to the end.
