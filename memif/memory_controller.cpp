@@ -57,8 +57,11 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
   }
 }
 
-MemoryController::Port& MemoryController::add_port(const std::string& name) {
-  ports_.push_back(std::make_unique<Port>(kernel(), name, config_.port_capacity));
+MemoryController::Port& MemoryController::add_port(const std::string& name, int response_width) {
+  if (response_width < 1)
+    throw std::runtime_error("memory controller '" + this->name() + "': port " + name +
+                             " needs a response width >= 1");
+  ports_.push_back(std::make_unique<Port>(kernel(), name, config_.port_capacity, response_width));
   consumes(ports_.back()->requests);
   produces(ports_.back()->responses);
   return *ports_.back();
@@ -124,7 +127,8 @@ int MemoryController::evaluate() {
   return progress;
 }
 
-// Completed reads leave towards their port, oldest due first; one per port and cycle.
+// Completed reads leave towards their port, oldest due first; per port and cycle as many as its
+// response channel is wide (one but for the routing's port with a wider broadcast).
 int MemoryController::retire_responses() {
   if (inflight_ == 0) return 0;
   int moved = 0;

@@ -5,7 +5,9 @@
 // Model:
 //   * Ports: each client group (the simple routing of the caches, a shading unit, a frame-buffer
 //     writer, the host bus) talks to the controller through one Port: a request channel and a
-//     response channel (latency 1 each: the routing cycle each way of D21).
+//     response channel (latency 1 each: the routing cycle each way of D21). The response channel
+//     is `response_width` responses per cycle wide (add_port; 1 but for the routing's port, which
+//     is as wide as its broadcast) and holds max(port_capacity, 2 x width) responses.
 //   * Intake: per port and cycle at most one request moves into the per-bank queue of its bank
 //     (depth `queue_depth`); a full queue holds the port (head-of-line, back-pressure).
 //   * Banks: six 32-bit SRAM banks reading the MemoryImage. A request of w words occupies its
@@ -22,6 +24,7 @@
 //     and reported as MB/s at the modelled clock (MB = 2^20 bytes, D39).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -52,8 +55,10 @@ class MemoryController : public hw::Module {
     std::string name;
     hw::Channel<MemRequest> requests;    // client pushes, controller pops
     hw::Channel<MemResponse> responses;  // controller pushes, client pops
-    Port(hw::Kernel& k, const std::string& n, int capacity)
-        : name(n), requests(k, n + ".req", capacity, 1), responses(k, n + ".resp", capacity, 1) {}
+    Port(hw::Kernel& k, const std::string& n, int capacity, int response_width = 1)
+        : name(n),
+          requests(k, n + ".req", capacity, 1),
+          responses(k, n + ".resp", std::max(capacity, 2 * response_width), 1, response_width) {}
   };
 
   // Throws std::runtime_error for a bad configuration (one line naming the parameter).
@@ -65,7 +70,9 @@ class MemoryController : public hw::Module {
 
   // Set-up (before the first cycle). A port is a pair of channels; a client is a name bandwidth
   // is counted under (several clients may share one port, e.g. all caches behind the routing).
-  Port& add_port(const std::string& name);
+  // `response_width`: responses the port's client can take per cycle (>= 1; the routing's
+  // broadcast width).
+  Port& add_port(const std::string& name, int response_width = 1);
   std::uint16_t add_client(const std::string& name);
 
   int evaluate() override;

@@ -204,6 +204,46 @@ TEST(MemoryController, ReorderingCutsBankSwitchesOnRandomTraffic) {
               static_cast<unsigned long long>(cycles_reorder));
 }
 
+// A port's response channel is as wide as its client takes (the routing's broadcast width,
+// routing.responses): two reads due in the same cycle reach a 2-wide port together, a 1-wide
+// port one cycle apart.
+TEST(MemoryController, AWideResponsePortTakesSeveralReadsPerCycle) {
+  for (int width : {1, 2}) {
+    MemoryImage img = numbered_image();
+    hw::Kernel k;
+    MemoryControllerConfig cfg;
+    cfg.bank_path = {0, 1, 2, 3, 4, 5};
+    MemoryController mc(k, "ctrl", img, cfg);
+    MemoryController::Port& port = mc.add_port("p", width);
+    const std::uint16_t c = mc.add_client("c");
+    // A 2-word read of bank 3 started at 2 and a 1-word read of bank 4 started at 3: both due at 7.
+    const std::vector<std::pair<std::uint64_t, MemRequest>> script = {{0, read(c, 1, 3, 10, 2)},
+                                                                      {1, read(c, 2, 4, 20, 1)}};
+    std::size_t next = 0;
+    std::vector<std::uint64_t> got;
+    FnModule client(k, "client", [&] {
+      int p = 0;
+      if (next < script.size() && script[next].first <= k.now() && port.requests.can_push()) {
+        port.requests.push(script[next++].second);
+        ++p;
+      }
+      while (port.responses.can_pop()) {
+        port.responses.pop();
+        got.push_back(k.now());
+        ++p;
+      }
+      return p;
+    });
+    k.run_to_completion([&] { return got.size() == 2; }, 100);
+    EXPECT_EQ(got,
+              (width == 1 ? std::vector<std::uint64_t>{8, 9} : std::vector<std::uint64_t>{8, 8}))
+        << width;
+    EXPECT_EQ(port.responses.width(), width);
+    EXPECT_EQ(port.responses.capacity(), 4);  // max(port_capacity 4, 2 x width)
+    EXPECT_THROW(mc.add_port("bad", 0), std::runtime_error);
+  }
+}
+
 TEST(MemoryController, WritesLandInTheImageAndLaterReadsSeeThem) {
   MemoryImage img = numbered_image();
   hw::Kernel k;

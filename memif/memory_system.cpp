@@ -25,7 +25,9 @@ MemorySystem::MemorySystem(hw::Kernel& kernel, MemoryImage& image, const MemoryS
     }
   }
   controller_ = std::make_unique<MemoryController>(kernel, "mi.ctrl", image, config.controller);
-  MemoryController::Port& cache_port = controller_->add_port("mi.ctrl.caches");
+  // The caches' port answers as many responses per cycle as the routing broadcasts.
+  MemoryController::Port& cache_port =
+      controller_->add_port("mi.ctrl.caches", config.responses_per_cycle);
   routing_ =
       std::make_unique<SimpleRouting>(kernel, "mi.routing", cache_port, config.responses_per_cycle);
   pipes_.resize(static_cast<std::size_t>(config.pipelines));

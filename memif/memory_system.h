@@ -30,7 +30,8 @@ struct MemorySystemConfig {
   CacheConfig list_cache{};
   CacheConfig row_cache{};
   MemoryControllerConfig controller{};
-  int responses_per_cycle = 1;  // labelled broadcast width of the simple routing
+  int responses_per_cycle = 1;  // labelled broadcast width of the simple routing (and of the
+                                // controller's response channel to it)
   HostBusConfig host{};
 };
 

@@ -3,9 +3,10 @@
 //
 // Requests: one per cycle from the clients (every cache of every DynRTP) to the controller port,
 // chosen round-robin among the clients that have one (fair: a client waits at most one turn of
-// the others). Responses: up to `responses_per_cycle` per cycle from the controller port, each
-// delivered to the client named by its label (MemResponse::client); a client whose fill channel
-// is full holds the broadcast (head-of-line), as a shared bus would.
+// the others). Responses: up to `responses_per_cycle` per cycle from the controller port (whose
+// response channel MemorySystem makes as wide), each delivered to the client named by its label
+// (MemResponse::client); a client whose fill channel is full or already took a fill this cycle
+// holds the broadcast (head-of-line), as a shared bus would.
 // Latency: one cycle each way in the routing's channels (the client's request channel and its
 // fill channel, both latency 1), plus one each way in the controller's port channels.
 #pragma once

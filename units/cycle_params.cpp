@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "memif/request.h"
+
 namespace saarcor::units {
 namespace {
 
@@ -72,6 +74,18 @@ const std::vector<Binding>& bindings() {
        SAARCOR_FIELD(cache_hit_latency, int)},
       {{"cache.misses", 8, "misses", "outstanding misses per cache (MSHRs, D20)", 1, 256, false},
        SAARCOR_FIELD(cache_misses, int)},
+      {{"cache.merge_targets", 16, "requests",
+        "requests waiting on one outstanding miss, the first included (secondary misses merged "
+        "per MSHR); a full MSHR holds the cache, 1 = no merging",
+        1, 1024, false},
+       SAARCOR_FIELD(cache_merge_targets, int)},
+      {{"cache.request_queue", 4, "entries",
+        "request FIFO from a unit into its cache; full = the unit waits", 1, 256, false},
+       SAARCOR_FIELD(cache_request_queue, int)},
+      {{"cache.memory_queue", 2, "entries",
+        "each cache's memory-request and fill channels to and from the simple routing", 1, 256,
+        false},
+       SAARCOR_FIELD(cache_memory_queue, int)},
       {{"mem.latency", 4, "cycles", "SRAM read latency (D21)", 1, 1000, false},
        SAARCOR_FIELD(mem_latency, int)},
       {{"mem.switch_penalty", 1, "cycles", "bank switch penalty on a shared path (D21)", 0, 100,
@@ -82,6 +96,36 @@ const std::vector<Binding>& bindings() {
         "independent SRAM banks (D21), 1 = one word per cycle from any of them",
         1, 3, false},
        SAARCOR_FIELD(mem_scene_paths, int)},
+      {{"mem.queue_depth", 8, "requests",
+        "requests per bank queue in the memory controller; a full queue holds the port the "
+        "request came from (D23)",
+        1, 1024, false},
+       SAARCOR_FIELD(mem_queue_depth, int)},
+      {{"mem.reorder", 1, "bool",
+        "an issue path keeps serving its open bank to avoid bank switches (D23); 0 = the path's "
+        "oldest request first",
+        0, 1, false},
+       SAARCOR_FIELD(mem_reorder, bool)},
+      {{"mem.max_burst", 8, "starts",
+        "with mem.reorder: starts in a row on a path's open bank while its other banks wait", 1,
+        1024, false},
+       SAARCOR_FIELD(mem_max_burst, int)},
+      {{"mem.port_capacity", 4, "entries",
+        "request and response channel capacity of each memory-controller port (the caches' "
+        "routing, shading, frame buffer, host bus)",
+        2, 256, false},
+       SAARCOR_FIELD(mem_port_capacity, int)},
+      {{"routing.responses", 1, "responses/cycle",
+        "memory responses the simple routing's labelled broadcast delivers per cycle (D23)", 1, 64,
+        false},
+       SAARCOR_FIELD(routing_responses, int)},
+      {{"hostbus.mb_s", 132, "MB/s",
+        "host-bus upload bandwidth, MB = 2^20 bytes (D40: 32-bit PCI at 33 MHz)", 0.001, 1e6,
+        false},
+       SAARCOR_FIELD(hostbus_mb_s, double)},
+      {{"hostbus.burst_words", 4, "words", "words per host-bus write burst into a bank", 1,
+        memif::kMaxRequestWords, false},
+       SAARCOR_FIELD(hostbus_burst_words, int)},
       {{"lat.add", 3, "cycles", "fp adder latency (D7)", 1, 64, false},
        SAARCOR_FIELD(lat_add, int)},
       {{"lat.mul", 3, "cycles", "fp multiplier latency (D7)", 1, 64, false},
@@ -130,8 +174,15 @@ std::string fmt(double v) {
 }
 
 bool integral_param(const Binding& b) {
-  return b.info.name != "clock_mhz";
+  return b.info.name != "clock_mhz" && b.info.name != "hostbus.mb_s";
 }
+
+// Keys whose range check_cycle_params enforces on parameters built in code (--set checks every
+// key's range as it parses).
+constexpr const char* kRangeChecked[] = {
+    "cache.merge_targets", "cache.request_queue", "cache.memory_queue", "mem.queue_depth",
+    "mem.reorder",         "mem.max_burst",       "mem.port_capacity",  "routing.responses",
+    "hostbus.mb_s",        "hostbus.burst_words"};
 
 }  // namespace
 
@@ -204,6 +255,15 @@ void apply_cycle_setting(CycleParams& params, const std::string& key_value) {
 }
 
 void check_cycle_params(const CycleParams& p) {
+  for (const char* key : kRangeChecked) {
+    for (const auto& b : bindings()) {
+      if (b.info.name != key) continue;
+      const double v = b.get(p);
+      if (!std::isfinite(v) || v < b.info.min || v > b.info.max)
+        throw std::runtime_error("bad " + b.info.name + "=" + fmt(v) + ": expected " +
+                                 fmt(b.info.min) + ".." + fmt(b.info.max) + " " + b.info.unit);
+    }
+  }
   for (int c = 0; c < kCacheUnits; ++c) {
     const auto& cc = p.cache[c];
     if (cc.ways > cc.items || cc.items % cc.ways != 0)

@@ -9,6 +9,10 @@
 #include <utility>
 #include <vector>
 
+namespace saarcor::memif {
+struct MemorySystemConfig;
+}
+
 namespace saarcor::units {
 
 // Item caches of the DynRTC by the unit that reads them.
@@ -20,15 +24,15 @@ inline const char* cache_unit_name(CacheUnit c) {
 }
 
 struct CycleParams {
-  int pipelines = 0;           // DynRTPs sharing the memory controller (D44)
-  int threads = 0;             // threads per DynRTP (D24)
-  int packet = 0;              // rays per packet
-  int stack = 0;               // traversal stack entries per packet (D26)
-  int mailbox = 0;             // object mailbox entries per thread (D28)
-  int triangle_mailbox = 0;    // triangle mailbox entries per thread (the list unit, bottom level)
-  bool shared_origin = true;   // the n+1 transformation rule (D31)
-  bool clip_exit_only = true;  // box clips of packets starting inside the box: exit faces only
-  bool skip_empty = true;      // empty children flagged in their parent are never stepped into
+  int pipelines = 0;            // DynRTPs sharing the memory controller (D44)
+  int threads = 0;              // threads per DynRTP (D24)
+  int packet = 0;               // rays per packet
+  int stack = 0;                // traversal stack entries per packet (D26)
+  int mailbox = 0;              // object mailbox entries per thread (D28)
+  int triangle_mailbox = 0;     // triangle mailbox entries per thread (the list unit, bottom level)
+  bool shared_origin = true;    // the n+1 transformation rule (D31)
+  bool clip_exit_only = true;   // box clips of packets starting inside the box: exit faces only
+  bool skip_empty = true;       // empty children flagged in their parent are never stepped into
   int clip_faces_per_step = 1;  // box faces divided per clip step (dividers per ray)
   struct Cache {
     int items = 0;
@@ -39,6 +43,17 @@ struct CycleParams {
   int mem_latency = 0;   // SRAM read latency in cycles (D21)
   int mem_switch_penalty = 0;
   int mem_scene_paths = 0;  // issue paths over the three scene banks: 1 (shared) or 3 (D21)
+  // The memory interface's remaining knobs (docs/memif.md; memif::MemorySystemConfig).
+  int mem_queue_depth = 0;      // requests per bank queue in the memory controller (D23)
+  int mem_max_burst = 0;        // starts in a row on a path's open bank while other banks wait
+  bool mem_reorder = true;      // prefer the open bank (D23); false: oldest request first
+  int mem_port_capacity = 0;    // request and response channel capacity per controller port
+  int cache_merge_targets = 0;  // requests waiting on one outstanding miss, the first included
+  int cache_request_queue = 0;  // unit -> cache request FIFO entries
+  int cache_memory_queue = 0;   // cache <-> routing memory request and fill channel entries
+  int routing_responses = 0;    // responses the routing's labelled broadcast delivers per cycle
+  double hostbus_mb_s = 0.0;    // host-bus upload bandwidth, MB = 2^20 bytes (D40)
+  int hostbus_burst_words = 0;  // words per host-bus write burst
   int lat_add = 0, lat_mul = 0, lat_div = 0, lat_cmp = 0;  // fp unit latencies (D7)
   double clock_mhz = 0.0;
   std::uint64_t watchdog = 0;  // cycles without progress that stop a run
@@ -76,5 +91,8 @@ inline constexpr int kMaxChipThreads = 4096;
 void check_cycle_params(const CycleParams& params);
 // The resolved configuration: every parameter with its current value.
 std::vector<CycleParamInfo> describe(const CycleParams& params);
+// The memory interface the parameters describe (pipelines, caches, controller, routing, host
+// bus): what the cycle model's chip instantiates (units/dynrtp.cpp).
+memif::MemorySystemConfig memory_system_config(const CycleParams& params);
 
 }  // namespace saarcor::units

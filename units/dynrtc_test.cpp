@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <random>
 #include <sstream>
@@ -15,6 +17,7 @@
 
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "memif/memory_system.h"
 #include "units/dynrtc_testing.h"
 
 namespace saarcor::units {
@@ -333,6 +336,67 @@ TEST(DynRtc, ParametersPresetsAndBadSettings) {
   fails("mem.scene_paths=4", "mem.scene_paths");
   fails("pipelines=0", "pipelines");
   fails("pipelines=17", "pipelines");
+  fails("mem.queue_depth=0", "mem.queue_depth");
+  fails("mem.max_burst=0", "mem.max_burst");
+  fails("mem.reorder=2", "mem.reorder");
+  fails("mem.port_capacity=1", "mem.port_capacity");
+  fails("cache.merge_targets=0", "cache.merge_targets");
+  fails("cache.request_queue=0", "cache.request_queue");
+  fails("cache.memory_queue=0", "cache.memory_queue");
+  fails("cache.merge_targets=2.5", "integer");
+  fails("routing.responses=0", "routing.responses");
+  fails("hostbus.mb_s=0", "hostbus.mb_s");
+  fails("hostbus.mb_s=-132", "hostbus.mb_s");
+  fails("hostbus.mb_s=inf", "hostbus.mb_s");
+  fails("hostbus.burst_words=5", "hostbus.burst_words");
+  fails("hostbus.burst_words=0", "hostbus.burst_words");
+  // Every memory-interface key with its default, in the table and the resolved configuration.
+  const std::map<std::string, double> mem_defaults = {
+      {"mem.queue_depth", 8},    {"mem.reorder", 1},          {"mem.max_burst", 8},
+      {"mem.port_capacity", 4},  {"cache.merge_targets", 16}, {"cache.request_queue", 4},
+      {"cache.memory_queue", 2}, {"routing.responses", 1},    {"hostbus.mb_s", 132},
+      {"hostbus.burst_words", 4}};
+  for (const auto& [key, value] : mem_defaults) {
+    int found = 0;
+    for (const CycleParamInfo& i : describe(p))
+      if (i.name == key) {
+        ++found;
+        EXPECT_EQ(i.value, value) << key;
+        EXPECT_FALSE(i.unit.empty()) << key;
+        EXPECT_FALSE(i.help.empty()) << key;
+      }
+    EXPECT_EQ(found, 1) << key;
+  }
+  CycleParams fast = p;
+  apply_cycle_setting(fast, "hostbus.mb_s=266.5");  // fractions are fine for a bandwidth
+  EXPECT_DOUBLE_EQ(fast.hostbus_mb_s, 266.5);
+  // Set in code, out of range: check_cycle_params refuses it in one line naming the key.
+  const auto refused = [](CycleParams r, const std::string& line) {
+    try {
+      check_cycle_params(r);
+      ADD_FAILURE() << line << " accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), line);
+    }
+  };
+  CycleParams bad = p;
+  bad.mem_queue_depth = 0;
+  refused(bad, "bad mem.queue_depth=0: expected 1..1024 requests");
+  bad = p;
+  bad.cache_merge_targets = -1;
+  refused(bad, "bad cache.merge_targets=-1: expected 1..1024 requests");
+  bad = p;
+  bad.routing_responses = 0;
+  refused(bad, "bad routing.responses=0: expected 1..64 responses/cycle");
+  bad = p;
+  bad.hostbus_mb_s = 0;
+  refused(bad, "bad hostbus.mb_s=0: expected 0.001..1000000 MB/s");
+  bad = p;
+  bad.hostbus_burst_words = 8;
+  refused(bad, "bad hostbus.burst_words=8: expected 1..4 words");
+  bad = p;
+  bad.mem_port_capacity = 1;
+  refused(bad, "bad mem.port_capacity=1: expected 2..256 entries");
   // 16 DynRTPs of the prototype's 64 threads: 1024 threads in all, accepted; 128 each: too many.
   CycleParams many = prototype_params();
   apply_cycle_setting(many, "pipelines=16");
@@ -466,6 +530,177 @@ TEST(DynRtc, TimeSeriesAddsUpToTheFrame) {
     prev = f.cycle;
   }
   EXPECT_NEAR(busy / static_cast<double>(c.cycles), c.figures.usage[2], 1e-9);
+}
+
+// A statistic of the frame's hw/ registry (CycleFrame::stats_json) by its full name.
+double stat(const CycleFrame& c, const std::string& name) {
+  const std::string key = "\"" + name + "\": {";
+  const auto at = c.stats_json.find(key);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "no statistic " << name;
+    return 0;
+  }
+  const auto v = c.stats_json.find("\"value\": ", at);
+  return std::strtod(c.stats_json.c_str() + v + 9, nullptr);
+}
+
+// The memory interface's keys (docs/memif.md "Knobs"): the table's defaults are memif's own, so
+// the prototype builds the memory system it built before the keys existed.
+TEST(DynRtc, MemoryKeysDefaultToTheMemifDefaults) {
+  const memif::MemorySystemConfig d;
+  const memif::MemorySystemConfig m = memory_system_config(prototype_params());
+  EXPECT_EQ(m.pipelines, d.pipelines);
+  for (const memif::CacheConfig* c : {&m.node_cache, &m.list_cache, &m.row_cache}) {
+    EXPECT_EQ(c->items, d.node_cache.items);
+    EXPECT_EQ(c->ways, d.node_cache.ways);
+    EXPECT_EQ(c->hit_latency, d.node_cache.hit_latency);
+    EXPECT_EQ(c->max_misses, d.node_cache.max_misses);
+    EXPECT_EQ(c->max_targets, d.node_cache.max_targets);
+    EXPECT_EQ(c->ports, d.node_cache.ports);
+    EXPECT_EQ(c->request_capacity, d.node_cache.request_capacity);
+    EXPECT_EQ(c->memory_capacity, d.node_cache.memory_capacity);
+  }
+  EXPECT_EQ(m.controller.queue_depth, d.controller.queue_depth);
+  EXPECT_EQ(m.controller.latency, d.controller.latency);
+  EXPECT_EQ(m.controller.switch_penalty, d.controller.switch_penalty);
+  EXPECT_EQ(m.controller.max_burst, d.controller.max_burst);
+  EXPECT_EQ(m.controller.reorder, d.controller.reorder);
+  EXPECT_EQ(m.controller.bank_path, (std::vector<int>{0, 1, 2, 3, 4, 5}));  // mem.scene_paths=3
+  EXPECT_EQ(m.controller.port_capacity, d.controller.port_capacity);
+  EXPECT_EQ(m.controller.clock_hz, d.controller.clock_hz);
+  EXPECT_EQ(m.responses_per_cycle, d.responses_per_cycle);
+  EXPECT_EQ(m.host.mb_per_s, d.host.mb_per_s);
+  EXPECT_EQ(m.host.burst_words, d.host.burst_words);
+  EXPECT_EQ(m.host.clock_hz, d.host.clock_hz);
+  CycleParams one = prototype_params();
+  apply_cycle_setting(one, "mem.scene_paths=1");
+  EXPECT_EQ(memory_system_config(one).controller.bank_path, d.controller.bank_path);
+}
+
+// Each memory-interface key moves a small frame in the expected direction, and the statistics
+// show why; the hits stay bit-exact (the timing changes, never the result).
+TEST(DynRtc, MemoryKeysMoveTheFrame) {
+  const host::BuiltImage b = build("builtin:room", 32, 24);
+  const auto run = [&](std::vector<std::string> set) {
+    CycleParams p = prototype_params();
+    for (const auto& kv : set)
+      apply_cycle_setting(p, kv);
+    return run_cycle(b.image, p);
+  };
+  const CycleFrame base = run({});
+  const auto same_result = [&](const CycleFrame& c, const std::string& what) {
+    EXPECT_EQ(c.frame.rgb, base.frame.rgb) << what;
+    EXPECT_EQ(c.frame.units.requests, base.frame.units.requests) << what;
+  };
+  const auto merges = [](const CycleFrame& c) {
+    std::uint64_t n = 0;
+    for (const auto& cc : c.caches)
+      n += cc.merges;
+    return n;
+  };
+  const auto max_queue = [](const CycleFrame& c) {
+    double q = 0;
+    for (int bank = 3; bank <= 5; ++bank)
+      q = std::max(q, stat(c, "mi.ctrl.bank" + std::to_string(bank) + ".max_queue"));
+    return q;
+  };
+
+  // mem.queue_depth: one request per bank queue holds the routing behind every busy bank.
+  const CycleFrame q1 = run({"mem.queue_depth=1"});
+  same_result(q1, "mem.queue_depth=1");
+  EXPECT_GT(max_queue(base), 1);
+  EXPECT_EQ(max_queue(q1), 1);
+  EXPECT_GT(q1.cycles, base.cycles);
+
+  // cache.merge_targets: 1 = no secondary miss is merged; the cache waits for the fill instead.
+  const CycleFrame t1 = run({"cache.merge_targets=1"});
+  same_result(t1, "cache.merge_targets=1");
+  EXPECT_GT(merges(base), 0u);
+  EXPECT_EQ(merges(t1), 0u);
+  EXPECT_GT(t1.cycles, base.cycles);
+
+  // cache.request_queue: a 1-entry FIFO holds a unit whenever its cache waits.
+  const CycleFrame r1 = run({"cache.request_queue=1"});
+  same_result(r1, "cache.request_queue=1");
+  EXPECT_GT(r1.cycles, base.cycles);
+
+  // cache.memory_queue: one miss at a time towards the routing, one fill at a time back.
+  const CycleFrame m1 = run({"cache.memory_queue=1"});
+  same_result(m1, "cache.memory_queue=1");
+  EXPECT_GT(m1.cycles, base.cycles);
+
+  // routing.responses: the broadcast (and the controller's port to it) takes two responses per
+  // cycle, so the controller hardly ever holds a finished read for the port. (The frame's time is
+  // not monotone in it: earlier fills move contention to the caches' fill channels; on this frame
+  // it is shorter.)
+  const CycleFrame w2 = run({"routing.responses=2"});
+  same_result(w2, "routing.responses=2");
+  EXPECT_GT(stat(base, "mi.ctrl.stall_cycles"), 100);
+  EXPECT_LT(stat(w2, "mi.ctrl.stall_cycles"), stat(base, "mi.ctrl.stall_cycles") / 10);
+  EXPECT_LT(w2.cycles, base.cycles);
+
+  // mem.port_capacity: with 1-entry bank queues on one shared path the port's request channel
+  // is the buffer in front of the banks; a larger one holds the routing (and the caches behind
+  // it) less often.
+  const auto port = [&](int capacity) {
+    return run({"mem.scene_paths=1", "mem.queue_depth=1",
+                "mem.port_capacity=" + std::to_string(capacity)});
+  };
+  const CycleFrame pc2 = port(2), pc4 = port(4), pc16 = port(16);
+  same_result(pc16, "mem.port_capacity=16");
+  EXPECT_EQ(stat(pc2, "mi.ctrl.caches.req.max_occupancy"), 2);
+  EXPECT_EQ(stat(pc16, "mi.ctrl.caches.req.max_occupancy"), 16);
+  EXPECT_GT(stat(pc2, "mi.routing.stall_cycles"), stat(pc4, "mi.routing.stall_cycles"));
+  EXPECT_GT(stat(pc4, "mi.routing.stall_cycles"), 10 * stat(pc16, "mi.routing.stall_cycles"));
+  EXPECT_LT(pc16.cycles, pc2.cycles);
+
+  // mem.reorder and mem.max_burst act on a shared issue path: the scene banks on one path.
+  const std::string path = "mi.ctrl.path3.bank_switches";
+  const CycleFrame shared = run({"mem.scene_paths=1"});
+  const CycleFrame fifo = run({"mem.scene_paths=1", "mem.reorder=0"});
+  const CycleFrame burst1 = run({"mem.scene_paths=1", "mem.max_burst=1"});
+  same_result(fifo, "mem.reorder=0");
+  same_result(burst1, "mem.max_burst=1");
+  EXPECT_GT(stat(fifo, path), stat(shared, path));
+  EXPECT_GT(fifo.cycles, shared.cycles);
+  EXPECT_GT(stat(burst1, path), stat(shared, path));
+  EXPECT_GT(burst1.cycles, shared.cycles);
+}
+
+// The host-bus keys shape the memory system the chip builds (a frame uploads nothing): twice the
+// bandwidth, half the upload time; one-word bursts, four times the write requests.
+TEST(DynRtc, HostBusKeysShapeTheUpload) {
+  const auto upload = [](const std::vector<std::string>& set, std::uint64_t& writes) {
+    CycleParams p = prototype_params();
+    for (const auto& kv : set)
+      apply_cycle_setting(p, kv);
+    check_cycle_params(p);
+    memif::MemoryImage img(ff::kFp24, 16384);
+    hw::Kernel k;
+    memif::MemorySystem mi(k, img, memory_system_config(p));
+    const std::vector<std::uint32_t> words(4096, 0x5A5A5A5Au);  // 16 KB
+    mi.host().upload(memif::kShadingBank, 0, words);
+    const std::uint64_t cycles = k.run_to_completion([&] { return mi.idle(); }, 100000000);
+    EXPECT_EQ(mi.host().bytes_sent(), 16384u);
+    EXPECT_EQ(img.word(memif::kShadingBank, 4095), 0x5A5A5A5Au);
+    writes = k.stats()
+                 .get_counter("mi.ctrl.bank" + std::to_string(memif::kShadingBank) + ".writes")
+                 .value;
+    return cycles;
+  };
+  std::uint64_t w132 = 0, w264 = 0, w1 = 0, w33 = 0;
+  const std::uint64_t c132 = upload({}, w132);
+  const std::uint64_t c264 = upload({"hostbus.mb_s=264"}, w264);
+  const std::uint64_t c33 = upload({"hostbus.mb_s=33.5"}, w33);
+  const std::uint64_t c1 = upload({"hostbus.burst_words=1"}, w1);
+  // 16 KB at 132 MB/s and 90 MHz: about 10,650 cycles.
+  EXPECT_NEAR(static_cast<double>(c132), 16384.0 * 90e6 / (132.0 * 1048576.0), 5);
+  EXPECT_NEAR(static_cast<double>(c264) * 2, static_cast<double>(c132), 6);
+  EXPECT_NEAR(static_cast<double>(c33) * 33.5, static_cast<double>(c132) * 132, 132 * 6);
+  EXPECT_EQ(w132, 1024u);
+  EXPECT_EQ(w264, 1024u);
+  EXPECT_EQ(w1, 4096u);
+  EXPECT_NEAR(static_cast<double>(c1), static_cast<double>(c132), 5);
 }
 
 }  // namespace

@@ -287,15 +287,6 @@ void collect(FunctionalFrame& frame, Threads<F, kLanes>& threads) {
   collect_frame(frame, threads.units(), threads.sink());
 }
 
-memif::CacheConfig cache_config(const CycleParams& p, CacheUnit c) {
-  memif::CacheConfig cc;
-  cc.items = p.cache[static_cast<int>(c)].items;
-  cc.ways = p.cache[static_cast<int>(c)].ways;
-  cc.hit_latency = p.cache_hit_latency;
-  cc.max_misses = p.cache_misses;
-  return cc;
-}
-
 constexpr memif::ItemType kCacheItem[kCacheUnits] = {memif::ItemType::kNode, memif::ItemType::kList,
                                                      memif::ItemType::kRow};
 constexpr UnitId kTable4Unit[kTable4Units] = {UnitId::kTraversal, UnitId::kList,
@@ -398,23 +389,9 @@ class DynRtp {
 class Chip {
  public:
   Chip(hw::Kernel& k, memif::MemoryImage& image, const CycleParams& p, ThreadTable& threads)
-      : mi_(k, image, memory_config(p)), rgc_(threads.packets(), p.pipelines) {
+      : mi_(k, image, memory_system_config(p)), rgc_(threads.packets(), p.pipelines) {
     for (int i = 0; i < p.pipelines; ++i)
       pipes_.push_back(std::make_unique<DynRtp>(k, mi_, p, threads, rgc_, i));
-  }
-
-  static memif::MemorySystemConfig memory_config(const CycleParams& p) {
-    memif::MemorySystemConfig mc;
-    mc.pipelines = p.pipelines;
-    mc.node_cache = cache_config(p, CacheUnit::kTraversal);
-    mc.list_cache = cache_config(p, CacheUnit::kList);
-    mc.row_cache = cache_config(p, CacheUnit::kTransformation);
-    mc.controller.latency = p.mem_latency;
-    mc.controller.switch_penalty = p.mem_switch_penalty;
-    if (p.mem_scene_paths == 3) mc.controller.bank_path = {0, 1, 2, 3, 4, 5};
-    mc.controller.clock_hz = p.clock_mhz * 1e6;
-    mc.host.clock_hz = p.clock_mhz * 1e6;
-    return mc;
   }
 
   // Every packet handed out and every thread free again (checked between cycles).
@@ -624,6 +601,36 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
 }
 
 }  // namespace
+
+// The CycleParams as the memory system's parameters (every memif knob of the table).
+memif::MemorySystemConfig memory_system_config(const CycleParams& p) {
+  memif::MemorySystemConfig mc;
+  mc.pipelines = p.pipelines;
+  memif::CacheConfig* caches[kCacheUnits] = {&mc.node_cache, &mc.list_cache, &mc.row_cache};
+  for (int c = 0; c < kCacheUnits; ++c) {
+    memif::CacheConfig& cc = *caches[c];
+    cc.items = p.cache[c].items;
+    cc.ways = p.cache[c].ways;
+    cc.hit_latency = p.cache_hit_latency;
+    cc.max_misses = p.cache_misses;
+    cc.max_targets = p.cache_merge_targets;
+    cc.request_capacity = p.cache_request_queue;
+    cc.memory_capacity = p.cache_memory_queue;
+  }
+  mc.controller.queue_depth = p.mem_queue_depth;
+  mc.controller.latency = p.mem_latency;
+  mc.controller.switch_penalty = p.mem_switch_penalty;
+  mc.controller.max_burst = p.mem_max_burst;
+  mc.controller.reorder = p.mem_reorder;
+  if (p.mem_scene_paths == 3) mc.controller.bank_path = {0, 1, 2, 3, 4, 5};
+  mc.controller.port_capacity = p.mem_port_capacity;
+  mc.controller.clock_hz = p.clock_mhz * 1e6;
+  mc.responses_per_cycle = p.routing_responses;
+  mc.host.mb_per_s = p.hostbus_mb_s;
+  mc.host.burst_words = p.hostbus_burst_words;
+  mc.host.clock_hz = p.clock_mhz * 1e6;
+  return mc;
+}
 
 const char* program_mode_name(ProgramMode m) {
   switch (m) {
