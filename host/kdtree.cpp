@@ -249,7 +249,11 @@ class Builder {
  public:
   // Parameters are checked before anything is derived from them (the grid needs a valid format).
   Builder(const KdBuildParams& params, KdTree& tree)
-      : p_(checked(params)), grid_(params.split_format), tree_(tree) {}
+      : p_(checked(params)),
+        grid_(params.split_format),
+        tree_(tree),
+        step_rel_(std::ldexp(1.0, -params.split_format.man_bits)),
+        min_normal_(std::ldexp(1.0, params.split_format.emin())) {}
 
   void build_triangles(std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
                        std::span<const std::uint8_t> skip);
@@ -309,6 +313,9 @@ class Builder {
   KdBuildParams p_;  // a copy: run() resolves the automatic depth limit
   SplitGrid grid_;
   KdTree& tree_;
+  // The split format's grid step relative to the magnitude, and its smallest normal (the bins).
+  double step_rel_;
+  double min_normal_;
 
   std::span<const glm::vec3> positions_;
   std::span<const glm::uvec3> tris_;
@@ -368,9 +375,9 @@ void Builder::start(std::size_t items) {
   if (items >= kMaxItems)
     throw std::runtime_error("kd-tree: " + std::to_string(items) + " items exceed the limit of " +
                              std::to_string(kMaxItems - 1));
-  // Room for the root list and, stacked above it, the lists along the recursion path (about
-  // 1 + 1 + 1/2 + ... times the root's, plus straddlers' duplicates). Untouched pages cost
-  // nothing; growing copies everything.
+  // Room for the root list and, stacked above it, the right lists along the recursion path
+  // (left lists overwrite their parent's: about 1 + 1/2 + 1/4 + ... times the root's, plus
+  // straddlers' duplicates). Untouched pages cost nothing; growing copies everything.
   items_.top_ = 0;
   items_.ensure(std::max<std::size_t>(64, items * 4));
   for (int k = 0; k < 3; ++k) {
@@ -448,7 +455,8 @@ void Builder::build_boxes(std::span<const Aabb> boxes) {
 void Builder::run() {
   tree_.nodes.clear();
   tree_.items.clear();
-  tree_.nodes.reserve(std::size_t{item_count_} * 2 + 1);
+  // Large meshes reach about 2.5 nodes per item: room for 3 saves a copy of the whole array.
+  tree_.nodes.reserve(std::size_t{item_count_} * 3 + 1);
   tree_.items.reserve(std::size_t{item_count_} * 3);
   tree_.nodes.emplace_back();
   if (item_count_ == 0) {
@@ -501,6 +509,40 @@ void Builder::exact_subtree(std::uint32_t node, int depth, const Box& box, std::
   build_node(node, depth, box, eb, ee, n);
 }
 
+// The bins' counts, per bin the three axes side by side (and a zero lane): the sweep below
+// reads one bin of all axes at once.
+constexpr int kHistLanes = 4;
+using BinHist = std::uint32_t[kMaxBins][kHistLanes];
+
+// One axis's sweep over its bin planes (find_binned_split): the children's half areas step by
+// da, the counts by the histograms. A plane with an empty side is never better than the
+// empty-space plane at the items' bound below, so only planes with items on both sides are
+// weighed, without the bonus: compared as aL * nL + aR * nR (the even position is within a
+// quarter bin of s_j); the first least one is kept (its counts are summed again once it wins).
+struct BinScan {
+  const std::uint32_t* hist_lo;  // this axis's lane of BinHist (stride kHistLanes)
+  const std::uint32_t* hist_hi;
+  int nc = 0;
+  double da = 0.0;
+  double al = 0.0;
+  double ar = 0.0;
+  std::uint32_t nl = 0;
+  std::uint32_t not_right = 0;
+  double best_m = std::numeric_limits<double>::infinity();
+  int best_j = -1;
+  void step(int j, std::uint32_t n) {
+    nl += hist_lo[j * kHistLanes];
+    not_right += hist_hi[j * kHistLanes];
+    al += da;
+    ar -= da;
+    const std::uint32_t nr = n - not_right;
+    const double m = al * nl + ar * nr;
+    const bool better = (nl != 0) & (nr != 0) & (m < best_m);
+    best_m = better ? m : best_m;
+    best_j = better ? j : best_j;
+  }
+};
+
 // Binned SAH (Wald 2007; for kd-trees Shevtsov et al. 2007) with exact counts on the grid.
 // Per axis, a grid value x falls into bin f(x) = trunc(clamp((x - lo) * bins / extent, 0,
 // bins - 1)), monotone in x. Candidate plane j is the smallest grid value s_j with f(s_j) > j,
@@ -522,36 +564,33 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
   const double ki = p_.intersection_cost;
   const double bonus = p_.empty_bonus;
   // Fewer bins for smaller nodes: the per-node cost is proportional to the bins, the per-item
-  // cost is not; the top of the tree, which decides the most, gets the most.
-  // Fewer bins for smaller nodes: the per-node cost is proportional to the bins, the per-item
   // cost is not; the top of the tree, which decides the most, gets the most. On each axis a bin
   // spans at least 4 grid steps (finer candidates would collapse onto the same grid values).
   const int nb_node = std::clamp(static_cast<int>(n), std::min(32, p_.bins), p_.bins);
-  const double step_rel = std::ldexp(1.0, -p_.split_format.man_bits);
-  const double min_normal = std::ldexp(1.0, p_.split_format.emin());
   int nb[3];
   float scale[3];
   float base[3];
   float top[3];
-  std::uint32_t hist_lo[3][kMaxBins];
-  std::uint32_t hist_hi[3][kMaxBins];
+  alignas(16) BinHist hist_lo;
+  alignas(16) BinHist hist_hi;
   float tlo[3];
   float tkey[3];
   for (int k = 0; k < 3; ++k) {
     const double mag = std::max(std::fabs(static_cast<double>(box.lo[k])),
                                 std::fabs(static_cast<double>(box.hi[k])));
-    const double grid_step = std::max(mag * step_rel, min_normal);
+    const double grid_step = std::max(mag * step_rel_, min_normal_);
     nb[k] =
         static_cast<int>(std::clamp(d[k] / (4.0 * grid_step), 2.0, static_cast<double>(nb_node)));
     base[k] = box.lo[k];
     // Flat: all in bin 0. Any finite scale keeps f monotone (and free of 0 * inf).
     scale[k] = d[k] > 0.0 ? static_cast<float>(std::min(nb[k] / d[k], 0x1p127)) : 0.0f;
     top[k] = static_cast<float>(nb[k] - 1);
-    std::fill(hist_lo[k], hist_lo[k] + nb[k], 0u);
-    std::fill(hist_hi[k], hist_hi[k] + nb[k], 0u);
     tlo[k] = std::numeric_limits<float>::infinity();
     tkey[k] = -std::numeric_limits<float>::infinity();
   }
+  const int nb_max = std::max({nb[0], nb[1], nb[2]});
+  std::fill(&hist_lo[0][0], &hist_lo[0][0] + nb_max * kHistLanes, 0u);
+  std::fill(&hist_hi[0][0], &hist_hi[0][0] + nb_max * kHistLanes, 0u);
 #if defined(__SSE2__)
   // The same arithmetic four lanes at a time (IEEE single, as the scalar f below): lanes
   // lo0 lo1 lo2 key0 and key0 key1 key2 id (id lane: times 0, unused).
@@ -577,12 +616,12 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
           _mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(c, base_a), scale_b), zero), top_a);
       _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(fa));
       _mm_store_si128(reinterpret_cast<__m128i*>(idx + 4), _mm_cvttps_epi32(fc));
-      ++hist_lo[0][idx[0]];
-      ++hist_lo[1][idx[1]];
-      ++hist_lo[2][idx[2]];
-      ++hist_hi[0][idx[4]];
-      ++hist_hi[1][idx[5]];
-      ++hist_hi[2][idx[6]];
+      ++hist_lo[idx[0]][0];
+      ++hist_lo[idx[1]][1];
+      ++hist_lo[idx[2]][2];
+      ++hist_hi[idx[4]][0];
+      ++hist_hi[idx[5]][1];
+      ++hist_hi[idx[6]][2];
     }
     alignas(16) float l4[4];
     alignas(16) float k4[4];
@@ -603,8 +642,8 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
       tkey[k] = std::max(tkey[k], key);
       const int j = static_cast<int>(std::min(std::max((lo - base[k]) * scale[k], 0.0f), top[k]));
       const int h = static_cast<int>(std::min(std::max((key - base[k]) * scale[k], 0.0f), top[k]));
-      ++hist_lo[k][j];
-      ++hist_hi[k][h];
+      ++hist_lo[j][k];
+      ++hist_hi[h][k];
     }
   }
 #endif
@@ -637,6 +676,117 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
     }
     return grid_.up(unordered(at));
   };
+  // The bin planes of the three axes swept together: three independent chains of additions
+  // (each axis's half areas step by repeated addition, so one axis alone waits on its adds),
+  // and the best plane selected without a branch (which plane improves is unpredictable). The
+  // same sums in the same order as one axis at a time: the same planes.
+  BinScan s0{&hist_lo[0][0], &hist_hi[0][0]};
+  BinScan s1{&hist_lo[0][1], &hist_hi[0][1]};
+  BinScan s2{&hist_lo[0][2], &hist_hi[0][2]};
+  auto init = [&](BinScan& sc, int k) {
+    if (!(d[k] > 0.0)) return;  // flat: no planes
+    const double sum = d[(k + 1) % 3] + d[(k + 2) % 3];
+    const double prod = d[(k + 1) % 3] * d[(k + 2) % 3];
+    sc.nc = nb[k] - 1;
+    sc.da = d[k] / nb[k] * sum;
+    sc.al = prod;
+    sc.ar = d[k] * sum + prod;
+  };
+  init(s0, 0);
+  init(s1, 1);
+  init(s2, 2);
+  const int nc_common = std::min({s0.nc, s1.nc, s2.nc});
+#if defined(__SSE2__)
+  // Two lanes per register (axes 0, 1 and axis 2 with an idle lane), each lane the scalar
+  // step's binary64 operations in the same order; the counts are exact integers in binary64.
+  if (nc_common > 0) {
+    const double inf = std::numeric_limits<double>::infinity();
+    const __m128d zero = _mm_setzero_pd();
+    const __m128d n2 = _mm_set1_pd(static_cast<double>(n));
+    const __m128d da_a = _mm_setr_pd(s0.da, s1.da);
+    const __m128d da_b = _mm_setr_pd(s2.da, 0.0);
+    __m128d al_a = _mm_setr_pd(s0.al, s1.al);
+    __m128d al_b = _mm_setr_pd(s2.al, 0.0);
+    __m128d ar_a = _mm_setr_pd(s0.ar, s1.ar);
+    __m128d ar_b = _mm_setr_pd(s2.ar, 0.0);
+    __m128d nl_a = zero;
+    __m128d nl_b = zero;
+    __m128d nn_a = zero;  // not right
+    __m128d nn_b = zero;
+    const __m128d inf2 = _mm_set1_pd(inf);
+    __m128d bm_a = inf2;
+    __m128d bm_b = bm_a;
+    __m128d bj_a = _mm_set1_pd(-1.0);
+    __m128d bj_b = bj_a;
+    __m128d jv = zero;
+    const __m128d one = _mm_set1_pd(1.0);
+    auto blend = [](__m128d mask, __m128d a, __m128d b) {
+      return _mm_or_pd(_mm_and_pd(mask, a), _mm_andnot_pd(mask, b));
+    };
+    for (int j = 0; j < nc_common; ++j) {
+      const __m128i cl = _mm_load_si128(reinterpret_cast<const __m128i*>(hist_lo[j]));
+      const __m128i ch = _mm_load_si128(reinterpret_cast<const __m128i*>(hist_hi[j]));
+      nl_a = _mm_add_pd(nl_a, _mm_cvtepi32_pd(cl));
+      nl_b = _mm_add_pd(nl_b, _mm_cvtepi32_pd(_mm_srli_si128(cl, 8)));
+      nn_a = _mm_add_pd(nn_a, _mm_cvtepi32_pd(ch));
+      nn_b = _mm_add_pd(nn_b, _mm_cvtepi32_pd(_mm_srli_si128(ch, 8)));
+      al_a = _mm_add_pd(al_a, da_a);
+      al_b = _mm_add_pd(al_b, da_b);
+      ar_a = _mm_sub_pd(ar_a, da_a);
+      ar_b = _mm_sub_pd(ar_b, da_b);
+      const __m128d nr_a = _mm_sub_pd(n2, nn_a);
+      const __m128d nr_b = _mm_sub_pd(n2, nn_b);
+      const __m128d m_a = _mm_add_pd(_mm_mul_pd(al_a, nl_a), _mm_mul_pd(ar_a, nr_a));
+      const __m128d m_b = _mm_add_pd(_mm_mul_pd(al_b, nl_b), _mm_mul_pd(ar_b, nr_b));
+      // A plane with an empty side counts as +inf; the least value is a min (one short chain
+      // per register), and the index follows it where the value drops strictly.
+      const __m128d mv_a =
+          blend(_mm_and_pd(_mm_cmpneq_pd(nl_a, zero), _mm_cmpneq_pd(nr_a, zero)), m_a, inf2);
+      const __m128d mv_b =
+          blend(_mm_and_pd(_mm_cmpneq_pd(nl_b, zero), _mm_cmpneq_pd(nr_b, zero)), m_b, inf2);
+      bj_a = blend(_mm_cmplt_pd(mv_a, bm_a), jv, bj_a);
+      bj_b = blend(_mm_cmplt_pd(mv_b, bm_b), jv, bj_b);
+      bm_a = _mm_min_pd(mv_a, bm_a);
+      bm_b = _mm_min_pd(mv_b, bm_b);
+      jv = _mm_add_pd(jv, one);
+    }
+    alignas(16) double v[6][4];
+    _mm_store_pd(v[0], al_a);
+    _mm_store_pd(v[0] + 2, al_b);
+    _mm_store_pd(v[1], ar_a);
+    _mm_store_pd(v[1] + 2, ar_b);
+    _mm_store_pd(v[2], nl_a);
+    _mm_store_pd(v[2] + 2, nl_b);
+    _mm_store_pd(v[3], nn_a);
+    _mm_store_pd(v[3] + 2, nn_b);
+    _mm_store_pd(v[4], bm_a);
+    _mm_store_pd(v[4] + 2, bm_b);
+    _mm_store_pd(v[5], bj_a);
+    _mm_store_pd(v[5] + 2, bj_b);
+    BinScan* sc[3] = {&s0, &s1, &s2};
+    for (int k = 0; k < 3; ++k) {
+      sc[k]->al = v[0][k];
+      sc[k]->ar = v[1][k];
+      sc[k]->nl = static_cast<std::uint32_t>(v[2][k]);
+      sc[k]->not_right = static_cast<std::uint32_t>(v[3][k]);
+      sc[k]->best_m = v[4][k];
+      sc[k]->best_j = static_cast<int>(v[5][k]);
+    }
+  }
+#else
+  for (int j = 0; j < nc_common; ++j) {
+    s0.step(j, n);
+    s1.step(j, n);
+    s2.step(j, n);
+  }
+#endif
+  for (int j = nc_common; j < s0.nc; ++j)
+    s0.step(j, n);
+  for (int j = nc_common; j < s1.nc; ++j)
+    s1.step(j, n);
+  for (int j = nc_common; j < s2.nc; ++j)
+    s2.step(j, n);
+  const BinScan* scans[3] = {&s0, &s1, &s2};
   int bin_j = -1;  // the winner's candidate when it is a bin plane
   for (int k = 0; k < 3; ++k) {
     if (!(d[k] > 0.0)) continue;
@@ -649,37 +799,18 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
       const double ar = (hi - x) * sum + prod;
       return (nl == 0 || nr == 0 ? bonus : 1.0) * (kt + ki * inv_area * (al * nl + ar * nr));
     };
-    // A plane with an empty side is never better than the empty-space plane at the items'
-    // bound below, so only planes with items on both sides are weighed, without the bonus:
-    // compared as aL * nL + aR * nR, with the children's half areas stepping evenly (the even
-    // position is within a quarter bin of s_j).
-    const int nc = nb[k] - 1;
-    const double da = d[k] / nb[k] * sum;
-    double al = prod;
-    double ar = d[k] * sum + prod;
-    double best_m = std::numeric_limits<double>::infinity();
-    std::uint32_t nl = 0;
-    std::uint32_t not_right = 0;
-    int best_j = -1;
-    std::uint32_t best_nl = 0;
-    std::uint32_t best_nr = 0;
-    for (int j = 0; j < nc; ++j) {
-      nl += hist_lo[k][j];
-      not_right += hist_hi[k][j];
-      al += da;
-      ar -= da;
-      const std::uint32_t nr = n - not_right;
-      const double m = al * nl + ar * nr;
-      if (nl != 0 && nr != 0 && m < best_m) {
-        best_m = m;
-        best_j = j;
-        best_nl = nl;
-        best_nr = nr;
-      }
-    }
+    const int best_j = scans[k]->best_j;
+    const double best_m = scans[k]->best_m;
     if (best_j >= 0) {
       const double c = kt + ki * inv_area * best_m;
       if (c < best.cost) {
+        std::uint32_t best_nl = 0;
+        std::uint32_t not_right = 0;
+        for (int j = 0; j <= best_j; ++j) {
+          best_nl += hist_lo[j][k];
+          not_right += hist_hi[j][k];
+        }
+        const std::uint32_t best_nr = n - not_right;
         best = BinnedSplit{c, k, 0.0f, false, best_nl, best_nr};
         bin_j = best_j;  // s_j searched once the winner is known
       }
@@ -714,6 +845,11 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
 
 void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_t b,
                        std::uint32_t n) {
+  if (n == 0) {  // the empty side of an empty-space plane: a leaf under every rule
+    leaf_scratch_.clear();
+    emit_leaf(node, leaf_scratch_);
+    return;
+  }
   if (n <= static_cast<std::uint32_t>(p_.binned_above)) {
     exact_subtree(node, depth, box, b, n);
     return;
@@ -740,16 +876,19 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
   rbox.lo[k] = split;
 
   // One pass: classify (as the exact stage does) and write the children's lists, whose sizes
-  // the binning counted (clipping may only drop pieces).
-  const std::size_t lb = items_.top_;
-  const std::size_t rb = lb + best.left;
+  // the binning counted (clipping may only drop pieces). The left list overwrites this node's
+  // in place (each item read yields at most one left item, so writing never overtakes reading);
+  // the right one goes on top of the stack.
+  const std::size_t entry_top = items_.top_;
+  const std::size_t lb = b;
+  const std::size_t rb = entry_top;
   items_.ensure(rb + best.right);
   BinItem* all = items_.data();
   const std::uint8_t planar_side = best.planar_left ? kLeft : kRight;
   std::uint32_t nl = 0;
   std::uint32_t nr = 0;
   for (std::uint32_t i = 0; i < n; ++i) {
-    const BinItem& it = all[b + i];
+    const BinItem it = all[b + i];  // a copy: the left list may overwrite its slot
     const float lo = it.lo[k];
     const bool planar = (it.planar >> k) & 1u;
     const std::uint8_t v = planar && lo == split ? planar_side
@@ -799,7 +938,7 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
   bin_node(child, depth + 1, lbox, lb, nl);
   items_.top_ = top;
   bin_node(child + 1, depth + 1, rbox, rb, nr);
-  items_.top_ = lb;
+  items_.top_ = entry_top;
 }
 
 Split Builder::find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],

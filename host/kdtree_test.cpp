@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <functional>
 #include <random>
@@ -1121,6 +1123,82 @@ TEST(KdTree, AutomaticDepthLimitFollowsTheItemCount) {
   EXPECT_EQ(kd_max_depth(p, 806), 20);
   p.max_depth = 5;
   EXPECT_EQ(kd_max_depth(p, 806), 5);
+}
+
+}  // namespace
+}  // namespace saarcor::host
+
+namespace saarcor::host {
+namespace {
+// ---- the trees themselves ----------------------------------------------------------------------
+
+// FNV-1a over everything a tree stores: node kinds, axes, split bits, children, leaf ranges and
+// the item lists.
+std::uint64_t tree_hash(const KdTree& t) {
+  std::uint64_t h = 14695981039346656037ull;
+  auto mix = [&](std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) {
+      h ^= (v >> (8 * i)) & 0xFFu;
+      h *= 1099511628211ull;
+    }
+  };
+  for (const KdTreeNode& nd : t.nodes) {
+    mix(nd.leaf);
+    if (nd.leaf) {
+      mix(nd.first);
+      mix(nd.count);
+    } else {
+      mix(nd.axis);
+      mix(std::bit_cast<std::uint32_t>(nd.split));
+      mix(nd.child);
+    }
+  }
+  for (const std::uint32_t id : t.items)
+    mix(id);
+  return h;
+}
+
+// The trees are tuned against the modelled hardware (the room's costs, docs/kdtree.md "Costs for
+// this hardware"), so a change meant to make the builder faster must leave them bit for bit as
+// they are. These hashes pin the default build of fixed meshes and boxes (both stages, face slabs,
+// empty-space planes, flat axes); a change that means to alter the trees updates them and says
+// so in docs/kdtree.md.
+TEST(KdTree, TreesOfFixedInputsAreUnchanged) {
+  Mesh spheres = sphere(24, 32, glm::vec3(0.0f), 3.0f);
+  append(spheres, sphere(12, 16, glm::vec3(2.5f, 0.5f, 0.0f), 1.0f));
+  const Mesh land = terrain(40, 30, 5);
+  const Mesh soup = random_triangles(900, 77, 4.0f, 1.0f);
+  const Mesh box = cube();
+  const Mesh flat = planar_grid(30, 20);
+  struct Case {
+    const char* name;
+    const Mesh* mesh;
+    std::uint64_t hash;
+  };
+  const Case cases[] = {
+      {"spheres", &spheres, 0x677fbac1c1ce91b2ull},  {"terrain", &land, 0xbadaacdcd74cc440ull},
+      {"soup", &soup, 0x9120e280d5fd30c7ull},        {"cube", &box, 0x51f6dc2663dba91ull},
+      {"planar grid", &flat, 0x68ff23bd66cc45abull},
+  };
+  for (const Case& c : cases) {
+    const KdTree tree = build_kdtree(c.mesh->pos, c.mesh->tris, {});
+    EXPECT_EQ(tree_hash(tree), c.hash)
+        << c.name << ": " << tree.nodes.size() << " nodes, hash 0x" << std::hex << tree_hash(tree);
+  }
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<float> u(-50.0f, 50.0f);
+  std::uniform_real_distribution<float> s(0.0f, 6.0f);
+  std::vector<Aabb> boxes(700);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const glm::vec3 lo(u(rng), u(rng), u(rng));
+    // Every 7th box flat in y, every 11th a point.
+    const glm::vec3 ext(s(rng), i % 7 == 0 ? 0.0f : s(rng), s(rng));
+    boxes[i].lo = lo;
+    boxes[i].hi = i % 11 == 0 ? lo : lo + ext;
+  }
+  const KdTree top = build_kdtree(boxes, {});
+  EXPECT_EQ(tree_hash(top), 0x211123f28b8665beull)
+      << "boxes: " << top.nodes.size() << " nodes, hash 0x" << std::hex << tree_hash(top);
 }
 
 }  // namespace
