@@ -9,6 +9,7 @@ packages=(
   libopenimageio-dev openimageio-tools libopencv-core-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
   libmpfr-dev libembree-dev
+  verilator yosys
 )
 
 missing=()
