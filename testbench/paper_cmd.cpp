@@ -61,7 +61,7 @@ void check_options(const PaperOptions& opts) {
 }
 
 std::vector<PaperScene> chosen_scenes(const PaperOptions& opts) {
-  const std::vector<PaperScene> all = paper_scenes(opts.references);
+  std::vector<PaperScene> all = paper_scenes(opts.references);
   if (opts.scenes.empty()) return all;
   std::vector<PaperScene> v;
   for (const std::string& name : opts.scenes) {
@@ -69,8 +69,10 @@ std::vector<PaperScene> chosen_scenes(const PaperOptions& opts) {
         std::find_if(all.begin(), all.end(), [&](const PaperScene& s) { return s.paper == name; });
     if (it == all.end()) {
       std::string known;
-      for (const PaperScene& s : all)
-        known += (known.empty() ? "" : ", ") + s.paper;
+      for (const PaperScene& s : all) {
+        if (!known.empty()) known += ", ";
+        known += s.paper;
+      }
       throw std::runtime_error("bad --scene " + name + ": the paper scenes shown are " + known);
     }
     v.push_back(*it);
