@@ -206,7 +206,7 @@ void assign_scene_layout(BuiltImage& b) {
         mb(cap * 4 * memif::kSceneBanks) + " (nodes " + mb(node_words * 4 * memif::kSceneBanks) +
         ", lists " + mb(list_words * 4 * memif::kSceneBanks) + ", rows " +
         mb(row_words * 4 * memif::kSceneBanks) + "; " + region + " overflow by " + mb(over) +
-        " = " + std::to_string(over) + " bytes); raise mem.bank_mb");
+        " = " + std::to_string(over) + " bytes); raise --bank-mb");
   }
   memif::SceneRegions& r = b.image.regions();
   r.base = {0u, static_cast<std::uint32_t>(node_words),
@@ -532,7 +532,7 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
                              mb(light_words * 4) + ", shading records " + mb(record_words * 4) +
                              ", textures " + mb(texel_words * 4) + "; " + region + " overflow by " +
                              mb((end - cap) * 4) + " = " + std::to_string((end - cap) * 4) +
-                             " bytes); raise mem.bank_mb");
+                             " bytes); raise --bank-mb");
   }
   regs.material_base = 0;
   regs.light_base = static_cast<std::uint32_t>(material_words);
@@ -682,7 +682,7 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
                              " of " + mb(std::uint64_t{params.bank_words} * 4) + " for " +
                              std::to_string(params.width) + "x" + std::to_string(params.height) +
                              " (overflow by " + std::to_string((pixels - params.bank_words) * 4) +
-                             " bytes); raise mem.bank_mb");
+                             " bytes); raise --bank-mb");
 
   // Bottom level: T_delta per slot, then the tree over the non-degenerate triangles, for every
   // object an instance uses.

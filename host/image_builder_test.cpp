@@ -448,7 +448,7 @@ TEST(ImageBuilder, SceneThatDoesNotFitNamesBankAndOverflow) {
   const std::string e = error_of(s, p);
   EXPECT_NE(e.find("scene does not fit: scene banks 3-5 need"), std::string::npos) << e;
   EXPECT_NE(e.find("rows overflow by"), std::string::npos) << e;
-  EXPECT_NE(e.find("raise mem.bank_mb"), std::string::npos) << e;
+  EXPECT_NE(e.find("raise --bank-mb"), std::string::npos) << e;
   // The overflow in bytes is exact: the words beyond the bank size, times three banks.
   EXPECT_NE(e.find("= " + std::to_string((end - p.bank_words) * 12) + " bytes"), std::string::npos)
       << e;
