@@ -105,6 +105,27 @@ TEST_F(SceneCmd, JsonReportOfTheRoom) {
   EXPECT_GT(scene_bytes, 806u * 36u);
 }
 
+// --set kd.KEY=VALUE builds the trees with the builder's keys: dearer traversal steps, fewer
+// nodes and more triangle tests per ray; every tree's expectations are printed.
+TEST_F(SceneCmd, TreeKeysChangeTheTrees) {
+  const CmdResult a = run("builtin:room --json");
+  const CmdResult b = run("builtin:room --json --set kd.traversal_cost=60");
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  const json ja = json::parse(a.out)["kdtree"]["bottom"];
+  const json jb = json::parse(b.out)["kdtree"]["bottom"];
+  EXPECT_LT(jb["nodes"].get<int>() * 2, ja["nodes"].get<int>());
+  EXPECT_LT(jb["nodes_per_triangle"].get<double>(), ja["nodes_per_triangle"].get<double>());
+  EXPECT_DOUBLE_EQ(ja["nodes_per_triangle"].get<double>(), ja["nodes"].get<double>() / 806.0);
+  EXPECT_GT(jb["objects"][0]["expected_item_tests"].get<double>(),
+            ja["objects"][0]["expected_item_tests"].get<double>());
+  const CmdResult t = run("builtin:room");
+  EXPECT_NE(t.out.find("806 triangles, "), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("nodes per triangle, depth "), std::string::npos) << t.out;
+  expect_one_line_error("builtin:room --set threads=4", "unknown --set key 'threads'");
+  expect_one_line_error("builtin:room --set kd.max_depth=-3", "bad --set kd.max_depth=-3");
+}
+
 TEST_F(SceneCmd, TextReportNamesEveryFigure) {
   const CmdResult r = run(kScenes + "/SimpleMeshes/SimpleMeshes.gltf");
   ASSERT_EQ(r.status, 0) << r.err;
