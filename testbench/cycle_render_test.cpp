@@ -63,6 +63,7 @@ TEST(CycleRender, ReportVcdAndTable) {
   EXPECT_EQ(run_render(o), 0);
   const std::string out = testing::internal::GetCapturedStdout();
   EXPECT_NE(out.find("paper Scene6"), std::string::npos) << out;
+  EXPECT_NE(out.find("the paper's fps scaled to this frame's"), std::string::npos) << out;
   EXPECT_NE(out.find("model builtin:room"), std::string::npos) << out;
   const auto j = nlohmann::json::parse(read(d / "room.json"));
   for (const char* k : {"cycles", "fps", "rays", "rays_per_s", "usage", "cache_hit",
