@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fixedfloat/float.h"
+#include "fixedfloat/operand_testing.h"
 #include "units/cycle_params.h"
 
 namespace saarcor::rtl::testing {
@@ -186,66 +187,8 @@ class OpsRig {
   std::array<std::uint64_t, kOps> seen_{}, stray_{}, mismatches_{}, late_{};
 };
 
-// Seeded operands in the manner of TestFloat (as fixedfloat's tests generate them): uniform
-// encodings, pairs with nearby exponents (cancellation, ties, carries), exponents at the ends of
-// the range (overflow, underflow, subnormals, inf, NaN) and special mantissa patterns.
-class OperandGen {
- public:
-  OperandGen(const ff::Format& f, std::uint64_t seed) : f_(f), rng_(seed) {}
-
-  std::uint32_t any() { return static_cast<std::uint32_t>(rng_()) & f_.bits_mask(); }
-
-  std::pair<std::uint32_t, std::uint32_t> pair() {
-    const auto kind = static_cast<std::uint32_t>(rng_() % 16);
-    std::uint32_t a = kind < 12 ? any() : edgy();
-    std::uint32_t b;
-    if (kind < 5) {
-      b = any();
-    } else if (kind < 11) {
-      const int ea = static_cast<int>((a >> f_.man_bits) & f_.exp_field_max());
-      const int span = f_.man_bits + 3;
-      int eb = ea + static_cast<int>(rng_() % (2 * span + 1)) - span;
-      eb = eb < 0
-               ? 0
-               : (eb > static_cast<int>(f_.exp_field_max()) ? static_cast<int>(f_.exp_field_max())
-                                                            : eb);
-      b = (static_cast<std::uint32_t>(rng_()) & f_.sign_mask()) |
-          (static_cast<std::uint32_t>(eb) << f_.man_bits) | mantissa();
-    } else {
-      b = edgy();
-    }
-    if (rng_() % 2) std::swap(a, b);
-    return {a, b};
-  }
-
- private:
-  std::uint32_t mantissa() {
-    switch (rng_() % 6) {
-      case 0:
-        return 0;
-      case 1:
-        return f_.man_mask();
-      case 2:
-        return static_cast<std::uint32_t>(rng_() % 4);
-      case 3:
-        return f_.man_mask() - static_cast<std::uint32_t>(rng_() % 4);
-      case 4:
-        return (1u << (f_.man_bits - 1)) ^ static_cast<std::uint32_t>(rng_() % 3);
-      default:
-        return static_cast<std::uint32_t>(rng_()) & f_.man_mask();
-    }
-  }
-  std::uint32_t edgy() {
-    const std::uint32_t top = f_.exp_field_max();
-    const std::uint32_t choices[] = {
-        0, 1, 2, 3, top - 3, top - 2, top - 1, top, static_cast<std::uint32_t>(f_.bias())};
-    const std::uint32_t e = choices[rng_() % std::size(choices)];
-    return (static_cast<std::uint32_t>(rng_()) & f_.sign_mask()) | (e << f_.man_bits) | mantissa();
-  }
-
-  ff::Format f_;
-  std::mt19937_64 rng_;
-};
+// Operands as fixedfloat's oracle tests generate them (fixedfloat/operand_testing.h).
+using ff::testing::OperandGen;
 
 // Hand-picked fp24 operands (fixedfloat/fp24_mpfr_test.cpp's edge list), both signs.
 inline std::vector<std::uint32_t> fp24_edges() {
