@@ -1,5 +1,6 @@
 // Datapath unit tests with hand-computed fp24 values (units/datapath.h, units/mailbox.h).
 #include "units/datapath.h"
+#include "units/fast_paths.h"
 
 #include <gtest/gtest.h>
 

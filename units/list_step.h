@@ -1,0 +1,119 @@
+// The list unit's semantics (paper section 3.1; Figure 2 paths c and d; DESIGN.md section 5;
+// decision D28): a leaf's list, one entry per request; at the top level an entry is an object
+// instance, at the bottom level a triangle; the mailbox "omits objects already visited by the same
+// ray" (and, with triangle_mailbox > 0, triangles). An entry some ray still needs goes to the
+// transformation unit (path d); the end of the list returns the packet to the traversal unit.
+// Timing: units/list_unit.cpp (depth: the mailbox compare); exact-cycle test:
+// units/unit_timing_test.cpp (ListUnit*).
+#pragma once
+
+#include <cstdint>
+
+#include "units/mailbox.h"
+#include "units/packet.h"
+
+namespace saarcor::units {
+
+template <class F, int kLanes>
+class ListStep {
+ public:
+  using State = PacketState<F, kLanes>;
+
+  explicit ListStep(const FunctionalParams& params)
+      : mailbox_(params.mailbox), tri_mailbox_(params.triangle_mailbox) {}
+
+  // The entry the list unit handed on, read by the transformation and intersection units and by
+  // the traversal unit's object clip.
+  std::uint64_t entry_mask() const { return entry_mask_; }
+  std::uint32_t instance() const { return instance_; }
+  std::uint32_t instance_row() const { return instance_row_; }
+  std::uint32_t triangle() const { return triangle_; }
+  const memif::InstanceHeader& header() const { return header_; }
+  // The entry the next request reads, and its rays.
+  std::uint32_t next(Level level) const { return cursor(level).next; }
+  std::uint64_t mask(Level level) const { return cursor(level).mask; }
+
+  // A packet leaves its mailbox behind (D28: a mailbox belongs to one packet's rays).
+  void clear() { mailbox_.clear(); }
+
+  // A leaf's list entries first .. end - 1 for the rays in `mask` (path c).
+  void start(Level level, std::uint32_t first, std::uint32_t end, std::uint64_t mask) {
+    Cursor& c = cursor(level);
+    c.next = first;
+    c.end = end;
+    c.mask = mask;
+  }
+
+  // Entering an object: its header, and a clear triangle mailbox.
+  void enter_object(const State& t) {
+    header_ = t.image.instance_header(instance_);
+    tri_mailbox_.clear();
+  }
+
+  // One list entry (a request): mailboxed, then to the transformation unit or on to the next.
+  void step(State& t) {
+    ++t.u.list_steps;
+    const Level level = t.traversal.level();
+    Cursor& c = cursor(level);
+    const std::uint32_t entry = t.scene.list_entry(c.next++);
+    // The matrix rows of this entry and of the next (its list entry was prefetched at the leaf).
+    prefetch_entry_rows(t, entry);
+    if (c.next < c.end) prefetch_entry_rows(t, t.scene.list_entry(c.next));
+    for (int i = 0; i < t.p; ++i)
+      t.lane(i).counters.list_entries += (c.mask >> i) & 1u;
+    Mailbox& mb = level == Level::kTop ? mailbox_ : tri_mailbox_;
+    const std::uint64_t todo = mb.filter(entry, c.mask);
+    for (int i = 0; i < t.p; ++i)
+      t.lane(i).counters.mailbox_skips += ((c.mask & ~todo) >> i) & 1u;
+    if (todo == 0) return resume(t);
+    entry_mask_ = todo;
+    if (level == Level::kTop) {
+      instance_ = entry;
+      instance_row_ = t.image.registers().instance_row_base + memif::kInstanceRows * entry;
+      t.phase = Phase::kTransformObject;
+    } else {
+      triangle_ = entry;
+      t.phase = Phase::kTransformTriangle;
+    }
+  }
+
+  // Back at the current level's list (path f): its next entry, or the traversal unit's pop once
+  // the list is done or (any-hit) its rays are.
+  void resume(State& t) {
+    Cursor& c = cursor(t.traversal.level());
+    const std::uint64_t live = t.kind == RayKind::kShadow ? c.mask & ~t.done_mask() : c.mask;
+    c.mask = live;
+    if (c.next < c.end && live != 0) {
+      t.phase = Phase::kList;
+      return;
+    }
+    t.traversal.pop(t);
+  }
+
+ private:
+  struct Cursor {
+    std::uint32_t next = 0, end = 0;
+    std::uint64_t mask = 0;
+  };
+  Cursor& cursor(Level level) { return level == Level::kTop ? top_list_ : bottom_list_; }
+  const Cursor& cursor(Level level) const {
+    return level == Level::kTop ? top_list_ : bottom_list_;
+  }
+
+  void prefetch_entry_rows(const State& t, std::uint32_t entry) const {
+    if (t.traversal.level() == Level::kTop)
+      t.scene.prefetch_rows(t.image.registers().instance_row_base + memif::kInstanceRows * entry,
+                            memif::kInstanceRows);
+    else
+      t.scene.prefetch_rows(header_.triangle_row_base + memif::kTriangleRows * entry,
+                            memif::kTriangleRows);
+  }
+
+  Cursor top_list_, bottom_list_;
+  Mailbox mailbox_, tri_mailbox_;
+  std::uint64_t entry_mask_ = 0;
+  std::uint32_t instance_ = 0, instance_row_ = 0, triangle_ = 0;
+  memif::InstanceHeader header_;
+};
+
+}  // namespace saarcor::units

@@ -1,0 +1,87 @@
+// The packet a DynRTP thread carries through the units (DESIGN.md section 5): per lane the ray in
+// world, current and unit-triangle space, the closest hit and the ray's counters; the binary64
+// values the traversal unit works on; what the RGS hands the transformation unit to generate a
+// packet (path a). The state each unit keeps besides is that unit's slice (units/*_step.h), all
+// held together by units/packet_state.h.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include "memif/image_format.h"
+#include "units/datapath.h"
+#include "units/fast_paths.h"
+#include "units/program_types.h"
+
+namespace saarcor::units {
+
+// The level of the two-level kd-tree a packet traverses (paper section 3.1: top level over the
+// objects, bottom level over an object's triangles; one stack for both).
+enum class Level : std::uint8_t { kTop, kBottom };
+
+// What the RGS hands the transformation unit for one lane (path a): T and R'.
+template <class F>
+struct GenLane {
+  bool valid = false;
+  std::uint32_t pixel = memif::kNone;
+  std::uint32_t weight = 0;
+  Mat34<F> t{};
+  Vec3<F> ro{}, rd{};
+};
+
+// A packet to generate: its kind, recursion depth, whether its rays share one origin (the n+1
+// rule), and its lanes.
+template <class F>
+struct GenPacket {
+  RayKind kind = RayKind::kPrimary;
+  std::uint32_t depth = 0;
+  bool shared_origin = false;
+  std::vector<GenLane<F>> lanes;
+};
+
+template <class F>
+struct Lane {
+  bool valid = false;  // carries a ray of the current packet
+  bool done = false;   // any-hit satisfied (shadow rays, D15)
+  std::uint32_t pixel = memif::kNone;
+  std::uint32_t weight = 0;
+  Ray<F> world, current, tri;
+  HitRecord<F> hit;  // hit.t = t_best (starts at the ray's t_max)
+  RayCounters counters;
+};
+
+// The traversal unit works on binary64 values (fast_paths.h, traversal_lane64): O and 1/D per axis
+// of the world and of the current (object) ray, and the segments. Every one is the exact value of
+// an encoding of F, so the encodings are recovered exactly where the encoding path is needed. Kept
+// per packet as arrays over the lanes, so two lanes go through one vector op (traversal_pair64);
+// slots from P up to the next even count are padding, computed along and never used. A lane's tn,
+// tf are meaningful only while it is in the packet's mask: it enters the mask only where they are
+// set (start of a sign group, pop, the near child), so whole-array copies may overwrite the others.
+template <int kLanes>
+using Slots = std::array<double, kLanes>;
+template <int kLanes>
+struct alignas(16) LaneValues {
+  std::array<Slots<kLanes>, 3> world_o{}, world_inv{}, o{}, inv{};
+  Slots<kLanes> tn{}, tf{};            // segment of the node being visited
+  Slots<kLanes> clip_tn{}, clip_tf{};  // the level's clipped segment (restart of a sign group)
+  Slots<kLanes> t_best{};              // value of hit.t
+};
+
+inline bool lane_in(std::uint64_t mask, int i) {
+  return ((mask >> i) & 1u) != 0;
+}
+inline V2d load2(const double* p) {
+  V2d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store2(double* p, V2d v) {
+  std::memcpy(p, &v, sizeof v);
+}
+
+template <class F, int kLanes>
+struct PacketState;
+
+}  // namespace saarcor::units

@@ -1,0 +1,240 @@
+// What a thread program and the models around it share (DESIGN.md section 5; paper section 3.1,
+// Figure 2): the model's functional parameters, the per-ray work counters, the ray kinds, the
+// DynRTP units a thread asks for and the phases that name them, the request a thread hands a unit,
+// the capture tap for unit transactions, the float units with their counters, and the frame sink
+// the RGS writes. The thread program itself is units/thread_program.h; each unit's semantics is in
+// its own *_step.h.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "fixedfloat/float.h"
+#include "memif/image_format.h"
+#include "units/datapath.h"
+#include "units/huge_pages.h"
+#include "units/unit_fp.h"
+
+namespace saarcor::units {
+
+inline constexpr int kMaxPacket = 64;  // lane masks are 64-bit
+
+struct FunctionalParams {
+  int packet = 4;             // P rays per packet (thread); a power of two, 1..64
+  int stack_depth = 64;       // traversal stack entries per packet (D26)
+  int mailbox = 8;            // object mailbox entries per thread (D28), 0 = off
+  int triangle_mailbox = 8;   // triangle mailbox entries (bottom-level lists), 0 = off
+  bool shared_origin = true;  // the n+1 rule for packets with one origin (D31)
+  // Box clips: when every ray of the packet starts inside the box, its entry faces cannot raise
+  // tn above 0, so the traversal unit divides for the three exit faces only (3 steps, not 6).
+  bool clip_exit_only = true;
+  // Children an inner node flags empty (memif::KdNode) are not stepped into: the traversal unit
+  // sees the flags with the parent's fetch, so an empty leaf costs no traversal step.
+  bool skip_empty = true;
+  // Box faces a clip step divides for: 1 = one divider per ray (Table 2's 4 dividers for a 4-ray
+  // packet); k > 1 models a traversal unit with k dividers per ray (1..6).
+  int clip_faces_per_step = 1;
+  // Every datapath step on encodings in the paper's op order (units/datapath.h), none on the
+  // binary64 fast paths: slower, the same results. The fast paths' independent check
+  // (testbench/reference_datapath_test.cpp compares both frames step by step).
+  bool reference_datapath = false;
+  bool shade = true;       // run the RGS; false leaves the image black (hit records only)
+  bool shadows = false;    // shadow rays (docs/shading.md 6.4); Table 3 setting: off
+  bool secondary = false;  // reflection and transparency rays; Table 3 setting: off
+  int max_depth = -1;      // secondary-ray depth bound, -1 = FrameRegisters::max_depth
+  ff::Mode mode{};         // rounding of every FP unit
+};
+
+// Work counted per ray (DESIGN.md section 5; issue 4).
+struct RayCounters {
+  std::uint64_t traversal_steps = 0;  // kd-node visits in which the ray was active
+  std::uint64_t list_entries = 0;     // list entries fetched for the ray
+  std::uint64_t mailbox_skips = 0;    // entries skipped because the ray already visited them
+  std::uint64_t transformations = 0;  // ray transforms (generation, object, triangle)
+  std::uint64_t intersections = 0;    // unit-triangle tests
+  RayCounters& operator+=(const RayCounters& o) {
+    traversal_steps += o.traversal_steps;
+    list_entries += o.list_entries;
+    mailbox_skips += o.mailbox_skips;
+    transformations += o.transformations;
+    intersections += o.intersections;
+    return *this;
+  }
+  friend bool operator==(const RayCounters&, const RayCounters&) = default;
+};
+
+enum class RayKind : std::uint8_t { kPrimary = 0, kShadow = 1, kReflection = 2, kTransparency = 3 };
+inline constexpr int kRayKinds = 4;
+inline const char* ray_kind_name(RayKind k) {
+  constexpr const char* kNames[] = {"primary", "shadow", "reflection", "transparency"};
+  return kNames[static_cast<int>(k)];
+}
+
+// The hardware units of one DynRTP a thread may ask for.
+enum class UnitId : std::uint8_t {
+  kRgs,
+  kTransformation,
+  kTraversal,
+  kList,
+  kIntersection,
+  kNone,
+};
+inline const char* unit_name(UnitId u) {
+  constexpr const char* kNames[] = {"rgs",  "transformation", "traversal",
+                                    "list", "intersection",   "none"};
+  return kNames[static_cast<int>(u)];
+}
+
+// The states of the thread program. Each names the unit that serves it.
+enum class Phase : std::uint8_t {
+  kGenerate,           // transformation (path a): R' through the RGS's T into world rays
+  kClipTop,            // traversal: one face of the scene box (6 steps, D29)
+  kTraverse,           // traversal (paths b, f): one kd-node step of the packet
+  kList,               // list (path c): one list entry, mailboxed at the top level
+  kTransformObject,    // transformation (path d): world -> object with the instance matrix
+  kClipBottom,         // traversal: one face of the object box (6 steps)
+  kTransformTriangle,  // transformation (path d): object -> unit-triangle space with T_delta
+  kIntersect,          // intersection (path e): the packet's rays one per cycle
+  kShadeSurface,       // RGS (path g): the surface hits of a primary/secondary packet
+  kShadeLight,         // RGS: cosines of one light from its generated shadow rays
+  kShadeShadow,        // RGS: shadow-ray results of one light
+  kDone,
+};
+inline const char* phase_name(Phase p) {
+  constexpr const char* kNames[] = {
+      "generate",         "clip_top",    "traverse",           "list",
+      "transform_object", "clip_bottom", "transform_triangle", "intersect",
+      "shade_surface",    "shade_light", "shade_shadow",       "done"};
+  return kNames[static_cast<int>(p)];
+}
+inline UnitId phase_unit(Phase p) {
+  switch (p) {
+    case Phase::kGenerate:
+    case Phase::kTransformObject:
+    case Phase::kTransformTriangle:
+      return UnitId::kTransformation;
+    case Phase::kClipTop:
+    case Phase::kTraverse:
+    case Phase::kClipBottom:
+      return UnitId::kTraversal;
+    case Phase::kList:
+      return UnitId::kList;
+    case Phase::kIntersect:
+      return UnitId::kIntersection;
+    case Phase::kShadeSurface:
+    case Phase::kShadeLight:
+    case Phase::kShadeShadow:
+      return UnitId::kRgs;
+    case Phase::kDone:
+      return UnitId::kNone;
+  }
+  return UnitId::kNone;
+}
+
+// What the thread asks of a unit next: enough for a cycle model to fetch the item through the
+// unit's cache and to know how many pipeline slots the work takes.
+struct Request {
+  UnitId unit = UnitId::kNone;
+  Phase phase = Phase::kDone;
+  std::uint32_t item = memif::kNone;  // kTraverse: node; kList: list entry; kTransform*: first
+                                      // matrix row; kClip*: face 0..5; otherwise kNone
+  int steps = 0;           // transformation steps (n+1 or 2n), intersection cycles (P), else 1
+  std::uint64_t mask = 0;  // the rays concerned
+};
+
+// Unit transactions as the datapaths see them (units/unit_vectors.h: the vectors an RTL unit is
+// checked against). Null in every model run; the capture sets it on a functional run.
+template <class F>
+class UnitTap {
+ public:
+  virtual ~UnitTap() = default;
+  // One ray's lane of an inner kd-node step (traversal_lane's operands and results).
+  virtual void traversal(F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far,
+                         F near_tf, F far_tn) = 0;
+  // One matrix-vector step of ray generation or of an object or triangle transformation
+  // (transform_step).
+  virtual void transformation(const Mat34<F>& m, const Vec3<F>& in, bool translate,
+                              const Vec3<F>& out) = 0;
+  // One ray's unit-triangle intersection (intersect_unit_triangle).
+  virtual void intersection(const Ray<F>& ray, const Candidate<F>& c) = 0;
+};
+
+// The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is
+// DIGEST D10's optional shading helper (cosines: mul, sqrt, div).
+template <class F>
+class PipelineUnits {
+ public:
+  explicit PipelineUnits(ff::Mode mode = {})
+      : traversal(mode, &traversal_ops),
+        transformation(mode, &transformation_ops),
+        intersection(mode, &intersection_ops),
+        rgs(mode, &rgs_ops),
+        raw(mode),
+        direct(mode) {}
+  PipelineUnits(const PipelineUnits&) = delete;
+  PipelineUnits& operator=(const PipelineUnits&) = delete;
+
+  ff::OpCounts traversal_ops, transformation_ops, intersection_ops, rgs_ops;
+  UnitFp<F> traversal, transformation, intersection, rgs;
+  // The same operators without counters, for the datapath steps the thread program counts in
+  // bulk: every step's op count is fixed by the datapath whatever the mask (D30: a masked lane
+  // fires and its result is discarded), so the counts are added where the step is issued.
+  RawFp<F> raw;
+  RawFp<F, false> direct;     // without the zero shortcuts: the traversal unit's few zeros
+  UnitTap<F>* tap = nullptr;  // unit transaction capture (units/unit_vectors.h)
+
+  static void count(ff::OpCounts& c, std::uint64_t add, std::uint64_t mul, std::uint64_t div,
+                    std::uint64_t cmp) {
+    c.add += add;
+    c.mul += mul;
+    c.div += div;
+    c.cmp += cmp;
+  }
+
+  // Work counted per unit, in the unit's own steps.
+  std::uint64_t traversal_steps = 0;       // kd-node steps (inner + leaf + empty)
+  std::uint64_t inner_steps = 0;           // steps on inner nodes (P add, P div, 3P cmp)
+  std::uint64_t clip_steps = 0;            // box-face steps (P add, P div, P (+P) cmp)
+  std::uint64_t clips = 0;                 // box clips (scene box or object box)
+  std::uint64_t exit_only_clips = 0;       // of them, exit faces only (origins inside the box)
+  std::uint64_t list_steps = 0;            // list entries fetched
+  std::uint64_t transformation_steps = 0;  // ray transformation steps (generation, object, tri)
+  std::uint64_t shading_transformation_steps = 0;  // normal and dot-product steps of the RGS
+  std::uint64_t intersection_packets = 0;          // packets intersected (P rays each)
+  std::uint64_t sub_packets = 0;       // masked sub-packets from mixed direction signs (D27)
+  std::uint64_t stack_drops = 0;       // stack entries dropped at the pop: every ray terminated
+  std::uint64_t empty_leaf_steps = 0;  // of traversal_steps, on leaves without items
+};
+
+// Where a thread's results go: the frame the RGC hands pixels from.
+struct FrameSink {
+  int width = 0;
+  int height = 0;
+  // Per pixel: the primary ray's closest hit (encodings), its world ray, its counters.
+  struct Pixel {
+    std::uint32_t t = 0, u = 0, v = 0, cos = 0;
+    std::uint32_t instance = memif::kNone, triangle = memif::kNone;
+    std::array<std::uint32_t, 3> o{}, d{};
+    RayCounters counters;
+  };
+  // (HugePageAllocator: a frame's buffers are first touched in 2 MiB pages.)
+  std::vector<Pixel, HugePageAllocator<Pixel>> pixels;
+  std::vector<std::array<std::uint32_t, 3>, HugePageAllocator<std::array<std::uint32_t, 3>>>
+      colour_sum;  // sum of weight * colour (docs 7)
+  std::array<RayCounters, kRayKinds> by_kind{};
+  std::array<std::uint64_t, kRayKinds> rays_issued{};
+  std::array<std::uint64_t, kRayKinds> rays_returned{};
+
+  void reset(int w, int h) {
+    width = w;
+    height = h;
+    pixels.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), Pixel{});
+    colour_sum.assign(pixels.size(), {0u, 0u, 0u});
+    by_kind = {};
+    rays_issued = {};
+    rays_returned = {};
+  }
+};
+
+}  // namespace saarcor::units

@@ -1,0 +1,425 @@
+// The ray generation and shading unit's semantics (paper section 3; Figure 2 paths a and g;
+// DESIGN.md section 7; docs/shading.md; decisions D10, D15, D19, D37): the RGC hands a thread a
+// primary packet of pixels, the RGS builds R' and T for the transformation unit (path a); when a
+// packet returns (path g) it records primary hits, shades: the world normal through M^T, the
+// material and texture, ambient, per light a packet of shadow-ray directions through the
+// transformation unit and the cosines on the RGS FP helper (mul, sqrt, div), specular highlights,
+// then reflection and transparency children, traced last in, first out. Dot products and normals
+// run on the transformation unit and are counted there. Timing: units/ray_source.cpp (the RGC's
+// admission and the final hits); exact-cycle test: units/unit_timing_test.cpp (RaySource*).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "units/packet.h"
+#include "units/shading.h"
+
+namespace saarcor::units {
+
+template <class F, int kLanes>
+class RgsStep {
+ public:
+  using State = PacketState<F, kLanes>;
+  using Mat64 = MatrixValues<F>;
+
+  RgsStep(const memif::MemoryImage& image, const FunctionalParams& params, int packet) {
+    const auto& regs = image.registers();
+    max_depth_ =
+        params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth) : regs.max_depth;
+    epsilon_ = F::from_bits(regs.epsilon);
+    surf_.resize(static_cast<std::size_t>(packet));
+  }
+
+  // The RGC hands the thread the primary packet of pixels `pixel[i]` (memif::kNone = empty lane).
+  void start_primary(State& t, const std::vector<std::uint32_t>& pixel) {
+    pending_size_ = 0;
+    t.scene.refresh(t.image);
+    normal_instance_ = memif::kNone;
+    const auto width = static_cast<std::uint32_t>(t.sink.width);
+    GenPacket<F>& pk = t.transformation.input();  // built in place (load's copy: self-assignment)
+    pk.kind = RayKind::kPrimary;
+    pk.depth = 0;
+    pk.shared_origin = t.params.shared_origin;
+    pk.lanes.assign(t.lanes.size(), GenLane<F>{});
+    for (int i = 0; i < t.p; ++i) {
+      auto& g = pk.lanes[static_cast<std::size_t>(i)];
+      g.t = t.transformation.camera();
+      g.ro = {F::zero(), F::zero(), F::zero()};
+      const std::uint32_t px = i < static_cast<int>(pixel.size()) ? pixel[i] : memif::kNone;
+      if (px == memif::kNone) continue;
+      g.valid = true;
+      g.pixel = px;
+      g.weight = 255;
+      // The pixel coordinates as F (exact binary64 integers, rounded once: as F::from_int).
+      g.rd = {t.u.raw.from_double(static_cast<double>(px % width)),
+              t.u.raw.from_double(static_cast<double>(px / width)), F::one()};
+    }
+    t.transformation.load(t, pk);
+  }
+
+  // A returning primary or secondary packet (path g): its surfaces, then the lights.
+  void shade_surface(State& t) {
+    account_counters(t);
+    if (t.kind == RayKind::kPrimary) record_primary(t);
+    if (!t.params.shade) return next_packet(t);
+    const auto& regs = t.image.registers();
+    const Rgb8 ambient = unpack_rgb(regs.ambient_rgb);
+    const Rgb8 background = unpack_rgb(regs.background_rgb);
+    static const Surface kClear{};
+    for (int i = 0; i < t.p; ++i) {
+      const Lane<F>& l = t.lane(i);
+      Surface& s = surf_[static_cast<std::size_t>(i)];
+      s = kClear;  // as Surface{}, without its string store (as in TransformationStep::load)
+      if (!l.valid) continue;
+      s.pixel = l.pixel;
+      s.weight = l.weight;
+      s.depth = t.depth;
+      if (!l.hit.hit()) {
+        add_colour(t, l.pixel, l.weight, background);
+        continue;
+      }
+      surface(t, l, s, ambient);
+    }
+    light_ = 0;
+    next_light(t);
+  }
+
+  // The cosines of light `light_` from the generated shadow-ray directions; the lit hits' shadow
+  // rays go to the traversal unit when shadows are traced.
+  void shade_light(State& t) {
+    std::uint64_t trace = 0;
+    for (int i = 0; i < t.p; ++i) {
+      Surface& s = surf_[static_cast<std::size_t>(i)];
+      s.lit = false;
+      s.highlight = false;
+      if (!s.hit) continue;
+      const Vec3<F>& sd = t.lane(i).world.d;  // hit point - L
+      const F ns = shade_dot(t, s.n, sd);
+      const F ss = shade_dot(t, sd, sd);
+      s.lit = is_neg_nonzero(ns);
+      if (!s.lit) continue;
+      s.cos = cosine(t, ns, s.nn, ss);
+      if (s.spec) {
+        const F rl = shade_dot(t, s.r, sd);
+        s.highlight = is_neg_nonzero(rl);
+        if (s.highlight) s.cos_s = cosine(t, rl, s.rr, ss);
+      }
+      trace |= std::uint64_t{1} << i;
+    }
+    t.u.shading_transformation_steps += 1;
+    if (!t.params.shadows || trace == 0) {
+      for (int i = 0; i < t.p; ++i)
+        t.lane(i).valid = false;
+      return accumulate_light(t);
+    }
+    for (int i = 0; i < t.p; ++i)
+      t.lane(i).valid = lane_in(trace, i);
+    t.traversal.issue(t);
+  }
+
+  // A returning shadow packet: the light's contribution for the unoccluded hits.
+  void shade_shadow(State& t) {
+    account_counters(t);
+    accumulate_light(t);
+  }
+
+ private:
+  // The RGS's per-lane surface context while it shades a packet's hits.
+  struct Surface {
+    bool hit = false;
+    std::uint32_t pixel = memif::kNone;
+    std::uint32_t weight = 0;
+    std::uint32_t depth = 0;
+    Ray<F> ray;
+    HitRecord<F> rec;
+    Vec3<F> n{};
+    F nn{}, kk{}, rr{};
+    Vec3<F> r{};  // reflected view direction (specular)
+    bool spec = false;
+    memif::MaterialRecord mat;
+    Rgb8 base{}, spec_rgb{};
+    std::array<std::uint32_t, 3> acc{};
+    F cos{}, cos_s{};
+    bool lit = false, highlight = false;
+  };
+
+  // ---- arithmetic: the value paths of fast_paths.h where they decide, else the ops on encodings;
+  // the ops counted here per use (the same counts as UnitFp's per op).
+  static void count_transform(State& t, std::uint64_t steps) {
+    PipelineUnits<F>::count(t.u.transformation_ops, 9 * steps, 9 * steps, 0, 0);
+  }
+  // A direction step (ops counted by the caller) as three dot products: each of its rows is
+  // dot_step's expression with the row as the first vector. With a matrix per lane (T_shadow, T_R)
+  // the rows' exponent ranges are cheaper than matrix_values for one step.
+  static Vec3<F> direction_step(const State& t, const Mat34<F>& m, const Vec3<F>& v) {
+    ExponentRange rv;
+    rv.include(v[0]);
+    rv.include(v[1]);
+    rv.include(v[2]);
+    Vec3<F> out;
+    for (int r = 0; r < 3; ++r) {
+      const Vec3<F> row{m[r][0], m[r][1], m[r][2]};
+      if (!dot_step64<F>(row, v, rv, t.nearest, out[r])) out[r] = dot_step(t.u.raw, row, v);
+    }
+    return out;
+  }
+  // A dot product on the transformation unit (a zero-translation row: 3 mul, 3 add).
+  static F shade_dot(State& t, const Vec3<F>& a, const Vec3<F>& b) {
+    PipelineUnits<F>::count(t.u.transformation_ops, 3, 3, 0, 0);
+    F r;
+    if (dot_step64<F>(a, b, t.nearest, r)) return r;
+    return dot_step(t.u.raw, a, b);
+  }
+  // -x / sqrt(a * b) on the RGS helper (1 mul, 1 sqrt, 1 div).
+  static F cosine(State& t, F x, F a, F b) {
+    PipelineUnits<F>::count(t.u.rgs_ops, 0, 1, 1, 0);
+    ++t.u.rgs_ops.sqrt;
+    const auto& fp = t.u.raw;
+    return fp.div(x.neg(), fp.sqrt(fp.mul(a, b)));
+  }
+  // k + k for k = n / d on the RGS helper (1 div, 1 add).
+  static F twice_quotient(State& t, F n, F d) {
+    PipelineUnits<F>::count(t.u.rgs_ops, 1, 0, 1, 0);
+    const F k = t.u.raw.div(n, d);
+    return t.u.raw.add(k, k);
+  }
+  // T_R = [D, N, D; O] (paper 2.2.2 with the erratum: translation O).
+  static Mat34<F> reflect_matrix(const Ray<F>& ray, const Vec3<F>& n) {
+    Mat34<F> m{};
+    for (int r = 0; r < 3; ++r)
+      m[r] = {ray.d[r], n[r], ray.d[r], ray.o[r]};
+    return m;
+  }
+
+  // ---- the frame ------------------------------------------------------------------------------
+  void record_primary(State& t) {
+    for (int i = 0; i < t.p; ++i) {
+      const Lane<F>& l = t.lane(i);
+      if (!l.valid) continue;
+      auto& px = t.sink.pixels[l.pixel];
+      px.t = l.hit.hit() ? l.hit.t.bits : F::infinity().bits;
+      px.u = l.hit.u.bits;
+      px.v = l.hit.v.bits;
+      px.cos = l.hit.c.bits;
+      px.instance = l.hit.instance;
+      px.triangle = l.hit.triangle;
+      for (int k = 0; k < 3; ++k) {
+        px.o[static_cast<std::size_t>(k)] = l.world.o[k].bits;
+        px.d[static_cast<std::size_t>(k)] = l.world.d[k].bits;
+      }
+      px.counters = l.counters;
+    }
+  }
+  static void add_colour(State& t, std::uint32_t pixel, std::uint32_t weight, const Rgb8& c) {
+    auto& s = t.sink.colour_sum[pixel];
+    for (int k = 0; k < 3; ++k)
+      s[static_cast<std::size_t>(k)] += weight * c[k];
+  }
+  static void account_counters(State& t) {
+    for (int i = 0; i < t.p; ++i) {
+      Lane<F>& l = t.lane(i);
+      l.counters.traversal_steps += t.traversal_steps[static_cast<std::size_t>(i)];
+      t.traversal_steps[static_cast<std::size_t>(i)] = 0;
+      if (l.valid) t.sink.by_kind[static_cast<int>(t.kind)] += l.counters;
+    }
+  }
+
+  // ---- shading --------------------------------------------------------------------------------
+  // One hit's surface: world normal, material, base colour, reflected direction, ambient.
+  void surface(State& t, const Lane<F>& l, Surface& s, const Rgb8& ambient) {
+    s.hit = true;
+    s.ray = l.world;
+    s.rec = l.hit;
+    const memif::InstanceHeader h = t.image.instance_header(s.rec.instance);
+    s.n = world_normal(t, h, s.rec);
+    s.nn = shade_dot(t, s.n, s.n);
+    t.u.shading_transformation_steps += 1;  // normal step; the dots count below
+    const memif::ShadingRecord rec = read_shading_record(t.image, h.shading_base + s.rec.triangle);
+    s.mat = read_material(t.image, rec.material);
+    s.base = base_colour(t.image, rec, s.mat, fix16(s.rec.u), fix16(s.rec.v));
+    const std::uint32_t shininess = s.mat.specular_rgb_shininess >> 24;
+    s.spec_rgb = unpack_rgb(s.mat.specular_rgb_shininess);
+    s.spec = shininess >= 1 && (s.mat.specular_rgb_shininess & 0xFFFFFFu) != 0;
+    const bool reflect = t.params.secondary && t.depth < max_depth_ && s.mat.reflectivity > 0;
+    if (s.spec || reflect) s.kk = twice_quotient(t, shade_dot(t, s.ray.d, s.n), s.nn);
+    if (s.spec) {
+      const Mat34<F> tr = reflect_matrix(s.ray, s.n);
+      count_transform(t, 1);
+      s.r = direction_step(t, tr, Vec3<F>{F::one(), s.kk.neg(), F::zero()});
+      s.rr = shade_dot(t, s.r, s.r);
+      t.u.shading_transformation_steps += 1;
+    }
+    for (int k = 0; k < 3; ++k)
+      s.acc[static_cast<std::size_t>(k)] = mul8(s.base[k], ambient[k]);
+  }
+
+  // World normal (D19): the triangle's unit normal (row 2 of T_delta) through M^T, facing the ray.
+  Vec3<F> world_normal(State& t, const memif::InstanceHeader& h, const HitRecord<F>& rec) {
+    const auto nrow = t.row(h.triangle_row_base + memif::kTriangleRows * rec.triangle + 2);
+    if (rec.instance != normal_instance_) {  // hits of a packet mostly share the instance
+      normal_instance_ = rec.instance;
+      const Mat34<F> m =
+          t.matrix(t.image.registers().instance_row_base + memif::kInstanceRows * rec.instance);
+      for (int r = 0; r < 3; ++r)
+        normal_m_[r] = {m[0][r], m[1][r], m[2][r], F::zero()};
+      normal_mv_ = t.matrix_values(normal_m_);
+    }
+    count_transform(t, 1);
+    Vec3<F> n = t.transform(normal_m_, normal_mv_, Vec3<F>{nrow[0], nrow[1], nrow[2]}, false);
+    if (is_pos_nonzero(rec.c))
+      for (auto& x : n)
+        x = x.neg();
+    return n;
+  }
+
+  std::uint64_t surface_hit_mask(const State& t) const {
+    std::uint64_t m = 0;
+    for (int i = 0; i < t.p; ++i)
+      if (surf_[static_cast<std::size_t>(i)].hit) m |= std::uint64_t{1} << i;
+    return m;
+  }
+
+  // Shadow rays of light `light_` through T_shadow = [L, O, D; 0], R' = ((1,0,0), (-1,1,t)).
+  void next_light(State& t) {
+    const auto& regs = t.image.registers();
+    if (light_ >= regs.light_count || surface_hit_mask(t) == 0) return finish_surface(t);
+    const std::uint32_t a = regs.light_base + memif::kLightWords * light_;
+    Vec3<F> pos;
+    for (std::uint32_t k = 0; k < 3; ++k)
+      pos[k] = F::from_bits(t.image.word(memif::kShadingBank, a + k));
+    light_rgb_ = unpack_rgb(t.image.word(memif::kShadingBank, a + 3));
+    GenPacket<F>& pk = t.transformation.input();  // built in place, as in start_primary
+    pk.kind = RayKind::kShadow;
+    pk.depth = t.depth;
+    pk.shared_origin = t.params.shared_origin;
+    pk.lanes.resize(t.lanes.size());
+    for (int i = 0; i < t.p; ++i) {
+      const Surface& s = surf_[static_cast<std::size_t>(i)];
+      GenLane<F>& g = pk.lanes[static_cast<std::size_t>(i)];
+      for (int r = 0; r < 3; ++r)
+        g.t[r] = {pos[r], s.ray.o[r], s.ray.d[r], F::zero()};
+      g.ro = {F::one(), F::zero(), F::zero()};
+      g.rd = {F::one().neg(), F::one(), s.rec.t};
+      g.valid = s.hit;
+      g.pixel = s.pixel;
+      g.weight = 0;
+    }
+    t.transformation.load(t, pk);
+    if (t.params.shadows) return;
+    // Without shadow rays only the directions are needed: n direction steps, no origin step.
+    t.u.shading_transformation_steps += static_cast<std::uint64_t>(t.p);
+    count_transform(t, static_cast<std::uint64_t>(t.p));
+    for (int i = 0; i < t.p; ++i) {
+      const GenLane<F>& g = pk.lanes[static_cast<std::size_t>(i)];
+      t.lane(i).world.d = direction_step(t, g.t, g.rd);
+    }
+    shade_light(t);
+  }
+
+  // Diffuse and specular of light `light_` for the lit, unoccluded hits.
+  void accumulate_light(State& t) {
+    for (int i = 0; i < t.p; ++i) {
+      Surface& s = surf_[static_cast<std::size_t>(i)];
+      if (!s.hit || !s.lit) continue;
+      if (t.params.shadows && t.lane(i).hit.hit()) continue;  // occluded
+      const std::uint32_t wd = fix8(s.cos);
+      for (int k = 0; k < 3; ++k)
+        s.acc[static_cast<std::size_t>(k)] += (mul8(s.base[k], light_rgb_[k]) * wd) >> 8;
+      if (s.spec && s.highlight) {
+        const std::uint32_t p = specular_power(fix8(s.cos_s), s.mat.specular_rgb_shininess >> 24);
+        for (int k = 0; k < 3; ++k)
+          s.acc[static_cast<std::size_t>(k)] += (mul8(s.spec_rgb[k], light_rgb_[k]) * p) >> 8;
+      }
+    }
+    ++light_;
+    next_light(t);
+  }
+
+  // Local colour into the pixel, then reflection and transparency children (D37).
+  void finish_surface(State& t) {
+    // The children are built in the next two pending slots, whose lane vectors are kept from
+    // earlier packets (no allocation per packet); the reflection packet is traced first.
+    if (pending_.size() < pending_size_ + 2) pending_.resize(pending_size_ + 2);
+    GenPacket<F>& transp = pending_[pending_size_];
+    GenPacket<F>& refl = pending_[pending_size_ + 1];
+    refl.kind = RayKind::kReflection;
+    transp.kind = RayKind::kTransparency;
+    refl.depth = transp.depth = t.depth + 1;
+    refl.shared_origin = transp.shared_origin = false;
+    refl.lanes.assign(t.lanes.size(), GenLane<F>{});
+    transp.lanes.assign(t.lanes.size(), GenLane<F>{});
+    bool any_refl = false, any_transp = false;
+    for (int i = 0; i < t.p; ++i) {
+      const Surface& s = surf_[static_cast<std::size_t>(i)];
+      if (s.hit)
+        finish_lane(t, s, refl.lanes[static_cast<std::size_t>(i)],
+                    transp.lanes[static_cast<std::size_t>(i)], any_refl, any_transp);
+    }
+    if (any_transp) ++pending_size_;
+    if (any_refl) {
+      if (!any_transp) std::swap(transp, refl);
+      ++pending_size_;
+    }
+    next_packet(t);
+  }
+
+  // One hit's local colour, weighted by what its children leave, and its children's lanes.
+  void finish_lane(State& t, const Surface& s, GenLane<F>& refl, GenLane<F>& transp, bool& any_refl,
+                   bool& any_transp) {
+    Rgb8 local{};
+    for (int k = 0; k < 3; ++k)
+      local[k] = std::min<std::uint32_t>(255u, s.acc[k]);
+    const bool spawn = t.params.secondary && t.depth < max_depth_;
+    const std::uint32_t kr = spawn ? s.mat.reflectivity : 0u;
+    const std::uint32_t kt = spawn ? s.mat.transparency : 0u;
+    const std::uint32_t wl =
+        t.params.secondary ? mul8(s.weight, 255u - std::min(255u, kr + kt)) : s.weight;
+    add_colour(t, s.pixel, wl, local);
+    const std::uint32_t wr = mul8(s.weight, kr), wt = mul8(s.weight, kt);
+    const Mat34<F> tr = reflect_matrix(s.ray, s.n);
+    if (wr > 0) {
+      refl = {true,
+              s.pixel,
+              wr,
+              tr,
+              {epsilon_.neg(), F::zero(), s.rec.t},
+              {F::one(), s.kk.neg(), F::zero()}};
+      any_refl = true;
+    }
+    if (wt > 0) {
+      transp = {
+          true, s.pixel, wt, tr, {epsilon_, F::zero(), s.rec.t}, {F::one(), F::zero(), F::zero()}};
+      any_transp = true;
+    }
+  }
+
+  // The next child packet (last in, first out), or the thread is done.
+  void next_packet(State& t) {
+    if (pending_size_ == 0) {
+      t.phase = Phase::kDone;
+      return;
+    }
+    --pending_size_;
+    t.transformation.load(t, pending_[pending_size_]);  // copied: the slot may be rebuilt
+  }
+
+  std::uint32_t max_depth_ = 3;
+  F epsilon_{};
+  std::vector<Surface> surf_;
+  std::uint32_t light_ = 0;
+  Rgb8 light_rgb_{};
+  // Child packets still to trace (a LIFO of pending_size_ entries); slots beyond it keep their
+  // lane vectors for reuse.
+  std::vector<GenPacket<F>> pending_;
+  std::size_t pending_size_ = 0;
+  // M^T (zero translation) of the instance whose normals the RGS transformed last, and its values;
+  // kNone: none yet in this primary packet's tree (the image may change between frames).
+  std::uint32_t normal_instance_ = memif::kNone;
+  Mat34<F> normal_m_{};
+  Mat64 normal_mv_{};
+};
+
+}  // namespace saarcor::units
