@@ -22,8 +22,9 @@ struct Binding {
   [](const CycleParams& p) { return static_cast<double>(p.expr); }, \
       [](CycleParams& p, double v) { p.expr = static_cast<type>(v); }
 
-const std::vector<Binding>& bindings() {
-  static const std::vector<Binding> table = {
+// The thread and its units (DynRTPs, threads, packets, stack, mailboxes, clip, traversal).
+std::vector<Binding> thread_bindings() {
+  return {
       {{"pipelines", 1, "DynRTPs",
         "dynamic ray tracing pipelines sharing the memory controller; the RGC grants them packets "
         "round robin, one pipeline per cycle (D44)",
@@ -57,6 +58,12 @@ const std::vector<Binding>& bindings() {
       {{"traversal.skip_empty", 1, "bool",
         "inner nodes flag empty children and the traversal never steps into them", 0, 1, false},
        SAARCOR_FIELD(skip_empty, bool)},
+  };
+}
+
+// The DynRTC caches (paper section 4: one per unit).
+std::vector<Binding> cache_bindings() {
+  return {
       {{"cache.traversal.items", 512, "items", "kd-node cache lines (D20)", 1, 1 << 20, true},
        SAARCOR_FIELD(cache[0].items, int)},
       {{"cache.traversal.ways", 1, "ways", "kd-node cache associativity", 1, 64, false},
@@ -86,6 +93,12 @@ const std::vector<Binding>& bindings() {
         "each cache's memory-request and fill channels to and from the simple routing", 1, 256,
         false},
        SAARCOR_FIELD(cache_memory_queue, int)},
+  };
+}
+
+// The memory controller, the routing of responses and the host bus.
+std::vector<Binding> memory_bindings() {
+  return {
       {{"mem.latency", 4, "cycles", "SRAM read latency (D21)", 1, 1000, false},
        SAARCOR_FIELD(mem_latency, int)},
       {{"mem.switch_penalty", 1, "cycles", "bank switch penalty on a shared path (D21)", 0, 100,
@@ -126,6 +139,12 @@ const std::vector<Binding>& bindings() {
       {{"hostbus.burst_words", 4, "words", "words per host-bus write burst into a bank", 1,
         memif::kMaxRequestWords, false},
        SAARCOR_FIELD(hostbus_burst_words, int)},
+  };
+}
+
+// The float operators, the clock and the watchdog.
+std::vector<Binding> operator_bindings() {
+  return {
       {{"lat.add", 3, "cycles", "fp adder latency (D7)", 1, 64, false},
        SAARCOR_FIELD(lat_add, int)},
       {{"lat.mul", 3, "cycles", "fp multiplier latency (D7)", 1, 64, false},
@@ -138,6 +157,17 @@ const std::vector<Binding>& bindings() {
       {{"watchdog", 100000, "cycles", "cycles without progress that stop a run", 1, 1e12, false},
        SAARCOR_FIELD(watchdog, std::uint64_t)},
   };
+}
+
+const std::vector<Binding>& bindings() {
+  static const std::vector<Binding> table = [] {
+    std::vector<Binding> t;
+    for (auto* group : {thread_bindings, cache_bindings, memory_bindings, operator_bindings}) {
+      const std::vector<Binding> g = group();
+      t.insert(t.end(), g.begin(), g.end());
+    }
+    return t;
+  }();
   return table;
 }
 #undef SAARCOR_FIELD

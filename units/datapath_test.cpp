@@ -254,72 +254,87 @@ std::uint32_t operand(std::mt19937_64& rng) {
   }
 }
 
+// One random traversal lane and its two clip faces: where the binary64 path decides, it equals
+// the encoding path. Returns whether the traversal lane was decided there.
+template <class G>
+bool check_traversal_and_clip_case(const RawFp<G, false>& fp, ff::Mode mode, std::mt19937_64& rng) {
+  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
+  const auto value = [&](G x) { return value_of(x, mode.subnormals); };
+  // Traversal lane: the segment bounds are values of encodings, never NaN (tf may be inf).
+  const G split = op(), o = op(), d = op();
+  G tn = op(), tf = op();
+  if (bits_nan(tn)) tn = G::zero();
+  if (bits_nan(tf)) tf = G::infinity();
+  TraversalLane64 r64;
+  const double inv = traversal_reciprocal(fp, d);
+  const bool decided = traversal_lane64<G>(value(split), value(o), inv, value(tn), value(tf), r64);
+  if (decided) {
+    const TraversalLane<G> r = traversal_lane(fp, split, o, d, tn, tf);
+    EXPECT_EQ(r64.go_near, r.go_near) << split.bits << " " << o.bits << " " << d.bits;
+    EXPECT_EQ(r64.go_far, r.go_far) << split.bits << " " << o.bits << " " << d.bits;
+    // The model keeps segment bounds as values (a subnormal reads as +-0 in flush mode).
+    const auto same = [&](double v, G e) {
+      return v == value(e) && std::signbit(v) == std::signbit(value(e));
+    };
+    EXPECT_TRUE(same(r64.near_tf, r.near_tf) && same(r64.far_tn, r.far_tn))
+        << ff::format_name(G::kFormat) << " keep=" << (mode.subnormals == ff::Subnormals::kKeep)
+        << " split " << split.bits << " o " << o.bits << " d " << d.bits << " tn " << tn.bits
+        << " tf " << tf.bits;
+  }
+  for (const bool entry : {true, false}) {
+    double tn64 = value(tn), tf64 = value(tf);
+    G tn_e = tn, tf_e = tf;
+    if (clip_face64<G>(value(split), value(o), inv, entry, tn64, tf64)) {
+      clip_face(fp, split, o, d, entry, tn_e, tf_e);
+      EXPECT_EQ(tn64, value(tn_e));
+      EXPECT_EQ(tf64, value(tf_e));
+      EXPECT_EQ(std::signbit(tn64), std::signbit(value(tn_e)));
+      EXPECT_EQ(std::signbit(tf64), std::signbit(value(tf_e)));
+    }
+  }
+  return decided;
+}
+
+// One random transformation step, mostly on moderate operands so that many are decided on
+// values: where transform_step64 decides, it equals transform_step. Returns the steps decided.
+template <class G>
+int check_transform_case(const RawFp<G, false>& fp, ff::Mode mode, std::mt19937_64& rng) {
+  const auto op_t = [&] {
+    const G x = G::from_bits(operand<G>(rng));
+    const std::uint32_t e = (x.bits >> G::kManBits) & G::kFormat.exp_field_max();
+    const int u = static_cast<int>(e) - G::kFormat.bias();
+    return (rng() % 16) == 0 || bits_zero(x) || (u >= -20 && u <= 20)
+               ? x
+               : G::from_bits(G::one().bits | (x.bits & G::kFormat.man_mask()) |
+                              (x.bits & G::kFormat.sign_mask()));
+  };
+  Mat34<G> m;
+  for (auto& row : m)
+    for (auto& x : row)
+      x = op_t();
+  const Vec3<G> v{op_t(), op_t(), op_t()};
+  MatrixValues<G> mv = matrix_values(m, mode.subnormals);
+  int decided = 0;
+  for (const bool translate : {true, false}) {
+    Vec3<G> out;
+    if (transform_step64<G>(mv, v, translate, out)) {
+      ++decided;
+      const Vec3<G> want = transform_step(fp, m, v, translate);
+      for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(out[k].bits, want[k].bits) << "row " << k;
+    }
+  }
+  return decided;
+}
+
 template <class G>
 void check_binary64_paths(ff::Mode mode, int n) {
   const RawFp<G, false> fp(mode);
   std::mt19937_64 rng(2024);
-  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
-  const auto value = [&](G x) { return value_of(x, mode.subnormals); };
   int decided = 0, transforms = 0;
-  for (int it = 0; it < n; ++it) {
-    // Traversal lane: the segment bounds are values of encodings, never NaN (tf may be inf).
-    const G split = op(), o = op(), d = op();
-    G tn = op(), tf = op();
-    if (bits_nan(tn)) tn = G::zero();
-    if (bits_nan(tf)) tf = G::infinity();
-    TraversalLane64 r64;
-    const double inv = traversal_reciprocal(fp, d);
-    if (traversal_lane64<G>(value(split), value(o), inv, value(tn), value(tf), r64)) {
-      ++decided;
-      const TraversalLane<G> r = traversal_lane(fp, split, o, d, tn, tf);
-      ASSERT_EQ(r64.go_near, r.go_near) << split.bits << " " << o.bits << " " << d.bits;
-      ASSERT_EQ(r64.go_far, r.go_far) << split.bits << " " << o.bits << " " << d.bits;
-      // The model keeps segment bounds as values (a subnormal reads as +-0 in flush mode).
-      const auto same = [&](double v, G e) {
-        return v == value(e) && std::signbit(v) == std::signbit(value(e));
-      };
-      ASSERT_TRUE(same(r64.near_tf, r.near_tf) && same(r64.far_tn, r.far_tn))
-          << ff::format_name(G::kFormat) << " keep=" << (mode.subnormals == ff::Subnormals::kKeep)
-          << " split " << split.bits << " o " << o.bits << " d " << d.bits << " tn " << tn.bits
-          << " tf " << tf.bits;
-    }
-    // Clip face.
-    for (const bool entry : {true, false}) {
-      double tn64 = value(tn), tf64 = value(tf);
-      G tn_e = tn, tf_e = tf;
-      if (clip_face64<G>(value(split), value(o), inv, entry, tn64, tf64)) {
-        clip_face(fp, split, o, d, entry, tn_e, tf_e);
-        ASSERT_EQ(tn64, value(tn_e));
-        ASSERT_EQ(tf64, value(tf_e));
-        ASSERT_EQ(std::signbit(tn64), std::signbit(value(tn_e)));
-        ASSERT_EQ(std::signbit(tf64), std::signbit(value(tf_e)));
-      }
-    }
-    // Transformation step: mostly moderate operands, so that many steps are decided here.
-    const auto op_t = [&] {
-      const G x = op();
-      const std::uint32_t e = (x.bits >> G::kManBits) & G::kFormat.exp_field_max();
-      const int u = static_cast<int>(e) - G::kFormat.bias();
-      return (rng() % 16) == 0 || bits_zero(x) || (u >= -20 && u <= 20)
-                 ? x
-                 : G::from_bits(G::one().bits | (x.bits & G::kFormat.man_mask()) |
-                                (x.bits & G::kFormat.sign_mask()));
-    };
-    Mat34<G> m;
-    for (auto& row : m)
-      for (auto& x : row)
-        x = op_t();
-    const Vec3<G> v{op_t(), op_t(), op_t()};
-    MatrixValues<G> mv = matrix_values(m, mode.subnormals);
-    for (const bool translate : {true, false}) {
-      Vec3<G> out;
-      if (transform_step64<G>(mv, v, translate, out)) {
-        ++transforms;
-        const Vec3<G> want = transform_step(fp, m, v, translate);
-        for (int k = 0; k < 3; ++k)
-          ASSERT_EQ(out[k].bits, want[k].bits) << "row " << k;
-      }
-    }
+  for (int it = 0; it < n && !::testing::Test::HasFailure(); ++it) {
+    decided += check_traversal_and_clip_case<G>(fp, mode, rng) ? 1 : 0;
+    transforms += check_transform_case<G>(fp, mode, rng);
   }
   EXPECT_GT(decided, n / 4);  // the binary64 paths decide the common case
   EXPECT_GT(transforms, n / 4);
@@ -353,113 +368,132 @@ TEST(Binary64Paths, AgreeWithTheEncodingPaths) {
   });
 }
 
+inline bool same_double(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+// round_to_format2 on arbitrary binary64 patterns (specials included) and on values near F's
+// range limits, against round_to_format lane by lane.
+template <class G>
+void check_round_pair_case(std::mt19937_64& rng) {
+  std::array<double, 2> x;
+  for (auto& v : x) {
+    const std::uint64_t r = rng();
+    v = (r & 3u) == 0 ? std::bit_cast<double>(rng())
+                      : std::ldexp(std::bit_cast<double>((r >> 12) | 0x3FF0000000000000ull),
+                                   static_cast<int>(rng() % 8) - 4 +
+                                       ((r & 4u) != 0 ? G::kFormat.emin() : G::kFormat.emax()));
+  }
+  V2i ok = {-1, -1};
+  const V2d r = round_to_format2<G>(V2d{x[0], x[1]}, ok);
+  for (int k = 0; k < 2; ++k) {
+    bool ok1 = true;
+    const double r1 = round_to_format<G>(x[static_cast<std::size_t>(k)], ok1);
+    EXPECT_EQ(ok[k] != 0, ok1) << x[static_cast<std::size_t>(k)];
+    EXPECT_TRUE(!ok1 || same_double(r[k], r1));
+  }
+}
+
+// Traversal and clip on two lanes against the one-lane forms. Returns the lanes decided.
+template <class G>
+int check_traversal_pair_case(const RawFp<G, false>& fp, ff::Mode mode, std::mt19937_64& rng) {
+  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
+  const auto value = [&](G x) { return value_of(x, mode.subnormals); };
+  std::array<double, 2> split, o, inv, tn, tf;
+  for (std::size_t k = 0; k < 2; ++k) {
+    split[k] = value(op());
+    o[k] = value(op());
+    inv[k] = traversal_reciprocal(fp, op());
+    G a = op(), b = op();
+    if (bits_nan(a)) a = G::zero();
+    if (bits_nan(b)) b = G::infinity();
+    tn[k] = value(a);
+    tf[k] = value(b);
+  }
+  const auto v2 = [](const std::array<double, 2>& a) { return V2d{a[0], a[1]}; };
+  const TraversalPair64 p = traversal_pair64<G>(v2(split), v2(o), v2(inv), v2(tn), v2(tf));
+  int decided_lanes = 0;
+  for (std::size_t k = 0; k < 2; ++k) {
+    TraversalLane64 r1;
+    const bool decided = traversal_lane64<G>(split[k], o[k], inv[k], tn[k], tf[k], r1);
+    EXPECT_EQ(((p.fail >> k) & 1u) == 0, decided);
+    if (!decided) continue;
+    ++decided_lanes;
+    EXPECT_EQ(((p.go_near >> k) & 1u) != 0, r1.go_near);
+    EXPECT_EQ(((p.go_far >> k) & 1u) != 0, r1.go_far);
+    EXPECT_TRUE(same_double(p.near_tf[static_cast<int>(k)], r1.near_tf));
+    EXPECT_TRUE(same_double(p.far_tn[static_cast<int>(k)], r1.far_tn));
+  }
+  for (const bool entry : {true, false}) {
+    V2d tn2 = v2(tn), tf2 = v2(tf);
+    V2i ok2 = {-1, -1};
+    clip_face_pair64<G>(v2(split), v2(o), v2(inv), entry, tn2, tf2, ok2);
+    for (std::size_t k = 0; k < 2; ++k) {
+      double tn1 = tn[k], tf1 = tf[k];
+      const bool decided = clip_face64<G>(split[k], o[k], inv[k], entry, tn1, tf1);
+      EXPECT_EQ(ok2[static_cast<int>(k)] != 0, decided);
+      EXPECT_TRUE(!decided || (same_double(tn2[static_cast<int>(k)], tn1) &&
+                               same_double(tf2[static_cast<int>(k)], tf1)));
+    }
+  }
+  return decided_lanes;
+}
+
+// Decode, encode and the transformation step on two lanes. Returns the lane steps decided.
+template <class G>
+int check_transform_pair_case(const RawFp<G, false>& fp, ff::Mode mode, std::mt19937_64& rng) {
+  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
+  const auto value = [&](G x) { return value_of(x, mode.subnormals); };
+  Mat34<G> m;
+  for (auto& row : m)
+    for (auto& e : row)
+      e = G::from_bits(G::one().bits ^
+                       (static_cast<std::uint32_t>(rng()) &
+                        (G::kFormat.man_mask() | G::kFormat.sign_mask() | (7u << G::kManBits))));
+  const MatrixValues<G> mv = matrix_values(m, mode.subnormals);
+  std::array<Vec3<G>, 2> v;
+  for (auto& vec : v)
+    for (auto& c : vec)
+      c = op();
+  for (int c = 0; c < 3; ++c) {
+    const V2d d = decode_pair<G>(v[0][c].bits, v[1][c].bits);
+    const V2u e = encode_pair<G>(d);
+    for (int k = 0; k < 2; ++k) {
+      const G x1 = v[static_cast<std::size_t>(k)][c];
+      if (!bits_zero(x1) && !ff::fast::is_normal<G::kExpBits, G::kManBits>(x1.bits)) continue;
+      EXPECT_TRUE(same_double(d[k], value(x1))) << x1.bits;
+      EXPECT_EQ(static_cast<std::uint32_t>(e[k]), x1.bits);
+    }
+  }
+  int transforms = 0;
+  for (const bool translate : {true, false}) {
+    const V2d xs[3] = {decode_pair<G>(v[0][0].bits, v[1][0].bits),
+                       decode_pair<G>(v[0][1].bits, v[1][1].bits),
+                       decode_pair<G>(v[0][2].bits, v[1][2].bits)};
+    V2u out[3];
+    transform_pair64<G>(mv, xs, translate, out);
+    for (int k = 0; k < 2; ++k) {
+      if (!transform_decides<G>(mv, v[static_cast<std::size_t>(k)], translate)) continue;
+      ++transforms;
+      const Vec3<G> want = transform_step(fp, m, v[static_cast<std::size_t>(k)], translate);
+      const Vec3<G> got = lane_of<G>(out, k);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(got[c].bits, want[c].bits);
+    }
+  }
+  return transforms;
+}
+
 // The two-lane forms (thread program) against the one-lane value paths, lane by lane.
 template <class G>
 void check_pair_paths(ff::Mode mode, int n) {
   std::mt19937_64 rng(77);
   const RawFp<G, false> fp(mode);
-  const auto op = [&] { return G::from_bits(operand<G>(rng)); };
-  const auto value = [&](G x) { return value_of(x, mode.subnormals); };
-  const auto same = [](double a, double b) {
-    return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
-  };
   int decided_lanes = 0, transforms = 0;
-  for (int it = 0; it < n; ++it) {
-    // round_to_format2 on arbitrary binary64 patterns (specials included) and on values near F's
-    // range limits.
-    std::array<double, 2> x;
-    for (auto& v : x) {
-      const std::uint64_t r = rng();
-      v = (r & 3u) == 0 ? std::bit_cast<double>(rng())
-                        : std::ldexp(std::bit_cast<double>((r >> 12) | 0x3FF0000000000000ull),
-                                     static_cast<int>(rng() % 8) - 4 +
-                                         ((r & 4u) != 0 ? G::kFormat.emin() : G::kFormat.emax()));
-    }
-    V2i ok = {-1, -1};
-    const V2d r = round_to_format2<G>(V2d{x[0], x[1]}, ok);
-    for (int k = 0; k < 2; ++k) {
-      bool ok1 = true;
-      const double r1 = round_to_format<G>(x[static_cast<std::size_t>(k)], ok1);
-      ASSERT_EQ(ok[k] != 0, ok1) << x[static_cast<std::size_t>(k)];
-      if (ok1) {
-        ASSERT_TRUE(same(r[k], r1));
-      }
-    }
-    // Traversal and clip on two lanes.
-    std::array<double, 2> split, o, inv, tn, tf;
-    for (std::size_t k = 0; k < 2; ++k) {
-      split[k] = value(op());
-      o[k] = value(op());
-      inv[k] = traversal_reciprocal(fp, op());
-      G a = op(), b = op();
-      if (bits_nan(a)) a = G::zero();
-      if (bits_nan(b)) b = G::infinity();
-      tn[k] = value(a);
-      tf[k] = value(b);
-    }
-    const auto v2 = [](const std::array<double, 2>& a) { return V2d{a[0], a[1]}; };
-    const TraversalPair64 p = traversal_pair64<G>(v2(split), v2(o), v2(inv), v2(tn), v2(tf));
-    for (std::size_t k = 0; k < 2; ++k) {
-      TraversalLane64 r1;
-      const bool decided = traversal_lane64<G>(split[k], o[k], inv[k], tn[k], tf[k], r1);
-      ASSERT_EQ(((p.fail >> k) & 1u) == 0, decided);
-      if (!decided) continue;
-      ++decided_lanes;
-      ASSERT_EQ(((p.go_near >> k) & 1u) != 0, r1.go_near);
-      ASSERT_EQ(((p.go_far >> k) & 1u) != 0, r1.go_far);
-      ASSERT_TRUE(same(p.near_tf[static_cast<int>(k)], r1.near_tf));
-      ASSERT_TRUE(same(p.far_tn[static_cast<int>(k)], r1.far_tn));
-    }
-    for (const bool entry : {true, false}) {
-      V2d tn2 = v2(tn), tf2 = v2(tf);
-      V2i ok2 = {-1, -1};
-      clip_face_pair64<G>(v2(split), v2(o), v2(inv), entry, tn2, tf2, ok2);
-      for (std::size_t k = 0; k < 2; ++k) {
-        double tn1 = tn[k], tf1 = tf[k];
-        const bool decided = clip_face64<G>(split[k], o[k], inv[k], entry, tn1, tf1);
-        ASSERT_EQ(ok2[static_cast<int>(k)] != 0, decided);
-        if (decided) {
-          ASSERT_TRUE(same(tn2[static_cast<int>(k)], tn1) && same(tf2[static_cast<int>(k)], tf1));
-        }
-      }
-    }
-    // Decode, encode and the transformation step on two lanes.
-    Mat34<G> m;
-    for (auto& row : m)
-      for (auto& e : row)
-        e = G::from_bits(G::one().bits ^
-                         (static_cast<std::uint32_t>(rng()) &
-                          (G::kFormat.man_mask() | G::kFormat.sign_mask() | (7u << G::kManBits))));
-    const MatrixValues<G> mv = matrix_values(m, mode.subnormals);
-    std::array<Vec3<G>, 2> v;
-    for (auto& vec : v)
-      for (auto& c : vec)
-        c = op();
-    for (int c = 0; c < 3; ++c) {
-      const V2d d = decode_pair<G>(v[0][c].bits, v[1][c].bits);
-      const V2u e = encode_pair<G>(d);
-      for (int k = 0; k < 2; ++k) {
-        const G x1 = v[static_cast<std::size_t>(k)][c];
-        if (!bits_zero(x1) && !ff::fast::is_normal<G::kExpBits, G::kManBits>(x1.bits)) continue;
-        ASSERT_TRUE(same(d[k], value(x1))) << x1.bits;
-        ASSERT_EQ(static_cast<std::uint32_t>(e[k]), x1.bits);
-      }
-    }
-    for (const bool translate : {true, false}) {
-      const V2d xs[3] = {decode_pair<G>(v[0][0].bits, v[1][0].bits),
-                         decode_pair<G>(v[0][1].bits, v[1][1].bits),
-                         decode_pair<G>(v[0][2].bits, v[1][2].bits)};
-      V2u out[3];
-      transform_pair64<G>(mv, xs, translate, out);
-      for (int k = 0; k < 2; ++k) {
-        if (!transform_decides<G>(mv, v[static_cast<std::size_t>(k)], translate)) continue;
-        ++transforms;
-        const Vec3<G> want = transform_step(fp, m, v[static_cast<std::size_t>(k)], translate);
-        const Vec3<G> got = lane_of<G>(out, k);
-        for (int c = 0; c < 3; ++c)
-          ASSERT_EQ(got[c].bits, want[c].bits);
-      }
-    }
+  for (int it = 0; it < n && !::testing::Test::HasFailure(); ++it) {
+    check_round_pair_case<G>(rng);
+    decided_lanes += check_traversal_pair_case<G>(fp, mode, rng);
+    transforms += check_transform_pair_case<G>(fp, mode, rng);
   }
   EXPECT_GT(decided_lanes, n / 4);  // the value paths decide the common case
   EXPECT_GT(transforms, n / 8);

@@ -483,11 +483,8 @@ std::string thread_report(Threads<F, kLanes>& threads, const CycleParams& p) {
   return s.str();
 }
 
-template <class F, int kLanes>
-CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
-                            const CycleRunOptions& opt) {
-  const auto t0 = std::chrono::steady_clock::now();
-  check_cycle_params(p);
+// The functional parameters every thread program of a cycle-model run gets.
+FunctionalParams functional_params(const CycleParams& p, const CycleRunOptions& opt) {
   FunctionalParams fp = opt.shading;
   fp.packet = p.packet;
   fp.stack_depth = p.stack;
@@ -497,27 +494,17 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   fp.skip_empty = p.skip_empty;
   fp.clip_faces_per_step = p.clip_faces_per_step;
   fp.shared_origin = p.shared_origin;
-  // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
-  // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
-  memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
-  if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
-    throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
-                             std::to_string(opt.ahead_packets) + ")");
-  Threads<F, kLanes> threads(image, fp, p.pipelines * p.threads, opt.programs, opt.ahead_packets);
-  hw::KernelConfig kc;
-  kc.watchdog_cycles = p.watchdog;
-  kc.shuffle_seed = opt.shuffle_seed;
-  kc.idle_skip = opt.idle_skip;
-  hw::Kernel k(kc);
-  Chip chip(k, image, p, threads);
-  if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
+  return fp;
+}
 
-  CycleFrame out;
-  out.params = p;
-  out.packets = static_cast<std::uint64_t>(threads.packets());
+// Runs the kernel until the chip has retired every packet, sampling the figures every
+// opt.interval cycles into out.series and reporting progress.
+template <class F, int kLanes>
+void simulate(hw::Kernel& k, Chip& chip, Threads<F, kLanes>& threads, const CycleParams& p,
+              const CycleRunOptions& opt, CycleFrame& out) {
   const auto done = [&] { return chip.finished(); };
   const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
-  Snapshot start = snapshot(k, chip), last = start;
+  Snapshot last = snapshot(k, chip);
   while (!done()) {
     std::uint64_t budget = chunk;
     if (opt.max_cycles != 0) {
@@ -539,13 +526,10 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
     if (opt.progress)
       opt.progress(k.now(), static_cast<int>(chip.packets_retired()), threads.packets());
   }
-  if (opt.vcd != nullptr) k.finish_trace();
-  const Snapshot end = snapshot(k, chip);
+}
 
-  threads.finish();
-  collect(out.frame, threads);
-  out.cycles = k.now();
-  out.figures = figures(start, end, p.clock_mhz);
+// Per pipeline and in total: packets, unit issue and stall cycles, requests, cache counts.
+void collect_units(const hw::Kernel& k, Chip& chip, const Snapshot& end, CycleFrame& out) {
   std::uint64_t served = 0;
   out.per_pipeline.resize(static_cast<std::size_t>(chip.pipelines()));
   for (int pi = 0; pi < chip.pipelines(); ++pi) {
@@ -576,6 +560,10 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   out.frame.units.packets = out.packets;
   for (int c = 0; c < kCacheUnits; ++c)
     out.caches[static_cast<std::size_t>(c)].mem_bytes = end.bytes[static_cast<std::size_t>(c)];
+}
+
+// The frame's rays, rates and SIMD efficiency at the modelled clock.
+void frame_rates(const CycleParams& p, CycleFrame& out) {
   for (int kd = 0; kd < kRayKinds; ++kd) {
     out.rays += out.frame.rays_issued[static_cast<std::size_t>(kd)];
     out.per_ray_sum += out.frame.by_kind[static_cast<std::size_t>(kd)];
@@ -587,6 +575,43 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   out.simd_efficiency = steps == 0 ? 0.0
                                    : static_cast<double>(out.per_ray_sum.traversal_steps) /
                                          static_cast<double>(steps) / p.packet;
+}
+
+template <class F, int kLanes>
+CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
+                            const CycleRunOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_cycle_params(p);
+  // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
+  // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
+  memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
+  if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
+    throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
+                             std::to_string(opt.ahead_packets) + ")");
+  Threads<F, kLanes> threads(image, functional_params(p, opt), p.pipelines * p.threads,
+                             opt.programs, opt.ahead_packets);
+  hw::KernelConfig kc;
+  kc.watchdog_cycles = p.watchdog;
+  kc.shuffle_seed = opt.shuffle_seed;
+  kc.idle_skip = opt.idle_skip;
+  hw::Kernel k(kc);
+  Chip chip(k, image, p, threads);
+  if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
+
+  CycleFrame out;
+  out.params = p;
+  out.packets = static_cast<std::uint64_t>(threads.packets());
+  const Snapshot start = snapshot(k, chip);
+  simulate(k, chip, threads, p, opt, out);
+  if (opt.vcd != nullptr) k.finish_trace();
+  const Snapshot end = snapshot(k, chip);
+
+  threads.finish();
+  collect(out.frame, threads);
+  out.cycles = k.now();
+  out.figures = figures(start, end, p.clock_mhz);
+  collect_units(k, chip, end, out);
+  frame_rates(p, out);
   out.packets_retired = chip.packets_retired();
   out.skipped_cycles = k.skipped_cycles();
   out.host_threads = opt.programs == ProgramMode::kAhead ? 2 : 1;
