@@ -29,6 +29,7 @@
 #include "host/float_reference.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "testbench/bench_summaries.h"
 #include "testbench/paper_cmd.h"
 #include "testbench/render_cmd.h"
 #include "units/functional_model.h"
@@ -220,6 +221,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
+  saarcor::testbench::print_functional_model_ratio();
   print_table3();
   for (const auto& [label, r] : g_rates) {
     const auto get = [&](const char* k) {

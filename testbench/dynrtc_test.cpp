@@ -18,7 +18,7 @@
 #include "host/image_builder.h"
 #include "host/scene.h"
 #include "memif/memory_system.h"
-#include "units/dynrtc_testing.h"
+#include "testbench/dynrtc_testing.h"
 
 namespace saarcor::units {
 namespace {

@@ -1,6 +1,6 @@
-// Test-only helpers of the cycle model tests (units/dynrtc_test.cpp, units/dynrtc_deep_test.cpp):
-// the covering design's configurations and scenes, and the bit-exactness check against the
-// functional fp24 model with conservation of rays and threads.
+// Test-only helpers of the cycle model tests (testbench/dynrtc_test.cpp, dynrtc_deep_test.cpp,
+// unit_vectors_test.cpp): the covering design's configurations and scenes, and the bit-exactness
+// check against the functional fp24 model with conservation of rays and threads.
 #pragma once
 
 #include <gtest/gtest.h>

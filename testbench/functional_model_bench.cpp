@@ -14,6 +14,7 @@
 #include "host/float_reference.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "testbench/bench_summaries.h"
 #include "units/functional_model.h"
 
 namespace {
@@ -244,15 +245,15 @@ BENCHMARK(BM_FloatReferenceRoom)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
+namespace saarcor::testbench {
+
+void print_functional_model_ratio() {
   if (g_fp24_rays_per_s > 0.0 && g_float_rays_per_s > 0.0)
     std::printf(
         "functional fp24 model (P=4): %.3f Mrays/s; float reference: %.3f Mrays/s; "
         "ratio fp24/float = %.3f\n",
         g_fp24_rays_per_s * 1e-6, g_float_rays_per_s * 1e-6,
         g_fp24_rays_per_s / g_float_rays_per_s);
-  return 0;
 }
+
+}  // namespace saarcor::testbench

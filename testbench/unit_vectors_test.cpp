@@ -8,7 +8,7 @@
 
 #include <stdexcept>
 
-#include "units/dynrtc_testing.h"
+#include "testbench/dynrtc_testing.h"
 
 namespace saarcor::units {
 namespace {
@@ -47,7 +47,7 @@ TEST(UnitVectors, CapturedVectorsAreTheDatapathsAnswers) {
   }
 }
 
-// Every scene of the covering design (units/dynrtc_testing.h): 2,000 vectors per unit, each
+// Every scene of the covering design (testbench/dynrtc_testing.h): 2,000 vectors per unit, each
 // recomputed on encodings, so the functional model's binary64 fast paths and the datapath the
 // vectors document agree on every scene's traffic (4.5 s in all in the release build).
 class UnitVectorsOnScenes : public ::testing::TestWithParam<int> {};

@@ -1,12 +1,12 @@
 // Deep (ctest label "deep"): the cycle model against the functional fp24 model on the full cross
-// product of scenes and configurations of units/dynrtc_testing.h at 64x48, and the thread-scaling
+// product of scenes and configurations of testbench/dynrtc_testing.h at 64x48, and the thread-scaling
 // curve of the room at 256x192.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <map>
 
-#include "units/dynrtc_testing.h"
+#include "testbench/dynrtc_testing.h"
 
 namespace saarcor::units {
 namespace {
