@@ -34,6 +34,13 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+// The bin sweep has a 256-bit path, chosen at run time where the processor has AVX.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SAARCOR_KD_AVX 1
+#include <immintrin.h>
+#else
+#define SAARCOR_KD_AVX 0
+#endif
 
 namespace saarcor::host {
 namespace {
@@ -416,10 +423,15 @@ void Builder::build_triangles(std::span<const glm::vec3> positions,
       throw std::runtime_error("kd-tree: triangle " + std::to_string(i) +
                                " indexes a vertex beyond the " + std::to_string(positions.size()) +
                                " positions");
-    // Only the vertices of used triangles matter (and must be finite and storable).
-    for (const unsigned v : {t.x, t.y, t.z})
-      for (int k = 0; k < 3; ++k)
-        check_coordinate(positions[v][k], "vertex", v);
+    // Only the vertices of used triangles matter (and must be finite and storable). One
+    // comparison per coordinate in the common case (false for a NaN), the message otherwise.
+    const float lim = grid_.max_finite();
+    for (const unsigned v : {t.x, t.y, t.z}) {
+      const glm::vec3 a = glm::abs(positions[v]);
+      if (!(a.x <= lim && a.y <= lim && a.z <= lim))
+        for (int k = 0; k < 3; ++k)
+          check_coordinate(positions[v][k], "vertex", v);
+    }
     const glm::vec3 lo = glm::min(glm::min(positions[t.x], positions[t.y]), positions[t.z]);
     const glm::vec3 hi = glm::max(glm::max(positions[t.x], positions[t.y]), positions[t.z]);
     const float l[3] = {lo.x, lo.y, lo.z};
@@ -542,6 +554,109 @@ struct BinScan {
     best_j = better ? j : best_j;
   }
 };
+
+// The three axes' bin-plane sweeps of one node: inputs nc (planes), da, al, ar per axis as
+// BinScan's (nc = 0 for a flat axis), outputs each axis's first least plane.
+struct BinSweep {
+  int nc[3] = {0, 0, 0};
+  double da[3] = {0.0, 0.0, 0.0};
+  double al[3] = {0.0, 0.0, 0.0};
+  double ar[3] = {0.0, 0.0, 0.0};
+  double best_m[3] = {std::numeric_limits<double>::infinity(),
+                      std::numeric_limits<double>::infinity(),
+                      std::numeric_limits<double>::infinity()};
+  int best_j[3] = {-1, -1, -1};
+};
+
+// The portable sweep: three BinScans side by side (three independent chains of additions: each
+// axis's half areas step by repeated addition, so one axis alone waits on its adds).
+void sweep_bins_portable(const BinHist& hist_lo, const BinHist& hist_hi, std::uint32_t n,
+                         BinSweep& sw) {
+  BinScan sc[3] = {{&hist_lo[0][0], &hist_hi[0][0]},
+                   {&hist_lo[0][1], &hist_hi[0][1]},
+                   {&hist_lo[0][2], &hist_hi[0][2]}};
+  for (int k = 0; k < 3; ++k) {
+    sc[k].nc = sw.nc[k];
+    sc[k].da = sw.da[k];
+    sc[k].al = sw.al[k];
+    sc[k].ar = sw.ar[k];
+  }
+  const int nc_common = std::min({sc[0].nc, sc[1].nc, sc[2].nc});
+  for (int j = 0; j < nc_common; ++j) {
+    sc[0].step(j, n);
+    sc[1].step(j, n);
+    sc[2].step(j, n);
+  }
+  for (int k = 0; k < 3; ++k) {
+    for (int j = nc_common; j < sc[k].nc; ++j)
+      sc[k].step(j, n);
+    sw.best_m[k] = sc[k].best_m;
+    sw.best_j[k] = sc[k].best_j;
+  }
+}
+
+#if SAARCOR_KD_AVX
+// The same sweep with the three axes in one 256-bit register (lane k = axis k): each lane the
+// step's binary64 operations in the same order (counts are exact integers either way), the least
+// value kept by a min and its index following it where the value drops strictly: the same
+// planes. Every lane runs to the longest axis's last plane: from an axis's own last bin on its
+// right count is 0 (every key lies in a bin below nb[k]; the histograms are zero above), which
+// rules those planes out as the step does, and a flat axis (all items in bin 0) never has one.
+__attribute__((target("avx"))) void sweep_bins_avx(const BinHist& hist_lo, const BinHist& hist_hi,
+                                                   int nb_max, std::uint32_t n, BinSweep& sw) {
+  const __m128i nv = _mm_set1_epi32(static_cast<int>(n));
+  const __m256d da = _mm256_setr_pd(sw.da[0], sw.da[1], sw.da[2], 0.0);
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
+  const __m256d one = _mm256_set1_pd(1.0);
+  __m256d al = _mm256_setr_pd(sw.al[0], sw.al[1], sw.al[2], 0.0);
+  __m256d ar = _mm256_setr_pd(sw.ar[0], sw.ar[1], sw.ar[2], 0.0);
+  __m128i nl = _mm_setzero_si128();
+  __m128i not_right = nl;
+  __m256d bm = inf;
+  __m256d bj = _mm256_set1_pd(-1.0);
+  __m256d jv = zero;
+  for (int j = 0; j + 1 < nb_max; ++j) {
+    nl = _mm_add_epi32(nl, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_lo[j])));
+    not_right =
+        _mm_add_epi32(not_right, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_hi[j])));
+    const __m256d nld = _mm256_cvtepi32_pd(nl);
+    const __m256d nrd = _mm256_cvtepi32_pd(_mm_sub_epi32(nv, not_right));
+    al = _mm256_add_pd(al, da);
+    ar = _mm256_sub_pd(ar, da);
+    const __m256d m = _mm256_add_pd(_mm256_mul_pd(al, nld), _mm256_mul_pd(ar, nrd));
+    const __m256d ok =
+        _mm256_and_pd(_mm256_cmp_pd(nld, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(nrd, zero, _CMP_NEQ_UQ));
+    // Selections as and / andnot / or: GCC turns blendv on a comparison into per-lane branches.
+    const __m256d mv = _mm256_or_pd(_mm256_and_pd(ok, m), _mm256_andnot_pd(ok, inf));
+    const __m256d lt = _mm256_cmp_pd(mv, bm, _CMP_LT_OQ);
+    bj = _mm256_or_pd(_mm256_and_pd(lt, jv), _mm256_andnot_pd(lt, bj));
+    bm = _mm256_min_pd(mv, bm);
+    jv = _mm256_add_pd(jv, one);
+  }
+  alignas(32) double m4[4];
+  alignas(32) double j4[4];
+  _mm256_store_pd(m4, bm);
+  _mm256_store_pd(j4, bj);
+  for (int k = 0; k < 3; ++k) {
+    sw.best_m[k] = m4[k];
+    sw.best_j[k] = static_cast<int>(j4[k]);
+  }
+}
+#endif
+
+void sweep_bins(const BinHist& hist_lo, const BinHist& hist_hi, int nb_max, std::uint32_t n,
+                BinSweep& sw) {
+#if SAARCOR_KD_AVX
+  static const bool avx = __builtin_cpu_supports("avx");
+  if (avx) {
+    sweep_bins_avx(hist_lo, hist_hi, nb_max, n, sw);
+    return;
+  }
+#endif
+  (void)nb_max;
+  sweep_bins_portable(hist_lo, hist_hi, n, sw);
+}
 
 // Binned SAH (Wald 2007; for kd-trees Shevtsov et al. 2007) with exact counts on the grid.
 // Per axis, a grid value x falls into bin f(x) = trunc(clamp((x - lo) * bins / extent, 0,
@@ -676,117 +791,18 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
     }
     return grid_.up(unordered(at));
   };
-  // The bin planes of the three axes swept together: three independent chains of additions
-  // (each axis's half areas step by repeated addition, so one axis alone waits on its adds),
-  // and the best plane selected without a branch (which plane improves is unpredictable). The
-  // same sums in the same order as one axis at a time: the same planes.
-  BinScan s0{&hist_lo[0][0], &hist_hi[0][0]};
-  BinScan s1{&hist_lo[0][1], &hist_hi[0][1]};
-  BinScan s2{&hist_lo[0][2], &hist_hi[0][2]};
-  auto init = [&](BinScan& sc, int k) {
-    if (!(d[k] > 0.0)) return;  // flat: no planes
+  // Per axis the first least bin plane (BinScan), all three axes swept together.
+  BinSweep sw;
+  for (int k = 0; k < 3; ++k) {
+    if (!(d[k] > 0.0)) continue;  // flat: no planes (the lane stays at its defaults)
     const double sum = d[(k + 1) % 3] + d[(k + 2) % 3];
     const double prod = d[(k + 1) % 3] * d[(k + 2) % 3];
-    sc.nc = nb[k] - 1;
-    sc.da = d[k] / nb[k] * sum;
-    sc.al = prod;
-    sc.ar = d[k] * sum + prod;
-  };
-  init(s0, 0);
-  init(s1, 1);
-  init(s2, 2);
-  const int nc_common = std::min({s0.nc, s1.nc, s2.nc});
-#if defined(__SSE2__)
-  // Two lanes per register (axes 0, 1 and axis 2 with an idle lane), each lane the scalar
-  // step's binary64 operations in the same order; the counts are exact integers in binary64.
-  if (nc_common > 0) {
-    const double inf = std::numeric_limits<double>::infinity();
-    const __m128d zero = _mm_setzero_pd();
-    const __m128d n2 = _mm_set1_pd(static_cast<double>(n));
-    const __m128d da_a = _mm_setr_pd(s0.da, s1.da);
-    const __m128d da_b = _mm_setr_pd(s2.da, 0.0);
-    __m128d al_a = _mm_setr_pd(s0.al, s1.al);
-    __m128d al_b = _mm_setr_pd(s2.al, 0.0);
-    __m128d ar_a = _mm_setr_pd(s0.ar, s1.ar);
-    __m128d ar_b = _mm_setr_pd(s2.ar, 0.0);
-    __m128d nl_a = zero;
-    __m128d nl_b = zero;
-    __m128d nn_a = zero;  // not right
-    __m128d nn_b = zero;
-    const __m128d inf2 = _mm_set1_pd(inf);
-    __m128d bm_a = inf2;
-    __m128d bm_b = bm_a;
-    __m128d bj_a = _mm_set1_pd(-1.0);
-    __m128d bj_b = bj_a;
-    __m128d jv = zero;
-    const __m128d one = _mm_set1_pd(1.0);
-    auto blend = [](__m128d mask, __m128d a, __m128d b) {
-      return _mm_or_pd(_mm_and_pd(mask, a), _mm_andnot_pd(mask, b));
-    };
-    for (int j = 0; j < nc_common; ++j) {
-      const __m128i cl = _mm_load_si128(reinterpret_cast<const __m128i*>(hist_lo[j]));
-      const __m128i ch = _mm_load_si128(reinterpret_cast<const __m128i*>(hist_hi[j]));
-      nl_a = _mm_add_pd(nl_a, _mm_cvtepi32_pd(cl));
-      nl_b = _mm_add_pd(nl_b, _mm_cvtepi32_pd(_mm_srli_si128(cl, 8)));
-      nn_a = _mm_add_pd(nn_a, _mm_cvtepi32_pd(ch));
-      nn_b = _mm_add_pd(nn_b, _mm_cvtepi32_pd(_mm_srli_si128(ch, 8)));
-      al_a = _mm_add_pd(al_a, da_a);
-      al_b = _mm_add_pd(al_b, da_b);
-      ar_a = _mm_sub_pd(ar_a, da_a);
-      ar_b = _mm_sub_pd(ar_b, da_b);
-      const __m128d nr_a = _mm_sub_pd(n2, nn_a);
-      const __m128d nr_b = _mm_sub_pd(n2, nn_b);
-      const __m128d m_a = _mm_add_pd(_mm_mul_pd(al_a, nl_a), _mm_mul_pd(ar_a, nr_a));
-      const __m128d m_b = _mm_add_pd(_mm_mul_pd(al_b, nl_b), _mm_mul_pd(ar_b, nr_b));
-      // A plane with an empty side counts as +inf; the least value is a min (one short chain
-      // per register), and the index follows it where the value drops strictly.
-      const __m128d mv_a =
-          blend(_mm_and_pd(_mm_cmpneq_pd(nl_a, zero), _mm_cmpneq_pd(nr_a, zero)), m_a, inf2);
-      const __m128d mv_b =
-          blend(_mm_and_pd(_mm_cmpneq_pd(nl_b, zero), _mm_cmpneq_pd(nr_b, zero)), m_b, inf2);
-      bj_a = blend(_mm_cmplt_pd(mv_a, bm_a), jv, bj_a);
-      bj_b = blend(_mm_cmplt_pd(mv_b, bm_b), jv, bj_b);
-      bm_a = _mm_min_pd(mv_a, bm_a);
-      bm_b = _mm_min_pd(mv_b, bm_b);
-      jv = _mm_add_pd(jv, one);
-    }
-    alignas(16) double v[6][4];
-    _mm_store_pd(v[0], al_a);
-    _mm_store_pd(v[0] + 2, al_b);
-    _mm_store_pd(v[1], ar_a);
-    _mm_store_pd(v[1] + 2, ar_b);
-    _mm_store_pd(v[2], nl_a);
-    _mm_store_pd(v[2] + 2, nl_b);
-    _mm_store_pd(v[3], nn_a);
-    _mm_store_pd(v[3] + 2, nn_b);
-    _mm_store_pd(v[4], bm_a);
-    _mm_store_pd(v[4] + 2, bm_b);
-    _mm_store_pd(v[5], bj_a);
-    _mm_store_pd(v[5] + 2, bj_b);
-    BinScan* sc[3] = {&s0, &s1, &s2};
-    for (int k = 0; k < 3; ++k) {
-      sc[k]->al = v[0][k];
-      sc[k]->ar = v[1][k];
-      sc[k]->nl = static_cast<std::uint32_t>(v[2][k]);
-      sc[k]->not_right = static_cast<std::uint32_t>(v[3][k]);
-      sc[k]->best_m = v[4][k];
-      sc[k]->best_j = static_cast<int>(v[5][k]);
-    }
+    sw.nc[k] = nb[k] - 1;
+    sw.da[k] = d[k] / nb[k] * sum;
+    sw.al[k] = prod;
+    sw.ar[k] = d[k] * sum + prod;
   }
-#else
-  for (int j = 0; j < nc_common; ++j) {
-    s0.step(j, n);
-    s1.step(j, n);
-    s2.step(j, n);
-  }
-#endif
-  for (int j = nc_common; j < s0.nc; ++j)
-    s0.step(j, n);
-  for (int j = nc_common; j < s1.nc; ++j)
-    s1.step(j, n);
-  for (int j = nc_common; j < s2.nc; ++j)
-    s2.step(j, n);
-  const BinScan* scans[3] = {&s0, &s1, &s2};
+  sweep_bins(hist_lo, hist_hi, nb_max, n, sw);
   int bin_j = -1;  // the winner's candidate when it is a bin plane
   for (int k = 0; k < 3; ++k) {
     if (!(d[k] > 0.0)) continue;
@@ -799,20 +815,11 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
       const double ar = (hi - x) * sum + prod;
       return (nl == 0 || nr == 0 ? bonus : 1.0) * (kt + ki * inv_area * (al * nl + ar * nr));
     };
-    const int best_j = scans[k]->best_j;
-    const double best_m = scans[k]->best_m;
-    if (best_j >= 0) {
-      const double c = kt + ki * inv_area * best_m;
+    if (sw.best_j[k] >= 0) {
+      const double c = kt + ki * inv_area * sw.best_m[k];
       if (c < best.cost) {
-        std::uint32_t best_nl = 0;
-        std::uint32_t not_right = 0;
-        for (int j = 0; j <= best_j; ++j) {
-          best_nl += hist_lo[j][k];
-          not_right += hist_hi[j][k];
-        }
-        const std::uint32_t best_nr = n - not_right;
-        best = BinnedSplit{c, k, 0.0f, false, best_nl, best_nr};
-        bin_j = best_j;  // s_j searched once the winner is known
+        best = BinnedSplit{c, k, 0.0f, false, 0, 0};  // counts summed once the winner is known
+        bin_j = sw.best_j[k];                         // and s_j searched
       }
     }
     // Empty-space planes at the items' bounds (all items on one side, planars with them):
@@ -836,6 +843,12 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
   }
   if (bin_j >= 0) {
     const int k = best.axis;
+    std::uint32_t not_right = 0;
+    for (int j = 0; j <= bin_j; ++j) {
+      best.left += hist_lo[j][k];
+      not_right += hist_hi[j][k];
+    }
+    best.right = n - not_right;
     best.pos = threshold(k, bin_j);
     // Only a box a few grid steps wide can leave no grid value strictly inside.
     if (!(best.pos > box.lo[k] && best.pos < box.hi[k])) return BinnedSplit{};
@@ -882,7 +895,7 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
   const std::size_t entry_top = items_.top_;
   const std::size_t lb = b;
   const std::size_t rb = entry_top;
-  items_.ensure(rb + best.right);
+  items_.ensure(rb + best.right + 1);  // + 1: the slot the branch-free write below may fill
   BinItem* all = items_.data();
   const std::uint8_t planar_side = best.planar_left ? kLeft : kRight;
   std::uint32_t nl = 0;
@@ -891,16 +904,17 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
     const BinItem it = all[b + i];  // a copy: the left list may overwrite its slot
     const float lo = it.lo[k];
     const bool planar = (it.planar >> k) & 1u;
-    const std::uint8_t v = planar && lo == split ? planar_side
-                           : it.key[k] < split   ? kLeft
-                           : lo >= split         ? kRight
-                                                 : kBoth;
-    if (v == kLeft) {
-      all[lb + nl++] = it;
-      continue;
-    }
-    if (v == kRight) {
-      all[rb + nr++] = it;
+    const bool at_plane = planar && lo == split;
+    const bool left = at_plane ? planar_side == kLeft : it.key[k] < split;
+    const bool right = at_plane ? planar_side == kRight : lo >= split;
+    if (left || right) {
+      // Written to both lists, kept by the cursor of its side: which side is unpredictable,
+      // so no branch on it (the right slot written for a left item is above the stack top, the
+      // left one for a right item at or below the slot just read).
+      all[lb + nl] = it;
+      all[rb + nr] = it;
+      nl += left;
+      nr += right;
       continue;
     }
     // Perfect split of a straddler, with the exact stage's rules.
@@ -1092,6 +1106,34 @@ void Builder::emit_leaf(std::uint32_t node, std::vector<std::uint32_t>& ids) {
   tree_.items.insert(tree_.items.end(), ids.begin(), ids.end());
 }
 
+// One piece of a cut polygon (clip_split): the binary64 bounds of its vertices, exact
+// coordinates as they are and the others widened by w, then rounded outward to binary32 within
+// the child box and the triangle's own bounds.
+struct PieceBounds {
+  double l[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                 std::numeric_limits<double>::infinity()};
+  double h[3] = {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                 -std::numeric_limits<double>::infinity()};
+  int count = 0;
+  void add(const double x[3], std::uint8_t exact, const double w[3]) {
+    for (int k = 0; k < 3; ++k) {
+      const bool e = exact & (1u << k);
+      l[k] = std::min(l[k], e ? x[k] : x[k] - w[k]);
+      h[k] = std::max(h[k], e ? x[k] : x[k] + w[k]);
+    }
+    ++count;
+  }
+  bool bound(const Box& b, const float tlo[3], const float thi[3], float lo[3], float hi[3]) const {
+    if (count == 0) return false;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::max({float_down(l[k]), b.lo[k], tlo[k]});
+      hi[k] = std::min({float_up(h[k]), b.hi[k], thi[k]});
+      if (lo[k] > hi[k]) return false;
+    }
+    return true;
+  }
+};
+
 // Perfect splits: the straddling item clipped to the node's box and cut by the plane; fills both
 // children's clipped bounds. Returns bit 0 when a left piece exists, bit 1 when a right one does.
 //
@@ -1162,25 +1204,31 @@ int Builder::clip_split(std::uint32_t id, const Box& box, int axis, float split,
       const double sign = side == 0 ? 1.0 : -1.0;
       const V* in = poly[cur];
       V* out = poly[cur ^ 1];
+      double dist[12];  // each vertex's signed distance, computed once for both its edges
+      for (int i = 0; i < n; ++i)
+        dist[i] = sign * (in[i].x[k] - c);
       int m = 0;
       for (int i = 0; i < n; ++i) {
-        const V& P = in[i];
-        const V& Q = in[i + 1 < n ? i + 1 : 0];
-        const double dp = sign * (P.x[k] - c);
-        const double dq = sign * (Q.x[k] - c);
-        if (dp >= 0.0) out[m++] = P;
-        if ((dp < 0.0) != (dq < 0.0)) out[m++] = cut(P, Q, k, c, dp, dq);
+        const int i1 = i + 1 < n ? i + 1 : 0;
+        const double dp = dist[i];
+        const double dq = dist[i1];
+        if (dp >= 0.0) out[m++] = in[i];
+        if ((dp < 0.0) != (dq < 0.0)) out[m++] = cut(in[i], in[i1], k, c, dp, dq);
       }
       n = m;
       cur ^= 1;
     }
   }
   if (n == 0) return 0;
-  // Cut the polygon at the plane; vertices on it belong to both pieces.
-  V left[12];
-  V right[12];
-  int nl = 0;
-  int nr = 0;
+  // Cut the polygon at the plane; vertices on it belong to both pieces. Each piece's bounds are
+  // gathered as its vertices are found (in polygon order, so ties between +0 and -0 resolve as
+  // they would over the piece's vertex list): exact coordinates as they are, the others widened.
+  constexpr double kWiden = 0x1p-32;
+  double w[3];
+  for (int k = 0; k < 3; ++k)
+    w[k] = kWiden * std::max(std::fabs(tlo[k]), std::fabs(thi[k]));
+  PieceBounds left;
+  PieceBounds right;
   const V* pg = poly[cur];
   const double c = split;
   for (int i = 0; i < n; ++i) {
@@ -1188,33 +1236,16 @@ int Builder::clip_split(std::uint32_t id, const Box& box, int axis, float split,
     const V& Q = pg[i + 1 < n ? i + 1 : 0];
     const double dp = P.x[axis] - c;
     const double dq = Q.x[axis] - c;
-    if (dp <= 0.0) left[nl++] = P;
-    if (dp >= 0.0) right[nr++] = P;
+    if (dp <= 0.0) left.add(P.x, P.exact, w);
+    if (dp >= 0.0) right.add(P.x, P.exact, w);
     if ((dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0)) {
       const V R = cut(P, Q, axis, c, dp, dq);
-      left[nl++] = R;
-      right[nr++] = R;
+      left.add(R.x, R.exact, w);
+      right.add(R.x, R.exact, w);
     }
   }
-  constexpr double kWiden = 0x1p-32;
-  auto bound = [&](const V* pv, int count, const Box& b, float lo[3], float hi[3]) {
-    if (count == 0) return false;
-    for (int k = 0; k < 3; ++k) {
-      const double w = kWiden * std::max(std::fabs(tlo[k]), std::fabs(thi[k]));
-      double l = std::numeric_limits<double>::infinity();
-      double h = -std::numeric_limits<double>::infinity();
-      for (int i = 0; i < count; ++i) {
-        const bool exact = pv[i].exact & (1u << k);
-        l = std::min(l, exact ? pv[i].x[k] : pv[i].x[k] - w);
-        h = std::max(h, exact ? pv[i].x[k] : pv[i].x[k] + w);
-      }
-      lo[k] = std::max({float_down(l), b.lo[k], tlo[k]});
-      hi[k] = std::min({float_up(h), b.hi[k], thi[k]});
-      if (lo[k] > hi[k]) return false;
-    }
-    return true;
-  };
-  return (bound(left, nl, lbox, llo, lhi) ? 1 : 0) | (bound(right, nr, rbox, rlo, rhi) ? 2 : 0);
+  return (left.bound(lbox, tlo, thi, llo, lhi) ? 1 : 0) |
+         (right.bound(rbox, tlo, thi, rlo, rhi) ? 2 : 0);
 }
 
 void Builder::add_clipped(std::uint32_t id, const float lo[3], const float hi[3],
