@@ -6,8 +6,9 @@ add_library(saarcor_warnings INTERFACE)
 target_compile_options(saarcor_warnings INTERFACE -Wall -Wextra -Wpedantic
   $<$<BOOL:${SAARCOR_WERROR}>:-Werror>
   # GCC 12 reports false -Wrestrict/-Wstringop-overflow inside libstdc++ string code at -O2/-O3
-  # (GCC bug 105329); they say nothing about our code.
-  -Wno-restrict -Wno-stringop-overflow
+  # (GCC bug 105329); they say nothing about our code. (Clang, the fuzz preset's compiler, has
+  # neither warning.)
+  $<$<CXX_COMPILER_ID:GNU>:-Wno-restrict -Wno-stringop-overflow>
   # Bit-exact arithmetic and the float reference must never be contracted into FMA.
   -ffp-contract=off)
 target_compile_definitions(saarcor_warnings INTERFACE $<$<BOOL:${SAARCOR_SANITIZE}>:SAARCOR_SANITIZED=1>)
@@ -18,11 +19,14 @@ if(SAARCOR_SANITIZE)
 endif()
 
 # saarcor_folder(NAME <lib> DEPS <public deps...> [TEST_DEPS ...] [BENCH_DEPS ...] [EXCLUDE <files...>])
+# foo_fuzz.cpp (a libFuzzer harness) is never part of the library; cmake/fuzz.cmake builds the
+# harnesses in the fuzz preset (SAARCOR_FUZZ), where saarcor_folder builds the library only.
 function(saarcor_folder)
   cmake_parse_arguments(F "" "NAME" "DEPS;TEST_DEPS;BENCH_DEPS;EXCLUDE" ${ARGN})
   file(GLOB _all CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   file(GLOB _tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_test.cpp)
   file(GLOB _benches CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_bench.cpp)
+  file(GLOB _fuzz CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_fuzz.cpp)
   # foo_deep_test.cpp: full-size runs, in <folder>_deep_tests with the ctest label "deep", left
   # out of the default test presets (ctest --preset deep runs them).
   file(GLOB _deep CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_deep_test.cpp)
@@ -41,6 +45,14 @@ function(saarcor_folder)
   endforeach()
   if(_deep)
     list(REMOVE_ITEM _lib ${_deep})
+  endif()
+  if(_fuzz)
+    list(REMOVE_ITEM _lib ${_fuzz})
+  endif()
+  if(SAARCOR_FUZZ)
+    set(_tests "")
+    set(_deep "")
+    set(_benches "")
   endif()
   if(_lib)
     add_library(saarcor_${F_NAME} STATIC ${_lib})

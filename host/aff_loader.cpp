@@ -1162,8 +1162,8 @@ class Loader {
   // time (both one-sided limits where the spline jumps, as two samples with the same time) and at
   // max(kAffMinStepsPerKey, kAffSamplesPerSecond x length) steps between consecutive key times.
   template <typename Spline, typename ToVec4, typename Same>
-  static void sample(const Spline& spline, const std::vector<AffKey>& keys, double end,
-                     AnimChannel& ch, ToVec4 to_vec4, Same same) {
+  void sample(const Spline& spline, const std::vector<AffKey>& keys, double end, AnimChannel& ch,
+              ToVec4 to_vec4, Same same) {
     const double lo = std::clamp(keys[1].time, 0.0, end);
     const double hi = std::clamp(keys[keys.size() - 2].time, 0.0, end);
     // Key times in order (BART allows decreasing ones; only new maxima start segments).
@@ -1171,6 +1171,23 @@ class Loader {
     for (std::size_t i = 1; i + 1 < keys.size(); ++i)
       if (keys[i].time > cuts.back() && keys[i].time < hi) cuts.push_back(keys[i].time);
     if (hi > cuts.back()) cuts.push_back(hi);
+    // The samples this channel takes (at most 2 per key time plus the steps between), counted
+    // before any is taken: key times days apart would ask for gigabytes.
+    double samples = 0.0;
+    for (std::size_t c = 0; c < cuts.size(); ++c)
+      samples += 2.0 + (c + 1 < cuts.size()
+                            ? std::max(static_cast<double>(kAffMinStepsPerKey),
+                                       std::ceil((cuts[c + 1] - cuts[c]) * kAffSamplesPerSecond))
+                            : 0.0);
+    if (samples > static_cast<double>(kMaxSamples - samples_))
+      throw std::runtime_error(
+          root_path_ + ": the keyframes of '" +
+          scene_.nodes[static_cast<std::size_t>(ch.node)].name + "' span " +
+          std::to_string(hi - lo) + " s: sampled " +
+          std::to_string(static_cast<int>(kAffSamplesPerSecond)) +
+          " times a second, the scene's channels would exceed the loader's limit of " +
+          std::to_string(kMaxSamples) + " samples");
+    samples_ += static_cast<std::size_t>(samples);
     const auto put = [&](double t, const auto& v) {
       ch.times.push_back(t);
       ch.values.push_back(to_vec4(v));
@@ -1193,7 +1210,7 @@ class Loader {
   }
 
   AnimChannel position_channel(int node, AnimPath path, const std::vector<AffKey>& keys,
-                               double end) const {
+                               double end) {
     AnimChannel ch;
     ch.node = node;
     ch.path = path;
@@ -1206,7 +1223,7 @@ class Loader {
     return ch;
   }
 
-  AnimChannel rotation_channel(int node, const std::vector<AffKey>& keys, double end) const {
+  AnimChannel rotation_channel(int node, const std::vector<AffKey>& keys, double end) {
     AnimChannel ch;
     ch.node = node;
     ch.path = AnimPath::kRotation;
@@ -1370,6 +1387,10 @@ class Loader {
   std::vector<AnimatedNode> animated_;
   std::vector<std::pair<int, std::string>> light_names_;
   std::set<std::string> skipped_kinds_;
+  // Animation samples of every channel in all (sample()): 2^24, 38 times what BART's robots take
+  // (442,327), at most 670 MB of keys.
+  static constexpr std::size_t kMaxSamples = std::size_t{1} << 24;
+  std::size_t samples_ = 0;
 };
 
 }  // namespace

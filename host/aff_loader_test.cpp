@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <glm/gtc/quaternion.hpp>
@@ -722,6 +723,45 @@ TEST_F(AffFiles, RefusesTooFewKeys) {
   const std::string root =
       write("k.aff", "k x\n{\n  rot 2\n 0 0 1 0 0 0 0 0\n 1 0 1 0 5 0 0 0\n}\n");
   expect_refused(root, "k.aff", 3, "rot needs at least 4 keys");
+}
+
+// Found by fuzzing (docs/fuzzing.md): keyframes 10^7 s apart were sampled 60 times a second,
+// 600 million samples (gigabytes) before anything was checked. The scene's channels may take
+// 2^24 samples in all; more is refused in one line naming the file and the animated node.
+TEST_F(AffFiles, RefusesKeyframesThatWouldTakeMillionsOfSamples) {
+  const std::string root = write("days.aff",
+                                 "x mover {\n"
+                                 "p 3 0 0 0 1 0 0 0 1 0\n"
+                                 "}\n"
+                                 "k mover {\n"
+                                 "transl 4\n"
+                                 "0 0 0 0 0 0 0\n"
+                                 "0 0 0 0 0 0 0\n"
+                                 "1e7 1 0 0 0 0 0\n"
+                                 "1e7 1 0 0 0 0 0\n"
+                                 "}\n");
+  try {
+    load_scene(root);
+    ADD_FAILURE() << "no error for " << root;
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(root + ": the keyframes of 'mover' span 10000000", 0), 0u) << msg;
+    EXPECT_NE(msg.find("exceed the loader's limit of 16777216 samples"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+// BART's scenes stay far below that limit (the robots take 442,327 samples).
+TEST(AffBart, AnimationSamplesStayFarBelowTheLoadersLimit) {
+  for (const Scene* s : {&kitchen(), &robot()}) {
+    std::size_t samples = 0;
+    for (const AnimChannel& ch : s->animations)
+      samples += ch.times.size();
+    std::printf("%s: %zu channels, %zu samples\n", s->source.c_str(), s->animations.size(),
+                samples);
+    EXPECT_GT(samples, 0u);
+    EXPECT_LT(samples, (std::size_t{1} << 24) / 30);
+  }
 }
 
 }  // namespace

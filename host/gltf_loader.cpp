@@ -64,6 +64,12 @@ const char* sniff_extension(const unsigned char* b, std::size_t n) {
   return nullptr;
 }
 
+// The values a scene's accessors may hold in all, reads of one accessor counted each time
+// (meshes that share accessors read them again): 2^25, about four times what a mesh of a million
+// triangles needs, so a file whose counts ask for gigabytes is refused in one line instead
+// (docs/scenes.md, "What is refused or reduced").
+constexpr std::size_t kMaxAccessorValues = std::size_t{1} << 25;
+
 // Reads one accessor into doubles (count * components), checking every byte it touches.
 struct AccessorData {
   std::size_t count = 0;
@@ -95,10 +101,15 @@ class Reader {
     const std::string name = what + " (accessor " + std::to_string(index) + ")";
     if (out.components <= 0 || csize <= 0) fail(name + ": unknown type or component type");
     if (out.count > (std::size_t{1} << 31)) fail(name + ": count too large");
-    out.values.assign(out.count * static_cast<std::size_t>(out.components), 0.0);
+    // Everything is checked before the values are allocated: a count is only a number in the
+    // JSON, and an accessor without a buffer view (zeros) is not bounded by the file's size.
+    const std::size_t values = out.count * static_cast<std::size_t>(out.components);
+    if (values > kMaxAccessorValues - values_read_)
+      fail(name + ": the scene is too large: its accessors hold more than " +
+           std::to_string(kMaxAccessorValues) + " values in all (the loader's limit)");
+    const unsigned char* base = nullptr;
+    std::size_t stride = 0;
     if (acc.bufferView >= 0) {
-      const unsigned char* base = nullptr;
-      std::size_t stride = 0;
       std::size_t available = 0;
       view(acc.bufferView, acc.byteOffset, name, base, available);
       const std::size_t elem =
@@ -107,6 +118,10 @@ class Reader {
       stride = bv.byteStride > 0 ? bv.byteStride : elem;
       if (out.count > 0 && (stride * (out.count - 1) + elem > available))
         fail(name + ": reads past the end of its buffer view");
+    }
+    values_read_ += values;
+    out.values.assign(values, 0.0);
+    if (base != nullptr) {
       for (std::size_t i = 0; i < out.count; ++i)
         for (int c = 0; c < out.components; ++c)
           out.values[i * static_cast<std::size_t>(out.components) + static_cast<std::size_t>(c)] =
@@ -140,7 +155,7 @@ class Reader {
     if (bv.buffer < 0 || static_cast<std::size_t>(bv.buffer) >= model_.buffers.size())
       fail(name + ": buffer " + std::to_string(bv.buffer) + " does not exist");
     const auto& buf = model_.buffers[static_cast<std::size_t>(bv.buffer)];
-    if (bv.byteOffset + bv.byteLength > buf.data.size())
+    if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset)
       fail(name + ": buffer view " + std::to_string(view_index) +
            " reaches past the end of buffer " + std::to_string(bv.buffer) +
            (buf.uri.empty() || buf.uri.rfind("data:", 0) == 0 ? std::string()
@@ -201,6 +216,13 @@ class Reader {
     const int csize =
         tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(acc.componentType));
     if (isize <= 0 || csize <= 0) fail(name + ": bad sparse component type");
+    // glTF 2.0 3.6.2.3: unsigned integer indices (a float one would be cast to an index).
+    const int itype = acc.sparse.indices.componentType;
+    if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      fail(name + ": sparse indices must be unsigned integers, not component type " +
+           std::to_string(itype));
     const unsigned char* ib = nullptr;
     const unsigned char* vb = nullptr;
     std::size_t ia = 0;
@@ -226,6 +248,7 @@ class Reader {
 
   const tinygltf::Model& model_;
   std::string path_;
+  mutable std::size_t values_read_ = 0;  // accessor values read so far (kMaxAccessorValues)
 };
 
 std::string mesh_label(const tinygltf::Mesh& mesh, std::size_t index) {

@@ -506,6 +506,51 @@ TEST_F(BadGltf, AccessorPastTheBufferIsRefused) {
   EXPECT_NE(e.find("reads past the end of its buffer view"), std::string::npos) << e;
 }
 
+// Found by fuzzing (docs/fuzzing.md): counts are only numbers in the JSON. An accessor without a
+// buffer view (zeros) of a billion VEC3s, and one of two billion MAT4s over a 36-byte view, were
+// allocated (24 GB, 256 GB) before any check; they are refused in one line first.
+TEST_F(BadGltf, HugeAccessorCountsAreRefusedBeforeAllocating) {
+  const std::string zeros =
+      write("zeros.gltf",
+            R"({"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"count":1000000000,)"
+            R"("type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+            R"("nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})");
+  std::string e = error_of(zeros);
+  EXPECT_NE(e.find("accessor 0): the scene is too large: its accessors hold more than 33554432 "
+                   "values in all"),
+            std::string::npos)
+      << e;
+  std::string text = gltf(kTri);
+  const std::string from = R"("count":3,"type":"VEC3")";
+  text.replace(text.find(from), from.size(), R"("count":2000000000,"type":"MAT4")");
+  e = error_of(write("mat4.gltf", text));
+  EXPECT_NE(e.find("the scene is too large"), std::string::npos) << e;
+}
+
+// The limit counts every read: meshes that share one accessor read it again each.
+TEST_F(BadGltf, MeshesSharingAnAccessorCountAgainstTheLimitEachTime) {
+  const std::string mesh = R"({"primitives":[{"attributes":{"POSITION":0}}]})";
+  const std::string e = error_of(write(
+      "shared.gltf",
+      R"({"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"count":5600000,)"
+      R"("type":"VEC3"}],"meshes":[)" +
+          mesh + "," + mesh + R"(],"nodes":[{"mesh":0},{"mesh":1}],"scenes":[{"nodes":[0,1]}]})"));
+  EXPECT_NE(e.find("mesh 1 primitive 0 POSITION (accessor 0): the scene is too large"),
+            std::string::npos)
+      << e;
+}
+
+// Found by fuzzing: a buffer view offset near 2^64 wrapped the end check (offset + length) and
+// the accessor read before the buffer (UBSan: pointer overflow).
+TEST_F(BadGltf, BufferViewOffsetThatWrapsIsRefused) {
+  std::string text = gltf(kTri);
+  const std::string from = R"("bufferViews":[{"buffer":0,)";
+  text.replace(text.find(from), from.size(),
+               R"("bufferViews":[{"buffer":0,"byteOffset":18446744073709551600,)");
+  const std::string e = error_of(write("wrap.gltf", text));
+  EXPECT_NE(e.find("buffer view 0 reaches past the end of buffer 0"), std::string::npos) << e;
+}
+
 // ---- features the manifest models do not exercise ---------------------------------------------
 
 // Positions (float xyz) followed by an index block of the given component type, all in one
@@ -597,6 +642,32 @@ TEST_F(BadGltf, SparseAccessorReplacesVertices) {
   ASSERT_EQ(s.objects[0].positions.size(), 4u);
   EXPECT_EQ(s.objects[0].positions[3], glm::vec3(5, 5, 5));
   EXPECT_EQ(s.objects[0].positions[2], glm::vec3(1, 1, 0));
+}
+
+// Found by fuzzing (docs/fuzzing.md): sparse indices of a float component type were read as
+// doubles and cast to an index (1e30: undefined behaviour, UBSan float-cast-overflow; 1.5: vertex
+// 1). glTF allows unsigned integers only.
+TEST_F(BadGltf, FloatSparseIndicesAreRefused) {
+  std::vector<unsigned char> bytes(kTri.size() * 4);
+  std::memcpy(bytes.data(), kTri.data(), bytes.size());
+  const float index_and_value[4] = {1e30f, 0, 0, 1};
+  bytes.insert(bytes.end(), reinterpret_cast<const unsigned char*>(index_and_value),
+               reinterpret_cast<const unsigned char*>(index_and_value) + 16);
+  const std::string text =
+      R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+      R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+      R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",)"
+      R"("sparse":{"count":1,"indices":{"bufferView":1,"componentType":5126},)"
+      R"("values":{"bufferView":2}}}],)"
+      R"("bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":4},)"
+      R"({"buffer":0,"byteOffset":40,"byteLength":12}],"buffers":[{"byteLength":52,)"
+      R"("uri":"data:application/octet-stream;base64,)" +
+      base64_encode(bytes) + "\"}]}";
+  const std::string e = error_of(write("sparse_float.gltf", text));
+  EXPECT_NE(e.find("POSITION (accessor 0): sparse indices must be unsigned integers, not "
+                   "component type 5126"),
+            std::string::npos)
+      << e;
 }
 
 TEST_F(BadGltf, DataUriImageAndPointLight) {

@@ -10,3 +10,9 @@ for preset in release asan; do
   cmake --build --preset "${preset}"
   ctest --preset "${preset}"
 done
+# The libFuzzer harnesses (clang, docs/fuzzing.md): built alone in build-fuzz, each run 30 s on
+# its seeds (label fuzz; `ctest --preset fuzz-deep` runs a million executions each).
+echo "== preset fuzz"
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz
+ctest --preset fuzz

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "testbench/vector_file.h"
 #include "units/unit_vectors.h"
 
 namespace saarcor {
@@ -26,19 +27,6 @@ struct VectorsOptions {
   std::string out;       // generate: the vector file
   std::string check;     // check this vector file instead of generating
 };
-
-// The file: '#' header lines (the unit, the field names, the source), then one vector per line.
-std::string format_vector_file(units::VectorUnit unit, const units::VectorCapture& capture,
-                               const std::string& source);
-
-struct VectorCheck {
-  units::VectorUnit unit = units::VectorUnit::kTraversal;
-  std::size_t vectors = 0;
-  std::size_t differing = 0;
-  std::vector<std::string> first_differences;  // "line L: field F is X, the datapath gives Y"
-};
-// Checks every line of a vector file's text; throws one line naming the line for a malformed one.
-VectorCheck check_vector_text(const std::string& text);
 
 // Returns 0, or 2 when `--check` finds vectors whose outputs differ from the datapath's (they are
 // listed on stdout); throws std::runtime_error with one line on bad input, before writing anything.

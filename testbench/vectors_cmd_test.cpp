@@ -91,7 +91,8 @@ TEST(Vectors, MalformedFilesNameTheLine) {
   EXPECT_EQ(error_of([&] { check_vector_text(head + "1000000 0 3f0000 0 400000 1 1 0 0\n"); }),
             "vector file line 3: field split '1000000' is not a hex fp24 encoding");
   EXPECT_EQ(error_of([] { check_vector_text("# saarcor unit vectors 1\n# unit: shading\n"); }),
-            "unknown unit 'shading' (known: traversal, transformation, intersection)");
+            "vector file line 2: unknown unit 'shading' (known: traversal, transformation, "
+            "intersection)");
   EXPECT_EQ(error_of([] { check_vector_text("# saarcor unit vectors 1\n"); }),
             "vector file line 1: no '# unit: ' line");
 }
