@@ -24,13 +24,13 @@ using F = ff::fp24;
 class RecordingTap final : public units::UnitTap<F> {
  public:
   std::vector<std::vector<std::uint32_t>> steps;
-  void traversal(F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far, F near_tf,
-                 F far_tn) override {
+  void traversal(int /*lane*/, F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far,
+                 F near_tf, F far_tn) override {
     steps.push_back({0u, split.bits, o_axis.bits, d_axis.bits, tn.bits, tf.bits,
                      std::uint32_t{go_near}, std::uint32_t{go_far}, near_tf.bits, far_tn.bits});
   }
-  void transformation(const units::Mat34<F>& m, const units::Vec3<F>& in, bool translate,
-                      const units::Vec3<F>& out) override {
+  void transformation(int /*lane*/, const units::Mat34<F>& m, const units::Vec3<F>& in,
+                      bool translate, const units::Vec3<F>& out) override {
     std::vector<std::uint32_t> w = {1u, std::uint32_t{translate}};
     for (const auto& row : m)
       for (const F x : row)
@@ -41,7 +41,7 @@ class RecordingTap final : public units::UnitTap<F> {
     }
     steps.push_back(std::move(w));
   }
-  void intersection(const units::Ray<F>& r, const units::Candidate<F>& c) override {
+  void intersection(int /*lane*/, const units::Ray<F>& r, const units::Candidate<F>& c) override {
     std::vector<std::uint32_t> w = {2u};
     for (int k = 0; k < 3; ++k) {
       w.push_back(r.o[k].bits);

@@ -56,6 +56,8 @@ int CycleUnit::deliver() {
     if (next.unit == UnitId::kNone) {
       pipeline_.pop_front();
       --inside_;
+      if (observer_ != nullptr) [[unlikely]]
+        observer_->left(now(), t);
       retire(t);
       ++moved;
       continue;
@@ -68,6 +70,10 @@ int CycleUnit::deliver() {
       break;
     }
     out->push(t);
+    if (observer_ != nullptr) [[unlikely]] {
+      observer_->left(now(), t);
+      observer_->queued(now(), next.unit, t);
+    }
     pipeline_.pop_front();
     --inside_;
     ++moved;
@@ -93,14 +99,17 @@ int CycleUnit::issue() {
     ++*served_;
     steps_left_ = r.steps < 1 ? 1 : r.steps;
     const Request& next = threads_.request(t);
+    std::uint64_t done_at = 0;
     if (next.unit == id_ && chains(r, next)) {
       chained_ = true;
       chain_thread_ = t;
     } else {
-      const std::uint64_t done_at = now() + static_cast<std::uint64_t>(steps_left_ - 1 + depth_);
+      done_at = now() + static_cast<std::uint64_t>(steps_left_ - 1 + depth_);
       if (pipeline_.empty()) deliver_at_ = done_at;  // later entries are due no earlier
       pipeline_.push_back({done_at, t});
     }
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->issued(now(), id_, t, r, steps_left_, done_at);
   }
   --steps_left_;
   ++*issued_;
@@ -114,6 +123,8 @@ int CycleUnit::receive() {
   if (--waiting_[t] == 0) {
     --waiting_threads_;
     ready_.push_back(t);
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->ready(now(), t);
   }
   return 1;
 }
@@ -123,6 +134,8 @@ int CycleUnit::accept(ThreadPath* from) {
     const ThreadToken t = from->pop();
     ++inside_;
     const Fetch f = fetch(threads_.request(t));
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->accepted(now(), id_, t, f.count);
     if (f.count == 0) {
       ready_.push_back(t);
       return 1;
@@ -142,7 +155,11 @@ int CycleUnit::accept(ThreadPath* from) {
   cache_requests_->push(
       {fetch_next_, {static_cast<std::uint16_t>(unit_index(id_)), fetch_thread_}});
   ++fetch_next_;
-  if (--fetch_left_ == 0) fetching_ = false;
+  if (--fetch_left_ == 0) {
+    fetching_ = false;
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->fetched(now(), fetch_thread_);
+  }
   return 1;
 }
 

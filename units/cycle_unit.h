@@ -18,6 +18,7 @@
 
 #include "hw/kernel.h"
 #include "memif/cache.h"
+#include "units/request_trace.h"
 #include "units/thread_program.h"
 
 namespace saarcor::units {
@@ -41,6 +42,12 @@ class ThreadTable {
   // The RGC hands thread `thread` primary packet `packet` (path a starts from here).
   virtual void start_primary(std::uint32_t thread, int packet) = 0;
   virtual int packets() const = 0;
+  // A traced run (units/run_trace.h): the request thread `thread` executed last, as the trace
+  // names it (packet, position, rays, kind, transactions). Empty when the run does not trace.
+  virtual const TracedStep& traced(std::uint32_t /*thread*/) const {
+    static const TracedStep kNothing;
+    return kNothing;
+  }
 
  protected:
   std::vector<Request> requests_;  // one per thread
@@ -74,6 +81,28 @@ class Ring {
 using ThreadToken = std::uint32_t;
 using ThreadPath = hw::Channel<ThreadToken>;
 
+// What a traced run observes of a thread's way through the units (units/run_trace.h writes the
+// request trace and the Kanata log from it). Null in a run that traces nothing: every hook is one
+// pointer test. Called from evaluate() with the current cycle, in the order the unit's script runs.
+class UnitObserver {
+ public:
+  virtual ~UnitObserver() = default;
+  // Thread t was pushed on the path towards unit `to`, its next request's unit.
+  virtual void queued(std::uint64_t cycle, UnitId to, ThreadToken t) = 0;
+  // `unit` took t from its input path and fetches `items` cache items (0: t is ready at once).
+  virtual void accepted(std::uint64_t cycle, UnitId unit, ThreadToken t, int items) = 0;
+  // t's last cache request went out.
+  virtual void fetched(std::uint64_t cycle, ThreadToken t) = 0;
+  // t's last cache response arrived: t waits for the issue slot.
+  virtual void ready(std::uint64_t cycle, ThreadToken t) = 0;
+  // t's request r was executed and issued for `steps` cycles; it leaves the pipeline at `done_at`,
+  // or, chained (0), its next request on this unit issues right behind it.
+  virtual void issued(std::uint64_t cycle, UnitId unit, ThreadToken t, const Request& r, int steps,
+                      std::uint64_t done_at) = 0;
+  // t left the pipeline: pushed on the path to its next unit (queued follows), or retired.
+  virtual void left(std::uint64_t cycle, ThreadToken t) = 0;
+};
+
 class CycleUnit : public hw::Module {
  public:
   // `cache` may be null (a unit that reads no scene data); `depth` = pipeline depth in cycles.
@@ -93,6 +122,8 @@ class CycleUnit : public hw::Module {
     outputs_[unit_index(to)] = path;
   }
 
+  // Every hook of the unit reports to `o` (null: none, the default).
+  void set_observer(UnitObserver* o) { observer_ = o; }
   UnitId id() const { return id_; }
   int depth() const { return depth_; }
   std::uint64_t issue_cycles() const { return issued_->value; }
@@ -131,6 +162,7 @@ class CycleUnit : public hw::Module {
   std::array<ThreadPath*, kUnitCount> outputs_{};
   int inside_ = 0;
   bool has_extra_ = false;
+  UnitObserver* observer_ = nullptr;
 
  private:
   struct InFlight {

@@ -18,6 +18,7 @@
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
 #include "units/dynrtc_units.h"
+#include "units/request_trace.h"
 
 namespace saarcor::units {
 namespace {
@@ -38,7 +39,7 @@ class Threads final : public ThreadTable {
  public:
   // kAhead: at most `ahead` finished packets ahead of the simulation.
   Threads(const memif::MemoryImage& image, const FunctionalParams& params, int threads,
-          ProgramMode mode, int ahead)
+          ProgramMode mode, int ahead, const RunTraceOptions& trace = {})
       : params_(params),
         units_(params.mode),
         mode_(mode),
@@ -49,6 +50,13 @@ class Threads final : public ThreadTable {
     tiling_ = packet_tiling(w_, h_, params.packet);
     sink_.reset(w_, h_);
     requests_.resize(static_cast<std::size_t>(threads));
+    if (trace.any()) {
+      tracing_ = true;
+      capture_ = trace.trace != nullptr;
+      trace_packet_ = trace.packet;
+      traced_.resize(static_cast<std::size_t>(threads));
+      per_step_.resize(static_cast<std::size_t>(threads));
+    }
     if (!recorded_) {
       for (int i = 0; i < threads; ++i) {
         programs_.push_back(
@@ -74,9 +82,13 @@ class Threads final : public ThreadTable {
   void execute(std::uint32_t t) override {
     if (recorded_) {
       Cursor& c = cursor_[t];
+      if (tracing_) [[unlikely]]
+        note_replayed(t);
       replay(t, slots_[c.slot].trace[++c.next]);
       return;
     }
+    if (tracing_) [[unlikely]]
+      return execute_traced(t);
     ThreadProgram<F, kLanes>& p = *programs_[t];
     p.execute();
     // Returned straight into the table (guaranteed elision): a copy of the returned temporary
@@ -106,6 +118,10 @@ class Threads final : public ThreadTable {
     }
     programs_[t]->start_primary(packet_pixels(tiling_, w_, h_, packet));
     ::new (static_cast<void*>(&requests_[t])) Request(programs_[t]->request());
+    if (tracing_) per_step_[t] = {packet, 0};
+  }
+  const TracedStep& traced(std::uint32_t t) const override {
+    return tracing_ ? traced_[t] : ThreadTable::traced(t);
   }
   int packets() const override { return tiling_.count(); }
   // The rays thread `t`'s current request concerns (for the watchdog's thread report; the units
@@ -144,6 +160,10 @@ class Threads final : public ThreadTable {
     std::vector<Step> trace;
     std::vector<std::uint64_t> masks;
     int packet = -1;
+    // A traced run: per executed request, the packet's kind and (with the request trace) the
+    // transactions.
+    std::vector<RayKind> kinds;
+    std::vector<std::string> txns;
   };
   // Runs packet `packet` on program `p` and records its request sequence into `s`.
   void record(Slot& s, ThreadProgram<F, kLanes>& p, int packet) {
@@ -151,16 +171,71 @@ class Threads final : public ThreadTable {
     s.trace.clear();
     s.masks.clear();
     p.start_primary(packet_pixels(tiling_, w_, h_, packet));
+    if (tracing_) [[unlikely]]
+      return record_traced(s, p);
     for (;;) {
       const Request& r = p.request();
-      if (r.steps < 0 || r.steps > 0xffff)
-        throw std::logic_error("cycle model: a request of " + std::to_string(r.steps) +
-                               " steps does not fit a trace entry");
-      s.trace.push_back({r.unit, r.phase, static_cast<std::uint16_t>(r.steps), r.item});
+      s.trace.push_back(step_of(r));
       s.masks.push_back(r.mask);
       if (p.done()) break;
       p.execute();
     }
+  }
+  static Step step_of(const Request& r) {
+    if (r.steps < 0 || r.steps > 0xffff)
+      throw std::logic_error("cycle model: a request of " + std::to_string(r.steps) +
+                             " steps does not fit a trace entry");
+    return {r.unit, r.phase, static_cast<std::uint16_t>(r.steps), r.item};
+  }
+
+  // ---- a traced run (units/run_trace.h) ----------------------------------------------------
+  // record() with each request's kind and, for the request trace, its transactions (the tap is
+  // set only around this packet's steps, so an untraced run never sees it).
+  void record_traced(Slot& s, ThreadProgram<F, kLanes>& p) {
+    s.kinds.clear();
+    s.txns.clear();
+    const bool capture = capture_ && (trace_packet_ < 0 || trace_packet_ == s.packet);
+    units_.tap = capture ? &tap_ : nullptr;
+    for (;;) {
+      const Request& r = p.request();
+      s.trace.push_back(step_of(r));
+      s.masks.push_back(r.mask);
+      if (p.done()) break;
+      s.kinds.push_back(p.kind());
+      tap_.begin();
+      p.execute();
+      s.txns.push_back(capture ? tap_.take() : std::string());
+    }
+    units_.tap = nullptr;
+  }
+  // The request thread t executes is its slot's entry `next`: what the trace says of it (moved
+  // out before the slot can be released to the program thread).
+  void note_replayed(std::uint32_t t) {
+    const Cursor& c = cursor_[t];
+    Slot& s = slots_[c.slot];
+    TracedStep& n = traced_[t];
+    n.packet = s.packet;
+    n.seq = static_cast<std::uint32_t>(c.next);
+    n.mask = s.masks[c.next];
+    n.kind = s.kinds[c.next];
+    n.txn = std::move(s.txns[c.next]);
+  }
+  // execute() of a program per thread, with the trace's view of the request.
+  void execute_traced(std::uint32_t t) {
+    ThreadProgram<F, kLanes>& p = *programs_[t];
+    TracedStep& n = traced_[t];
+    PerStep& ps = per_step_[t];
+    n.packet = ps.packet;
+    n.seq = ps.seq++;
+    n.mask = requests_[t].mask;
+    n.kind = p.kind();
+    const bool capture = capture_ && (trace_packet_ < 0 || trace_packet_ == ps.packet);
+    units_.tap = capture ? &tap_ : nullptr;
+    tap_.begin();
+    p.execute();
+    n.txn = capture ? tap_.take() : std::string();
+    units_.tap = nullptr;
+    requests_[t] = p.request();
   }
   void replay(std::uint32_t t, const Step& s) {
     Request& r = requests_[t];
@@ -172,6 +247,10 @@ class Threads final : public ThreadTable {
   }
   struct Cursor {
     std::size_t slot = 0, next = 0;
+  };
+  struct PerStep {  // kPerStep: each thread's packet and its next request's position
+    int packet = -1;
+    std::uint32_t seq = 0;
   };
 
   // The program thread: packets in the RGC's order, each into a free slot, at most max_ahead_
@@ -276,6 +355,13 @@ class Threads final : public ThreadTable {
   bool programs_waiting_ = false;  // the program thread sleeps on a full window
   std::exception_ptr error_;
   std::thread worker_;
+  // A traced run: the request each thread executed last, as the trace names it.
+  bool tracing_ = false;
+  bool capture_ = false;  // the request trace: the tap captures the transactions
+  int trace_packet_ = -1;
+  std::vector<TracedStep> traced_;
+  std::vector<PerStep> per_step_;
+  TraceTap<F> tap_;
 };
 
 template <class F, int kLanes>
@@ -378,6 +464,10 @@ class DynRtp {
   RaySource& rgs() { return *rgs_; }
   const RaySource& rgs() const { return *rgs_; }
   CycleUnit& unit(UnitId u) { return *units_[unit_index(u)]; }
+  void observe(UnitObserver* o) {
+    for (CycleUnit* u : units_)
+      u->set_observer(o);
+  }
 
  private:
   RaySource* rgs_ = nullptr;
@@ -409,6 +499,10 @@ class Chip {
   }
   int pipelines() const { return static_cast<int>(pipes_.size()); }
   DynRtp& pipeline(int i) { return *pipes_[static_cast<std::size_t>(i)]; }
+  void observe(UnitObserver* o) {
+    for (auto& d : pipes_)
+      d->observe(o);
+  }
   memif::MemorySystem& memory() { return mi_; }
 
  private:
@@ -589,7 +683,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
     throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
                              std::to_string(opt.ahead_packets) + ")");
   Threads<F, kLanes> threads(image, functional_params(p, opt), p.pipelines * p.threads,
-                             opt.programs, opt.ahead_packets);
+                             opt.programs, opt.ahead_packets, opt.trace);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;
@@ -597,6 +691,11 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   hw::Kernel k(kc);
   Chip chip(k, image, p, threads);
   if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
+  std::unique_ptr<RunTracer> tracer;
+  if (opt.trace.any()) {
+    tracer = std::make_unique<RunTracer>(opt.trace, threads, p.threads);
+    chip.observe(tracer.get());
+  }
 
   CycleFrame out;
   out.params = p;
@@ -604,6 +703,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   const Snapshot start = snapshot(k, chip);
   simulate(k, chip, threads, p, opt, out);
   if (opt.vcd != nullptr) k.finish_trace();
+  if (tracer) tracer->finish();
   const Snapshot end = snapshot(k, chip);
 
   threads.finish();

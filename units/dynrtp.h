@@ -17,6 +17,7 @@
 #include "memif/image_format.h"
 #include "units/cycle_params.h"
 #include "units/functional_model.h"
+#include "units/run_trace.h"
 
 namespace saarcor::units {
 
@@ -41,6 +42,9 @@ struct CycleRunOptions {
   std::uint64_t interval = 0;   // != 0: sample the figures every `interval` cycles
   std::ostream* vcd = nullptr;  // VCD trace of cycles [vcd_from, vcd_to]
   std::uint64_t vcd_from = 0, vcd_to = 0;
+  // The request trace and the Kanata log (units/run_trace.h, docs/traces.md); neither by default.
+  // Tracing changes no figure and no result (tested).
+  RunTraceOptions trace;
   std::uint64_t shuffle_seed = 0;  // != 0: random module evaluation order (figures must not move)
   bool idle_skip = true;           // false: evaluate every cycle (figures must not move)
   std::uint64_t max_cycles = 0;    // != 0: stop with an error after this many cycles

@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <ostream>
 #include <stdexcept>
 #include <utility>
+
+#include "units/request_trace.h"
 
 namespace saarcor::units {
 
@@ -104,11 +107,40 @@ decltype(auto) with_format(const ff::Format& f, Fn&& fn) {
                            " is not built in (e7m10..e7m23, e8m23)");
 }
 
+// ThreadProgram::run() with a request-trace line per request (the same requests in the same
+// order). Returns the number of requests served.
+template <class F>
+std::uint64_t run_traced(ThreadProgram<F>& thread, PipelineUnits<F>& units, TraceTap<F>& tap,
+                         int packet, std::ostream& out) {
+  TraceLine line;
+  line.packet = packet;
+  units.tap = &tap;
+  std::uint32_t n = 0;
+  while (!thread.done()) {
+    const Request r = thread.request();
+    line.seq = n++;
+    line.unit = r.unit;
+    line.phase = r.phase;
+    line.item = r.item;
+    line.steps = r.steps;
+    line.mask = r.mask;
+    line.kind = thread.kind();
+    tap.begin();
+    thread.execute();
+    line.txn = tap.take();
+    out << format_trace_line(line) << '\n';
+  }
+  units.tap = nullptr;
+  return n;
+}
+
 }  // namespace
 
 template <class F>
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
-                               const ProgressFn& progress, UnitTap<F>* tap) {
+                               const ProgressFn& progress, UnitTap<F>* tap, std::ostream* trace) {
+  if (tap != nullptr && trace != nullptr)
+    throw std::logic_error("functional model: a tap and a trace at once");
   const auto t0 = std::chrono::steady_clock::now();
   check_image(image);
   const int w = static_cast<int>(image.registers().width);
@@ -126,10 +158,13 @@ FunctionalFrame run_functional(const memif::MemoryImage& image, const Functional
   frame.params = params;
   const int total = tiling.count();
   std::vector<std::uint32_t> pixels;  // reused: no allocation per packet
+  TraceTap<F> trace_tap;
+  if (trace != nullptr) *trace << kTraceHeader << '\n';
   for (int p = 0; p < total; ++p) {
     fill_packet_pixels(tiling, w, h, p, pixels);
     thread.start_primary(pixels);
-    frame.units.requests += thread.run();
+    frame.units.requests +=
+        trace != nullptr ? run_traced(thread, units, trace_tap, p, *trace) : thread.run();
     if (progress && ((p + 1) % 1024 == 0 || p + 1 == total)) progress(p + 1, total);
   }
   frame.units.packets = static_cast<std::uint64_t>(total);
@@ -188,7 +223,7 @@ PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& 
 #define SAARCOR_INSTANTIATE(E, M)                                            \
   template FunctionalFrame run_functional<ff::Float<E, M>>(                  \
       const memif::MemoryImage&, const FunctionalParams&, const ProgressFn&, \
-      UnitTap<ff::Float<E, M>>*);
+      UnitTap<ff::Float<E, M>>*, std::ostream*);
 SAARCOR_INSTANTIATE(7, 10)
 SAARCOR_INSTANTIATE(7, 11)
 SAARCOR_INSTANTIATE(7, 12)

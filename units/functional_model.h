@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -77,10 +78,13 @@ using ProgressFn = std::function<void(int packets_done, int packets_total)>;
 
 // Renders the frame of `image` (FrameRegisters: resolution, camera, lights). F must be the image's
 // format (throws std::runtime_error otherwise). Instantiated for Float<7, 10..23> and Float<8,23>.
-// With `tap`, every unit transaction is also reported to it (units/unit_vectors.h).
+// With `tap`, every unit transaction is also reported to it (units/unit_vectors.h). With `trace`,
+// every request is written to it as a request-trace line (units/request_trace.h, docs/traces.md:
+// the header, then packet after packet, no cycle, DynRTP or thread); `tap` must then be null.
 template <class F>
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
-                               const ProgressFn& progress = {}, UnitTap<F>* tap = nullptr);
+                               const ProgressFn& progress = {}, UnitTap<F>* tap = nullptr,
+                               std::ostream* trace = nullptr);
 // The same, choosing F from image.format() (the formats above; others throw).
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
                                const ProgressFn& progress = {});

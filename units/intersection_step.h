@@ -27,7 +27,7 @@ class IntersectionStep {
       if (!lane_in(mask, i)) continue;
       const Candidate<F> c = intersect_unit_triangle(t.u.raw, l.tri);
       if (t.u.tap != nullptr) [[unlikely]]
-        t.u.tap->intersection(l.tri, c);
+        t.u.tap->intersection(i, l.tri, c);
       ++l.counters.intersections;
       if (!accepts(c, instance, triangle, l.hit)) continue;
       l.hit.t = c.t;

@@ -80,6 +80,7 @@ enum class UnitId : std::uint8_t {
   kIntersection,
   kNone,
 };
+inline constexpr int kUnitNames = 6;  // UnitId values, kNone included
 inline const char* unit_name(UnitId u) {
   constexpr const char* kNames[] = {"rgs",  "transformation", "traversal",
                                     "list", "intersection",   "none"};
@@ -101,6 +102,7 @@ enum class Phase : std::uint8_t {
   kShadeShadow,        // RGS: shadow-ray results of one light
   kDone,
 };
+inline constexpr int kPhaseNames = 12;  // Phase values, kDone included
 inline const char* phase_name(Phase p) {
   constexpr const char* kNames[] = {
       "generate",         "clip_top",    "traverse",           "list",
@@ -144,20 +146,22 @@ struct Request {
 };
 
 // Unit transactions as the datapaths see them (units/unit_vectors.h: the vectors an RTL unit is
-// checked against). Null in every model run; the capture sets it on a functional run.
+// checked against; units/request_trace.h: the per-request trace). Null in every model run but a
+// capture or a traced one. `lane` is the packet lane (0..P-1) the transaction is for; -1 for a
+// packet's shared origin (one step for every lane, D31).
 template <class F>
 class UnitTap {
  public:
   virtual ~UnitTap() = default;
   // One ray's lane of an inner kd-node step (traversal_lane's operands and results).
-  virtual void traversal(F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far,
-                         F near_tf, F far_tn) = 0;
+  virtual void traversal(int lane, F split, F o_axis, F d_axis, F tn, F tf, bool go_near,
+                         bool go_far, F near_tf, F far_tn) = 0;
   // One matrix-vector step of ray generation or of an object or triangle transformation
   // (transform_step).
-  virtual void transformation(const Mat34<F>& m, const Vec3<F>& in, bool translate,
+  virtual void transformation(int lane, const Mat34<F>& m, const Vec3<F>& in, bool translate,
                               const Vec3<F>& out) = 0;
   // One ray's unit-triangle intersection (intersect_unit_triangle).
-  virtual void intersection(const Ray<F>& ray, const Candidate<F>& c) = 0;
+  virtual void intersection(int lane, const Ray<F>& ray, const Candidate<F>& c) = 0;
 };
 
 // The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is

@@ -48,6 +48,8 @@ int RaySource::extra() {
   --free_;
   threads_.start_primary(t, rgc_.take(now()));
   a->push(t);
+  if (observer_ != nullptr) [[unlikely]]
+    observer_->queued(now(), UnitId::kTransformation, t);
   ++*admitted_;
   return 1;
 }

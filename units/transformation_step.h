@@ -170,24 +170,25 @@ class TransformationStep {
   // Ray generation's steps (R' through the RGS's T), as tap_transform's.
   void tap_generate(State& t, const Vec3<F>& shared) {
     const GenLane<F>& g0 = gen_.lanes[0];
-    if (t.shared_origin) t.u.tap->transformation(g0.t, g0.ro, true, shared);
+    if (t.shared_origin) t.u.tap->transformation(-1, g0.t, g0.ro, true, shared);
     for (int i = 0; i < t.p; ++i) {
       const Lane<F>& l = t.lane(i);
       if (!l.valid) continue;
       const GenLane<F>& g = gen_.lanes[static_cast<std::size_t>(i)];
-      if (!t.shared_origin) t.u.tap->transformation(g.t, g.ro, true, l.world.o);
-      t.u.tap->transformation(g.t, g.rd, false, l.world.d);
+      if (!t.shared_origin) t.u.tap->transformation(i, g.t, g.ro, true, l.world.o);
+      t.u.tap->transformation(i, g.t, g.rd, false, l.world.d);
     }
   }
   // The steps as the unit runs them: a shared origin once (lane 0's, which every lane holds),
   // else each entering lane's origin; each entering lane's direction.
   void tap_transform(State& t, const Mat34<F>& m, Ray<F> Lane<F>::*in, Ray<F> Lane<F>::*out) {
-    if (t.shared_origin) t.u.tap->transformation(m, (t.lanes[0].*in).o, true, (t.lanes[0].*out).o);
+    if (t.shared_origin)
+      t.u.tap->transformation(-1, m, (t.lanes[0].*in).o, true, (t.lanes[0].*out).o);
     for (int i = 0; i < t.p; ++i) {
       if (!lane_in(t.list.entry_mask(), i)) continue;
       const Lane<F>& l = t.lane(i);
-      if (!t.shared_origin) t.u.tap->transformation(m, (l.*in).o, true, (l.*out).o);
-      t.u.tap->transformation(m, (l.*in).d, false, (l.*out).d);
+      if (!t.shared_origin) t.u.tap->transformation(i, m, (l.*in).o, true, (l.*out).o);
+      t.u.tap->transformation(i, m, (l.*in).d, false, (l.*out).d);
     }
   }
 

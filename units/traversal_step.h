@@ -375,7 +375,7 @@ class TraversalStep {
       const int i = std::countr_zero(m);
       const auto s = static_cast<std::size_t>(i);
       const Lane<F>& l = t.lane(i);
-      t.u.tap->traversal(split, l.current.o[axis], l.current.d[axis], t.encoding(t.v.tn[s]),
+      t.u.tap->traversal(i, split, l.current.o[axis], l.current.d[axis], t.encoding(t.v.tn[s]),
                          t.encoding(t.v.tf[s]), lane_in(d.near_mask, i), lane_in(d.far_mask, i),
                          t.encoding(d.near_tf[s]), t.encoding(d.far_tn[s]));
     }

@@ -22,15 +22,15 @@ class SamplingTap final : public UnitTap<F> {
     kept_.reserve(count);
   }
 
-  void traversal(F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far, F near_tf,
-                 F far_tn) override {
+  void traversal(int /*lane*/, F split, F o_axis, F d_axis, F tn, F tf, bool go_near, bool go_far,
+                 F near_tf, F far_tn) override {
     if (unit_ != VectorUnit::kTraversal || !take()) {
       return;
     }
     keep({split.bits, o_axis.bits, d_axis.bits, tn.bits, tf.bits},
          {go_near ? 1u : 0u, go_far ? 1u : 0u, near_tf.bits, far_tn.bits});
   }
-  void transformation(const Mat34<F>& m, const Vec3<F>& in, bool translate,
+  void transformation(int /*lane*/, const Mat34<F>& m, const Vec3<F>& in, bool translate,
                       const Vec3<F>& out) override {
     if (unit_ != VectorUnit::kTransformation || !take()) {
       return;
@@ -47,7 +47,7 @@ class SamplingTap final : public UnitTap<F> {
     v.push_back(translate ? 1u : 0u);
     keep(std::move(v), {out[0].bits, out[1].bits, out[2].bits});
   }
-  void intersection(const Ray<F>& ray, const Candidate<F>& c) override {
+  void intersection(int /*lane*/, const Ray<F>& ray, const Candidate<F>& c) override {
     if (unit_ != VectorUnit::kIntersection || !take()) {
       return;
     }
