@@ -10,6 +10,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
   libmpfr-dev libembree-dev
   verilator yosys
+  python3-matplotlib libopenmpi-dev openmpi-bin
+  clang libclang-rt-14-dev llvm
 )
 
 missing=()

@@ -1,12 +1,12 @@
 // `saarcor render --model cycle`: options, report, Table 4 printout (docs/cycle-model.md).
 #include "testbench/cycle_render.h"
 
-#include <unistd.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+
+#include "testbench/heartbeat.h"
 
 namespace saarcor {
 
@@ -32,19 +32,22 @@ units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
 
 units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
                                    const units::FunctionalParams& shading,
-                                   const CycleRenderOptions& opts) {
+                                   const CycleRenderOptions& opts, bool heartbeat,
+                                   const units::RunTraceOptions& trace) {
   const units::CycleParams p = resolve_cycle_params(opts);
   units::CycleRunOptions ro;
   ro.shading = shading;
+  ro.trace = trace;
   ro.interval = opts.interval;
   if (opts.host_threads != 0)
     ro.programs =
         opts.host_threads == 2 ? units::ProgramMode::kAhead : units::ProgramMode::kPacketFirst;
-  if (isatty(fileno(stderr)))
-    ro.progress = [](std::uint64_t cycles, int done, int total) {
-      std::fprintf(stderr, "\r  cycle %llu, packets %d / %d",
-                   static_cast<unsigned long long>(cycles), done, total);
-      if (done == total) std::fprintf(stderr, "\n");
+  // The heartbeat outlives the run; the lambda only borrows it.
+  Heartbeat beat("  cycle model", heartbeat && heartbeat_enabled());
+  if (beat.enabled())
+    ro.progress = [&beat](std::uint64_t cycles, int done, int total) {
+      beat.beat(Heartbeat::cycle_status(cycles, done, total, beat.seconds()));
+      if (done == total) beat.finish(Heartbeat::cycle_status(cycles, done, total, beat.seconds()));
     };
   std::ofstream vcd;
   if (!opts.vcd.empty()) {

@@ -39,9 +39,13 @@ struct CycleRenderOptions {
 units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts);
 
 // Runs the cycle model on the image (VCD written when asked; no partial VCD file on error).
+// `heartbeat`: the terminal heartbeat (testbench/heartbeat.h) when stderr wants one; the sweep's
+// parallel frames run without, their one heartbeat counts points.
+// `trace`: the request trace and Kanata log to write (units/run_trace.h; none by default).
 units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
                                    const units::FunctionalParams& shading,
-                                   const CycleRenderOptions& opts);
+                                   const CycleRenderOptions& opts, bool heartbeat = true,
+                                   const units::RunTraceOptions& trace = {});
 
 // The per-frame report: cycles, fps, rays, rays_per_s, usage, cache_hit, bandwidth_mb_s, per_ray,
 // simd_efficiency, host, configuration, (time_series).

@@ -78,6 +78,8 @@ void write_hit_exr(const std::string& path, const HitBuffer& hits) {
                                                      : OIIO::TypeDesc::FLOAT);
   }
   spec.attribute("compression", "zip");
+  // Without it OpenImageIO stamps the time of writing (capDate): reruns would differ byte-wise.
+  spec.attribute("DateTime", kFixedImageDateTime);
   std::vector<std::uint32_t> words(hits.pixels.size() * kChannels);
   for (std::size_t p = 0; p < hits.pixels.size(); ++p)
     to_words(hits.pixels[p], &words[p * kChannels]);

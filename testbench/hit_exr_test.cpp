@@ -6,10 +6,14 @@
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <thread>
 
 #include "testbench/image_io.h"
 #include "testbench/testing.h"
@@ -187,6 +191,41 @@ TEST(HitExr, WriteToNonExrExtensionLeavesNoFile) {
   for (const auto& e : fs::directory_iterator(temp_dir())) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
   }
+}
+
+// Two writes of the same records, a second boundary apart, are the same bytes: OpenImageIO would
+// stamp the time of writing into the header (capDate), so the writer gives a fixed DateTime.
+TEST(HitExr, RewriteGivesTheSameBytes) {
+  const HitBuffer hb = random_hits(9, 7, 99);
+  const std::string a = (temp_dir() / "same_a.exr").string();
+  const std::string b = (temp_dir() / "same_b.exr").string();
+  write_hit_exr(a, hb);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  write_hit_exr(b, hb);
+  auto slurp = [](const std::string& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  };
+  const std::string bytes = slurp(a);
+  ASSERT_GT(bytes.size(), 500u);
+  EXPECT_EQ(slurp(b), bytes);
+  auto in = OIIO::ImageInput::open(a);
+  ASSERT_TRUE(in) << OIIO::geterror();
+  EXPECT_EQ(in->spec().get_string_attribute("DateTime"), kFixedImageDateTime);
+  in->close();
+  // The float image writer (image.exr) keeps the same rule.
+  const std::string fa = (temp_dir() / "image_a.exr").string();
+  const std::string fb = (temp_dir() / "image_b.exr").string();
+  Rgb8Image img;
+  img.width = 4;
+  img.height = 3;
+  img.rgb.assign(36, 200);
+  write_float_image(fa, to_float_image(img));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  write_float_image(fb, to_float_image(img));
+  EXPECT_EQ(slurp(fa), slurp(fb));
 }
 
 }  // namespace

@@ -120,6 +120,7 @@ void write_float_image(const std::string& path, const FloatImage& image) {
     spec.channelnames = image.channel_names;
   }
   spec.attribute("compression", "zip");
+  spec.attribute("DateTime", kFixedImageDateTime);
   write_oiio(path, spec, OIIO::TypeDesc::FLOAT, image.data.data());
 }
 

@@ -25,6 +25,12 @@ struct FloatImage {
   }
 };
 
+// The DateTime every written image carries (an EXR's capDate). OpenImageIO stamps the time of
+// writing when none is given, and that stamp alone made two runs of the same command write
+// different bytes; the Unix epoch (SOURCE_DATE_EPOCH=0's date) says "no date" and keeps every
+// file a function of the run's inputs (docs/runs.md).
+inline constexpr const char* kFixedImageDateTime = "1970:01:01 00:00:00";
+
 // Runs write(tmp) with a temporary path beside `path` (same extension, so OpenImageIO picks the
 // same format), then renames it to `path`. The parent directory is created when missing. If
 // write throws, the temporary file is removed and the exception passes on; `path` is untouched.

@@ -10,7 +10,10 @@
 #include <limits>
 #include <stdexcept>
 
+#include "host/tree_settings.h"
+#include "testbench/heartbeat.h"
 #include "testbench/image_io.h"
+#include "testbench/run_dir.h"
 
 namespace saarcor {
 namespace {
@@ -169,7 +172,8 @@ std::pair<int, int> parse_mantissa_range(const std::string& text) {
 }
 
 std::vector<PrecisionRow> run_precision_study(const std::string& scene,
-                                              const RenderSettings& settings, int lo, int hi) {
+                                              const RenderSettings& settings, int lo, int hi,
+                                              bool heartbeat) {
   if (lo < kMinMantissa || hi > kMaxMantissa || lo > hi) {
     throw std::runtime_error("bad mantissa range " + std::to_string(lo) + ".." +
                              std::to_string(hi));
@@ -179,17 +183,23 @@ std::vector<PrecisionRow> run_precision_study(const std::string& scene,
   PreparedScene prep = prepare_scene(scene, settings, ff::kFp24);
   progress("rendering the float reference");
   const FrameResult ref = render_model(parse_model("float"), prep, settings);
+  // One heartbeat for the study: formats done / total (the frames' own stay quiet under it).
+  Heartbeat beat("precision", heartbeat && heartbeat_enabled());
+  RenderSettings quiet = settings;
+  quiet.heartbeat = false;
+  const int formats = hi - lo + 1;
   const FloatImage ref_image = to_float_image(ref.image);
   std::vector<PrecisionRow> rows;
   for (int m = lo; m <= hi; ++m) {
     const ff::Format format{7, m};
     if (!(prep.built.params.format == format)) build_prepared_image(prep, settings, format);
-    progress("rendering Float<7," + std::to_string(m) + ">");
+    beat.beat("formats " + std::to_string(m - lo) + " / " + std::to_string(formats) +
+              ", rendering Float<7," + std::to_string(m) + ">");
     ModelSpec model;
     model.kind = ModelKind::kFunctional;
     model.mantissa = m;
     model.name = ff::format_name(format);
-    const FrameResult f = render_model(model, prep, settings);
+    const FrameResult f = render_model(model, prep, quiet);
     const CompareResult hits = compare_hits(f.hits, ref.hits);
     const CompareResult img = compare_images(to_float_image(f.image), ref_image);
     PrecisionRow row;
@@ -202,6 +212,7 @@ std::vector<PrecisionRow> run_precision_study(const std::string& scene,
     row.seconds = f.seconds;
     rows.push_back(row);
   }
+  beat.finish("formats " + std::to_string(formats) + " / " + std::to_string(formats));
   return rows;
 }
 
@@ -339,11 +350,20 @@ int run_precision(const PrecisionOptions& opts) {
   settings.res = parse_resolution(opts.res);
   settings.bank_mb = opts.bank_mb;
   const auto [lo, hi] = parse_mantissa_range(opts.mantissa);
-  const std::string out = output_prefix(opts.out, {".png", ".json"});
+  const bool in_dir = !opts.out_dir.empty();
+  if (in_dir) {
+    check_out_dir(opts.out_dir);
+    if (opts.out_given)
+      throw std::runtime_error(
+          "--out-dir names every file it writes (precision.png, "
+          "report.json): drop --out");
+  }
+  const std::string out =
+      in_dir ? run_file(opts.out_dir, "precision") : output_prefix(opts.out, {".png", ".json"});
   const std::vector<PrecisionRow> rows = run_precision_study(opts.scene, settings, lo, hi);
 
   const std::string png = out + ".png";
-  const std::string json = out + ".json";
+  const std::string json = in_dir ? run_file(opts.out_dir, "report.json") : out + ".json";
   const std::string name = std::filesystem::path(opts.scene).filename().string();
   write_rgb8(png, plot_precision(rows, name + "  " + std::to_string(settings.res.width) + "x" +
                                            std::to_string(settings.res.height))
@@ -352,6 +372,8 @@ int run_precision(const PrecisionOptions& opts) {
   j["scene"] = opts.scene;
   j["resolution"] = {{"width", settings.res.width}, {"height", settings.res.height}};
   j["reference"] = "float";
+  nlohmann::json host;  // --out-dir: the frames' wall-clock seconds, apart from the results
+  std::vector<StatLine> stats;
   for (const PrecisionRow& r : rows) {
     nlohmann::json row;
     row["mantissa"] = r.mantissa;
@@ -364,14 +386,64 @@ int run_precision(const PrecisionOptions& opts) {
                          {"edge_tie", r.mismatches.edge_tie},
                          {"grazing", r.mismatches.grazing},
                          {"other", r.mismatches.other}};
-    row["seconds"] = r.seconds;
+    if (in_dir) {
+      host["rows"].push_back({{"mantissa", r.mantissa}, {"seconds", r.seconds}});
+    } else {
+      row["seconds"] = r.seconds;
+    }
     j["rows"].push_back(row);
+    const std::string m = "e7m" + std::to_string(r.mantissa) + ".";
+    const std::string of = " of Float<7," + std::to_string(r.mantissa) + "> against float";
+    stats.push_back({m + "same_triangle_pct", r.same_triangle_pct,
+                     "% of pixels hitting the same triangle" + of});
+    // Identical images have no finite PSNR; stats.txt carries the number, so infinity is left
+    // out rather than printed as a value no parser agrees on.
+    if (std::isfinite(r.psnr_db)) stats.push_back({m + "psnr_db", r.psnr_db, "image PSNR" + of});
+    if (r.t_rel_err_median)
+      stats.push_back(
+          {m + "t_rel_err_median", *r.t_rel_err_median, "median relative hit-distance error" + of});
+    if (r.t_rel_err_max)
+      stats.push_back(
+          {m + "t_rel_err_max", *r.t_rel_err_max, "largest relative hit-distance error" + of});
+    stats.push_back({m + "mismatches.hit_vs_miss", static_cast<double>(r.mismatches.hit_vs_miss),
+                     "pixels where one hits and the other misses"});
+    stats.push_back({m + "mismatches.edge_tie", static_cast<double>(r.mismatches.edge_tie),
+                     "different triangles, hit on a shared edge"});
+    stats.push_back({m + "mismatches.grazing", static_cast<double>(r.mismatches.grazing),
+                     "different triangles, grazing ray"});
+    stats.push_back({m + "mismatches.other", static_cast<double>(r.mismatches.other),
+                     "different triangles, other cause"});
+  }
+  if (in_dir) {
+    j["outputs"] = {{"plot", "precision.png"}, {"report", "report.json"},  {"stats", "stats.txt"},
+                    {"config", "config.json"}, {"command", "command.txt"}, {"host", "host.json"}};
+    // The study's whole configuration: the frame, the formats, and the tree keys every format's
+    // image is built with (at their defaults: the study has no --set).
+    host::ImageParams trees;
+    nlohmann::json config;
+    config["scene"] = opts.scene;
+    config["resolution"] = j["resolution"];
+    config["bank_mb"] = settings.bank_mb;
+    config["mantissa"] = {{"from", lo}, {"to", hi}};
+    config["exponent_bits"] = 7;
+    config["reference"] = "float";
+    config["shadows"] = settings.shadows;
+    config["depth"] = settings.depth;
+    for (const host::TreeSettingInfo& t : host::describe_tree_settings(trees))
+      config["trees"][t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
+    write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text(stats));
+    write_text_file(run_file(opts.out_dir, "config.json"), config.dump(2) + "\n");
+    write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
+    write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
   }
   write_text_file(json, j.dump(2) + "\n");
   std::printf("saarcor precision: %s, %dx%d, Float<7,m> against the float reference\n%s",
               opts.scene.c_str(), settings.res.width, settings.res.height,
               precision_table(rows).c_str());
   std::printf("  plot:   %s\n  table:  %s\n", png.c_str(), json.c_str());
+  if (in_dir)
+    std::printf("  run folder: %s (stats.txt, config.json, command.txt, host.json)\n",
+                opts.out_dir.c_str());
   return 0;
 }
 

@@ -27,9 +27,11 @@ struct PrecisionRow {
 // "M" or "A..B" with kMinMantissa <= A <= B <= kMaxMantissa; throws "bad --mantissa ...".
 std::pair<int, int> parse_mantissa_range(const std::string& text);
 
-// Renders the float reference once and the functional model for each m in [lo, hi].
+// Renders the float reference once and the functional model for each m in [lo, hi], with a
+// terminal heartbeat (formats done / total) when `heartbeat`.
 std::vector<PrecisionRow> run_precision_study(const std::string& scene,
-                                              const RenderSettings& settings, int lo, int hi);
+                                              const RenderSettings& settings, int lo, int hi,
+                                              bool heartbeat = true);
 
 // The plot: x = mantissa bits; left axis same-triangle share (blue), right axis PSNR (red);
 // dashed guides at the acceptance thresholds (99 %, 35 dB) and at m = 16 (fp24).
@@ -50,6 +52,11 @@ struct PrecisionOptions {
   std::string res = "512x384";
   std::string out = "out/precision";  // PREFIX.png (plot), PREFIX.json (table)
   double bank_mb = 4.0;
+  // --out-dir DIR (testbench/run_dir.h): precision.png, report.json, stats.txt, config.json,
+  // command.txt, host.json; --out is refused with it.
+  std::string out_dir;
+  bool out_given = false;         // --out was on the command line (not its default)
+  std::vector<std::string> argv;  // the command line, for command.txt
 };
 
 int run_precision(const PrecisionOptions& opts);

@@ -2,22 +2,26 @@
 // run one model, write PNG / EXR / hit EXR / JSON report. docs/compare.md lists the outputs.
 #include "testbench/render_cmd.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "host/float_reference.h"
 #include "host/primary_rays.h"
 #include "host/tree_settings.h"
+#include "testbench/heartbeat.h"
 #include "testbench/hit_exr.h"
 #include "testbench/image_io.h"
+#include "testbench/run_dir.h"
 #include "units/functional_model.h"
+#include "units/request_trace.h"
 
 namespace saarcor {
 namespace {
@@ -133,36 +137,36 @@ PixelHit trace_float_pixel(const PreparedScene& prep, const RenderSettings& sett
 // Float<7, m> chosen by an explicit switch: each case is its own template instantiation.
 units::FunctionalFrame run_functional_m(int m, const memif::MemoryImage& image,
                                         const units::FunctionalParams& params,
-                                        const units::ProgressFn& progress) {
+                                        const units::ProgressFn& progress, std::ostream* trace) {
   switch (m) {
     case 10:
-      return units::run_functional<ff::Float<7, 10>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 10>>(image, params, progress, nullptr, trace);
     case 11:
-      return units::run_functional<ff::Float<7, 11>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 11>>(image, params, progress, nullptr, trace);
     case 12:
-      return units::run_functional<ff::Float<7, 12>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 12>>(image, params, progress, nullptr, trace);
     case 13:
-      return units::run_functional<ff::Float<7, 13>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 13>>(image, params, progress, nullptr, trace);
     case 14:
-      return units::run_functional<ff::Float<7, 14>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 14>>(image, params, progress, nullptr, trace);
     case 15:
-      return units::run_functional<ff::Float<7, 15>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 15>>(image, params, progress, nullptr, trace);
     case 16:
-      return units::run_functional<ff::Float<7, 16>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 16>>(image, params, progress, nullptr, trace);
     case 17:
-      return units::run_functional<ff::Float<7, 17>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 17>>(image, params, progress, nullptr, trace);
     case 18:
-      return units::run_functional<ff::Float<7, 18>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 18>>(image, params, progress, nullptr, trace);
     case 19:
-      return units::run_functional<ff::Float<7, 19>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 19>>(image, params, progress, nullptr, trace);
     case 20:
-      return units::run_functional<ff::Float<7, 20>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 20>>(image, params, progress, nullptr, trace);
     case 21:
-      return units::run_functional<ff::Float<7, 21>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 21>>(image, params, progress, nullptr, trace);
     case 22:
-      return units::run_functional<ff::Float<7, 22>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 22>>(image, params, progress, nullptr, trace);
     case 23:
-      return units::run_functional<ff::Float<7, 23>>(image, params, progress);
+      return units::run_functional<ff::Float<7, 23>>(image, params, progress, nullptr, trace);
     default:
       break;
   }
@@ -208,17 +212,19 @@ FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene&
                                     const RenderSettings& settings) {
   FrameResult r;
   r.model = model.name;
-  const bool tty = isatty(fileno(stderr));
+  Heartbeat beat("  " + model.name + " model", settings.heartbeat && heartbeat_enabled());
   units::ProgressFn report;
-  if (tty) {
-    report = [](int done, int total) {
-      std::fprintf(stderr, "\r  packets %d / %d", done, total);
-      if (done == total) std::fprintf(stderr, "\n");
+  if (beat.enabled()) {
+    report = [&beat](int done, int total) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "packets %d / %d", done, total);
+      beat.beat(buf);
+      if (done == total) beat.finish(buf);
     };
   }
   const auto t0 = Clock::now();
-  const units::FunctionalFrame frame =
-      run_functional_m(model.mantissa, prep.built.image, functional_params(settings), report);
+  const units::FunctionalFrame frame = run_functional_m(
+      model.mantissa, prep.built.image, functional_params(settings), report, settings.trace.trace);
   r.seconds = seconds_since(t0);
   r.hits.width = frame.width;
   r.hits.height = frame.height;
@@ -274,8 +280,8 @@ FrameResult render_cycle_frame(const ModelSpec& model, const PreparedScene& prep
   FrameResult r;
   r.model = model.name;
   const auto t0 = Clock::now();
-  const units::CycleFrame c =
-      run_cycle_render(prep.built.image, functional_params(settings), settings.cycle);
+  const units::CycleFrame c = run_cycle_render(prep.built.image, functional_params(settings),
+                                               settings.cycle, settings.heartbeat, settings.trace);
   r.seconds = seconds_since(t0);
   r.hits.width = c.frame.width;
   r.hits.height = c.frame.height;
@@ -311,7 +317,7 @@ void check_functional_format(const ModelSpec& model, const PreparedScene& prep) 
 }  // namespace
 
 void progress(const std::string& line) {
-  if (isatty(fileno(stderr))) std::fprintf(stderr, "%s\n", line.c_str());
+  if (heartbeat_enabled()) std::fprintf(stderr, "%s\n", line.c_str());
 }
 
 std::string output_prefix(const std::string& out, std::initializer_list<std::string_view> exts) {
@@ -511,13 +517,191 @@ RenderSettings frame_settings(const std::string& res, double time, bool shadows,
   return s;
 }
 
+void check_trace_options(const TraceOptions& t, const ModelSpec& model, bool pixel) {
+  const bool cycle = model.kind == ModelKind::kCycle;
+  if (t.any() && model.kind == ModelKind::kFloat)
+    throw std::runtime_error(
+        "--trace and --konata need a model with DynRTP units (fp24, e7mM, cycle, cycle-e7m23); "
+        "the float reference has none");
+  if (!t.konata.empty() && !cycle)
+    throw std::runtime_error("--konata needs --model cycle (the functional model has no cycles)");
+  if ((t.window_given || !t.konata_threads.empty()) && !cycle)
+    throw std::runtime_error(
+        "--trace-from, --trace-to and --konata-threads apply to --model cycle");
+  if (t.window_given && !t.any())
+    throw std::runtime_error("--trace-from and --trace-to limit --trace or --konata: give one");
+  if (!t.konata_threads.empty() && t.konata.empty())
+    throw std::runtime_error("--konata-threads chooses the threads of --konata: give it");
+  if (t.to < t.from)
+    throw std::runtime_error("bad --trace-to " + std::to_string(t.to) + ": before --trace-from " +
+                             std::to_string(t.from));
+  if (pixel && t.any())
+    throw std::runtime_error("--pixel prints its packet's requests itself: drop --trace, --konata");
+}
+
+std::vector<std::uint32_t> parse_thread_list(const std::string& text, int threads) {
+  const auto bad = [&](const std::string& why) {
+    return std::runtime_error("bad --konata-threads '" + text + "': " + why);
+  };
+  const auto number = [&](const std::string& w) {
+    if (w.empty() || w.size() > 9 || w.find_first_not_of("0123456789") != std::string::npos)
+      throw bad("expected thread ids like 0,3,8-11");
+    const int v = std::stoi(w);
+    if (v >= threads)
+      throw bad("thread " + w + " does not exist (" + std::to_string(threads) + " threads)");
+    return static_cast<std::uint32_t>(v);
+  };
+  std::vector<std::uint32_t> out;
+  std::istringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    const std::size_t dash = item.find('-');
+    const std::uint32_t a = number(item.substr(0, dash));
+    const std::uint32_t b = dash == std::string::npos ? a : number(item.substr(dash + 1));
+    if (b < a) throw bad("range " + item + " runs backwards");
+    for (std::uint32_t t = a; t <= b; ++t)
+      out.push_back(t);
+  }
+  if (out.empty() || text.back() == ',') throw bad("expected thread ids like 0,3,8-11");
+  return out;
+}
+
+int pixel_packet(PixelCoord pixel, const Resolution& res, int packet) {
+  const units::PacketTiling t = units::packet_tiling(res.width, res.height, packet);
+  return (pixel.y / t.tile_height) * t.tiles_x + pixel.x / t.tile_width;
+}
+
+namespace {
+
+// The trace files of a render, open while it runs: a file that cannot be written is an error
+// before the render, and one left half-written by an error is removed.
+class TraceFiles {
+ public:
+  TraceFiles(const TraceOptions& t, int threads) : t_(t) {
+    run.from = t.from;
+    run.to = t.to;
+    if (!t.konata_threads.empty())
+      run.konata_threads = parse_thread_list(t.konata_threads, threads);
+    open(t.file, "--trace", trace_, run.trace);
+    open(t.konata, "--konata", konata_, run.konata);
+  }
+  TraceFiles(const TraceFiles&) = delete;
+  TraceFiles& operator=(const TraceFiles&) = delete;
+  ~TraceFiles() {
+    if (done_) return;
+    for (const std::string* f : {&t_.file, &t_.konata})
+      if (!f->empty()) {
+        std::error_code ec;
+        std::filesystem::remove(*f, ec);
+      }
+  }
+  // Closes the files; throws when one could not be written completely.
+  void finish(std::vector<std::pair<std::string, std::string>>& outputs) {
+    close(t_.file, "--trace", trace_, "trace", outputs);
+    close(t_.konata, "--konata", konata_, "konata", outputs);
+    done_ = true;
+  }
+  units::RunTraceOptions run;
+
+ private:
+  static void open(const std::string& file, const char* flag, std::ofstream& f, std::ostream*& to) {
+    if (file.empty()) return;
+    f.open(file, std::ios::binary);
+    if (!f) throw std::runtime_error(std::string("cannot write ") + flag + " '" + file + "'");
+    to = &f;
+  }
+  static void close(const std::string& file, const char* flag, std::ofstream& f, const char* key,
+                    std::vector<std::pair<std::string, std::string>>& outputs) {
+    if (file.empty()) return;
+    f.close();
+    if (!f) throw std::runtime_error(std::string("cannot write ") + flag + " '" + file + "'");
+    outputs.push_back({key, file});
+  }
+  const TraceOptions& t_;
+  std::ofstream trace_, konata_;
+  bool done_ = false;
+};
+
+// --pixel with the cycle model: the frame with the request trace of the pixel's packet, whose
+// lines are printed with their cycles (the hit record comes from the same frame).
+PixelHit cycle_pixel(const ModelSpec& model, const PreparedScene& prep, RenderSettings settings,
+                     PixelCoord pixel, std::vector<std::string>& lines) {
+  std::ostringstream trace;
+  settings.trace.trace = &trace;
+  settings.trace.packet =
+      pixel_packet(pixel, settings.res, resolve_cycle_params(settings.cycle).packet);
+  const PixelHit h = trace_pixel(model, prep, settings, pixel);
+  std::istringstream in(trace.str());
+  for (std::string text; std::getline(in, text);) {
+    if (text.starts_with("#")) continue;
+    const units::TraceLine l = units::parse_trace_line(text);
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "cycle=%-9llu dynrtp=%d thread=%-3d %-14s %-18s item=%-10u steps=%-3d "
+                  "mask=%llx %s",
+                  static_cast<unsigned long long>(l.cycle), l.dynrtp, l.thread,
+                  units::unit_name(l.unit), units::phase_name(l.phase), l.item, l.steps,
+                  static_cast<unsigned long long>(l.mask), units::ray_kind_name(l.kind));
+    lines.emplace_back(line);
+  }
+  return h;
+}
+
+// --out-dir: the report without host timing, which goes to host.json; the configuration alone;
+// every statistic one per line; the command line. File names in the report are relative to the
+// folder, so a run folder reads the same wherever it is moved.
+void write_run_files(const RenderOptions& opts, nlohmann::json report, const FrameResult& frame,
+                     std::vector<std::pair<std::string, std::string>>& outputs) {
+  nlohmann::json host;
+  host["seconds"] = report["seconds"];
+  host["rays_per_second"] = report["rays_per_second"];
+  host["load_seconds"] = report["configuration"]["load_seconds"];
+  host["build_seconds"] = report["configuration"]["build_seconds"];
+  report.erase("seconds");
+  report.erase("rays_per_second");
+  report["configuration"].erase("load_seconds");
+  report["configuration"].erase("build_seconds");
+  if (report.contains("host")) host["cycle_model"] = take_cycle_host(report);
+  outputs.push_back({"report", run_file(opts.out_dir, "report.json")});
+  outputs.push_back({"stats", run_file(opts.out_dir, "stats.txt")});
+  outputs.push_back({"config", run_file(opts.out_dir, "config.json")});
+  outputs.push_back({"command", run_file(opts.out_dir, "command.txt")});
+  outputs.push_back({"host", run_file(opts.out_dir, "host.json")});
+  nlohmann::json names;
+  for (const auto& [k, v] : outputs)
+    names[k] = std::filesystem::path(v).filename().string();
+  report["outputs"] = names;
+
+  nlohmann::json config = report["configuration"];
+  config["scene"] = report["scene"];
+  config["model"] = report["model"];
+  config["resolution"] = report["resolution"];
+  std::vector<StatLine> stats;
+  if (!frame.cycle.is_null()) {
+    append_cycle_stats(stats, frame.cycle);
+  } else {
+    stats.push_back({"rays", static_cast<double>(frame.rays), "rays traced (count)"});
+    append_counter_stats(stats, frame.counters);
+  }
+
+  write_text_file(run_file(opts.out_dir, "report.json"), report.dump(2) + "\n");
+  write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text(stats));
+  write_text_file(run_file(opts.out_dir, "config.json"), config.dump(2) + "\n");
+  write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
+  write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
+}
+
+}  // namespace
+
 int run_render(const RenderOptions& opts) {
   const ModelSpec model = parse_model(opts.model);
   RenderSettings settings =
       frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
   settings.cycle = opts.cycle;
+  int threads = 0;  // the cycle model's threads over all DynRTPs (--konata-threads)
   if (model.kind == ModelKind::kCycle) {
-    resolve_cycle_params(opts.cycle);  // a bad --preset/--set fails before the scene loads
+    // A bad --preset/--set fails before the scene loads.
+    const units::CycleParams cp = resolve_cycle_params(opts.cycle);
+    threads = cp.pipelines * cp.threads;
   } else if (opts.cycle.any_given()) {
     throw std::runtime_error(
         "--preset, --set (but kd.* keys), --interval, --host-threads and --vcd apply to --model "
@@ -525,8 +709,21 @@ int run_render(const RenderOptions& opts) {
   }
   std::optional<PixelCoord> pixel;
   if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
+  check_trace_options(opts.trace, model, pixel.has_value());
   // Output names are checked before the work, so a bad one costs no render.
-  const std::string out = output_prefix(opts.out, {".png", ".exr"});
+  const bool in_dir = !opts.out_dir.empty();
+  if (in_dir) {
+    check_out_dir(opts.out_dir);
+    if (opts.out_given || !opts.report.empty() || !opts.hits.empty())
+      throw std::runtime_error(
+          "--out-dir names every file it writes: drop --out, --report and --hits' file name "
+          "(--hits alone writes DIR/hits.exr)");
+    if (pixel) throw std::runtime_error("--pixel prints one pixel; --out-dir is for frames");
+  } else if (opts.hits_asked && opts.hits.empty()) {
+    throw std::runtime_error("bad --hits: expected a file name FILE.exr (or --out-dir DIR)");
+  }
+  const std::string out =
+      in_dir ? run_file(opts.out_dir, "image") : output_prefix(opts.out, {".png", ".exr"});
   if (!opts.hits.empty() && !opts.hits.ends_with(".exr")) {
     throw std::runtime_error("bad --hits '" + opts.hits + "': a hit EXR file name ends in .exr");
   }
@@ -534,12 +731,18 @@ int run_render(const RenderOptions& opts) {
     throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
   }
 
+  TraceFiles traces(opts.trace, threads);  // opened now: an unwritable one costs no render
+  settings.trace = traces.run;
+
   const ff::Format format =
       model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
   const PreparedScene prep = prepare_scene(opts.scene, settings, format);
 
   if (pixel) {
-    const PixelHit h = trace_pixel(model, prep, settings, *pixel);
+    std::vector<std::string> cycle_lines;
+    const PixelHit h = model.kind == ModelKind::kCycle
+                           ? cycle_pixel(model, prep, settings, *pixel, cycle_lines)
+                           : trace_pixel(model, prep, settings, *pixel);
     std::printf("saarcor render %s --model %s --res %dx%d --time %g\n%s", opts.scene.c_str(),
                 model.name.c_str(), settings.res.width, settings.res.height, settings.time,
                 format_pixel_hit(*pixel, h).c_str());
@@ -550,6 +753,9 @@ int run_render(const RenderOptions& opts) {
       for (const std::string& line : t.log)
         std::printf("  %s\n", line.c_str());
     }
+    // The cycle model: every request of the pixel's packet with the cycle a unit issued it.
+    for (const std::string& line : cycle_lines)
+      std::printf("  %s\n", line.c_str());
     return 0;
   }
 
@@ -560,17 +766,21 @@ int run_render(const RenderOptions& opts) {
   const std::string png = out + ".png";
   write_rgb8(png, frame.image);
   std::vector<std::pair<std::string, std::string>> outputs = {{"image", png}};
+  traces.finish(outputs);
   if (opts.exr) {
     const std::string exr = out + ".exr";
     write_float_image(exr, to_float_image(frame.image));
     outputs.push_back({"image_exr", exr});
   }
-  if (!opts.hits.empty()) {
-    write_hit_exr(opts.hits, frame.hits);
-    outputs.push_back({"hits", opts.hits});
+  const std::string hits =
+      in_dir && opts.hits_asked ? run_file(opts.out_dir, "hits.exr") : opts.hits;
+  if (!hits.empty()) {
+    write_hit_exr(hits, frame.hits);
+    outputs.push_back({"hits", hits});
   }
   const double rays_per_s = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
-  if (!opts.report.empty()) {
+  const std::string report = in_dir ? run_file(opts.out_dir, "report.json") : opts.report;
+  if (!report.empty()) {
     nlohmann::json j;
     j["scene"] = opts.scene;
     j["model"] = model.name;
@@ -600,13 +810,21 @@ int run_render(const RenderOptions& opts) {
       j["configuration"]["cycle"] = c["configuration"];
       c.erase("configuration");
       j.update(c);
+    } else {  // the other models read the same trees: their keys are configuration too
+      for (const host::TreeSettingInfo& t : host::describe_tree_settings(prep.built.params))
+        j["configuration"]["trees"][t.name] = {
+            {"value", t.value}, {"unit", t.unit}, {"help", t.help}};
     }
-    nlohmann::json out;
-    for (const auto& [k, v] : outputs)
-      out[k] = v;
-    j["outputs"] = out;
-    write_text_file(opts.report, j.dump(2) + "\n");
-    outputs.push_back({"report", opts.report});
+    if (in_dir) {
+      write_run_files(opts, j, frame, outputs);
+    } else {
+      nlohmann::json out;
+      for (const auto& [k, v] : outputs)
+        out[k] = v;
+      j["outputs"] = out;
+      write_text_file(report, j.dump(2) + "\n");
+      outputs.push_back({"report", report});
+    }
   }
   std::printf("saarcor render: %s, model %s, %dx%d, %.3f s, %" PRIu64 " rays (%.3g rays/s)\n",
               opts.scene.c_str(), model.name.c_str(), settings.res.width, settings.res.height,

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <initializer_list>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -60,6 +61,10 @@ struct RenderSettings {
   // bit-identical to the reference on every scene (tests), binary64 is the golden image.
   host::InstanceStep float_instance_step = host::InstanceStep::kBinary64;
   CycleRenderOptions cycle;  // --model cycle: preset, --set overrides, --interval, --vcd
+  bool heartbeat = true;     // a frame's terminal heartbeat (off for the sweep's parallel frames)
+  // The request trace (the functional and the cycle models) and the Kanata log (the cycle model)
+  // to write; the streams belong to the caller (docs/traces.md).
+  units::RunTraceOptions trace;
 };
 
 // The scene loaded, set to the time, with its memory image built in `format`.
@@ -111,6 +116,25 @@ std::string join_words(const std::vector<std::string>& words);
 RenderSettings frame_settings(const std::string& res, double time, bool shadows, int depth,
                               double bank_mb);
 
+// --trace FILE [--trace-from N --trace-to M] and --konata FILE [--konata-threads LIST]
+// (docs/traces.md).
+struct TraceOptions {
+  std::string file;    // the request trace (models fp24, e7mM, cycle, cycle-e7m23)
+  std::string konata;  // the Kanata log (cycle models)
+  std::uint64_t from = 0;
+  std::uint64_t to = std::numeric_limits<std::uint64_t>::max();
+  bool window_given = false;   // --trace-from or --trace-to on the command line
+  std::string konata_threads;  // "0,3,8-11": the Kanata log's threads (default: every thread)
+  bool any() const { return !file.empty() || !konata.empty(); }
+};
+// Checks the trace options against the model (one line naming the option on misuse).
+void check_trace_options(const TraceOptions& t, const ModelSpec& model, bool pixel);
+// "0,3,8-11" as thread ids, each below `threads` (all DynRTPs' threads); throws "bad
+// --konata-threads ..." otherwise.
+std::vector<std::uint32_t> parse_thread_list(const std::string& text, int threads);
+// The RGC's packet index holding pixel (x, y) at packet width P (units/functional_model.h).
+int pixel_packet(PixelCoord pixel, const Resolution& res, int packet);
+
 struct RenderOptions {
   std::string scene;
   std::string model = "fp24";
@@ -125,12 +149,21 @@ struct RenderOptions {
   int depth = 0;
   double bank_mb = 4.0;
   CycleRenderOptions cycle;
+  TraceOptions trace;
+  // --out-dir DIR (testbench/run_dir.h): image.png, image.exr (--exr), hits.exr (--hits without
+  // a file name), report.json, stats.txt, config.json, command.txt, host.json; --out, --report and
+  // a --hits file name are refused with it (the folder names every file).
+  std::string out_dir;
+  bool out_given = false;         // --out was on the command line (not its default)
+  bool hits_asked = false;        // --hits was on the command line, with or without a file name
+  std::vector<std::string> argv;  // the command line, for command.txt
 };
 
 // Returns 0; throws std::runtime_error with one line on bad input.
 int run_render(const RenderOptions& opts);
 
-// Writes one line of progress to stderr when it is a terminal (and nothing otherwise).
+// Writes one line of progress to stderr when the heartbeat would show (a terminal, CI unset:
+// testbench/heartbeat.h), and nothing otherwise.
 void progress(const std::string& line);
 
 }  // namespace saarcor

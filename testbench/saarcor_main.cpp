@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "testbench/version.h"
 // [subcommand headers]
@@ -24,6 +25,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("saarcor ") + saarcor::kVersion);
   app.require_subcommand(1);
   int status = 0;
+  // The command line as given, for the run folder's command.txt (--out-dir).
+  const std::vector<std::string> command(argv, argv + argc);
 
   // [subcommands]
   saarcor::SceneOptions scene_opts;
@@ -79,12 +82,20 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     sub->add_option("--res", render_opts.res, "resolution WxH")->capture_default_str();
     sub->add_option("--time", render_opts.time, "animation time in seconds");
-    sub->add_option("--out", render_opts.out,
-                    "output prefix (PREFIX.png, PREFIX.exr; a given .png or .exr is dropped)")
-        ->capture_default_str();
+    auto* out =
+        sub->add_option("--out", render_opts.out,
+                        "output prefix (PREFIX.png, PREFIX.exr; a given .png or .exr is dropped)")
+            ->capture_default_str();
     sub->add_flag("--exr", render_opts.exr, "also write PREFIX.exr");
-    sub->add_option("--hits", render_opts.hits, "write the per-pixel hit records as a hit EXR");
+    // A file name, or none with --out-dir (DIR/hits.exr).
+    auto* hits = sub->add_option("--hits", render_opts.hits,
+                                 "write the per-pixel hit records as a hit EXR (FILE.exr; with "
+                                 "--out-dir no name: DIR/hits.exr)")
+                     ->expected(0, 1);
     sub->add_option("--report", render_opts.report, "write a JSON report");
+    sub->add_option("--out-dir", render_opts.out_dir,
+                    "write image, report.json, stats.txt, config.json, command.txt, host.json "
+                    "into DIR");
     sub->add_option("--pixel", render_opts.pixel, "trace one pixel x,y and print its hit record");
     sub->add_flag("--shadows", render_opts.shadows, "shadow rays");
     sub->add_option("--depth", render_opts.depth, "secondary-ray depth (0 = primary only)");
@@ -105,7 +116,25 @@ int main(int argc, char** argv) {
     sub->add_option("--vcd-from", render_opts.cycle.vcd_from, "first cycle of the VCD trace");
     sub->add_option("--vcd-to", render_opts.cycle.vcd_to, "last cycle of the VCD trace")
         ->capture_default_str();
-    sub->callback([&] { status = saarcor::run_render(render_opts); });
+    // Traces (docs/traces.md)
+    sub->add_option("--trace", render_opts.trace.file,
+                    "write the request trace: a line per unit request with its transactions "
+                    "(fp24, e7mM and cycle models)");
+    auto* trace_from = sub->add_option("--trace-from", render_opts.trace.from,
+                                       "cycle model: first cycle of --trace and --konata");
+    auto* trace_to = sub->add_option("--trace-to", render_opts.trace.to,
+                                     "cycle model: last cycle of --trace and --konata");
+    sub->add_option("--konata", render_opts.trace.konata,
+                    "cycle model: write a Kanata pipeline log (opens in Konata)");
+    sub->add_option("--konata-threads", render_opts.trace.konata_threads,
+                    "cycle model: the threads of --konata, e.g. 0,3,8-11 (default: all)");
+    sub->callback([&, out, hits, trace_from, trace_to] {
+      render_opts.out_given = out->count() > 0;
+      render_opts.hits_asked = hits->count() > 0;
+      render_opts.trace.window_given = trace_from->count() > 0 || trace_to->count() > 0;
+      render_opts.argv = command;
+      status = saarcor::run_render(render_opts);
+    });
   }
   saarcor::PaperOptions paper_opts;
   {
@@ -147,7 +176,25 @@ int main(int argc, char** argv) {
                     "2 = thread programs on a second host thread, 1 = on the simulation's thread");
     sub->add_option("--report", sweep_opts.report, "write every point's report as JSON");
     sub->add_option("--csv", sweep_opts.csv, "write the table as CSV");
-    sub->callback([&] { status = saarcor::run_sweep(sweep_opts); });
+    sub->add_option("--jobs", sweep_opts.jobs,
+                    "points run at once on this host (default: its cores; same rows)");
+    sub->add_option("--shard", sweep_opts.shard,
+                    "K/N: only shard K of N (every N-th point; merge with sweep-merge)");
+    sub->add_option("--out-dir", sweep_opts.out_dir,
+                    "write sweep.csv, report.json, stats.txt, config.json, command.txt, host.json "
+                    "into DIR");
+    sub->callback([&] {
+      sweep_opts.argv = command;
+      status = saarcor::run_sweep(sweep_opts);
+    });
+  }
+  saarcor::SweepMergeOptions merge_opts;
+  {
+    auto* sub = app.add_subcommand(
+        "sweep-merge", "merge the CSVs of sweep --shard K/N runs into the whole sweep's CSV");
+    sub->add_option("parts", merge_opts.parts, "shard CSVs (any order)")->required();
+    sub->add_option("-o,--out", merge_opts.out, "the merged CSV")->required();
+    sub->callback([&] { status = saarcor::run_sweep_merge(merge_opts); });
   }
   saarcor::VectorsOptions vectors_opts;
   {
@@ -178,13 +225,21 @@ int main(int argc, char** argv) {
     sub->add_option("--mantissa", precision_opts.mantissa, "mantissa bits: M or A..B (10..23)")
         ->capture_default_str();
     sub->add_option("--res", precision_opts.res, "resolution WxH")->capture_default_str();
-    sub->add_option(
-           "--out", precision_opts.out,
-           "output prefix (PREFIX.png plot, PREFIX.json; a given .png or .json is dropped)")
-        ->capture_default_str();
+    auto* out =
+        sub->add_option(
+               "--out", precision_opts.out,
+               "output prefix (PREFIX.png plot, PREFIX.json; a given .png or .json is dropped)")
+            ->capture_default_str();
     sub->add_option("--bank-mb", precision_opts.bank_mb, "SRAM bank size in MB")
         ->capture_default_str();
-    sub->callback([&] { status = saarcor::run_precision(precision_opts); });
+    sub->add_option("--out-dir", precision_opts.out_dir,
+                    "write precision.png, report.json, stats.txt, config.json, command.txt, "
+                    "host.json into DIR");
+    sub->callback([&, out] {
+      precision_opts.out_given = out->count() > 0;
+      precision_opts.argv = command;
+      status = saarcor::run_precision(precision_opts);
+    });
   }
   saarcor::CompareOptions compare_opts;
   {

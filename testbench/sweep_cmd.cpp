@@ -1,16 +1,29 @@
 // `saarcor sweep`: the cycle model over a grid of configurations (testbench/sweep_cmd.h).
 #include "testbench/sweep_cmd.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cinttypes>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <functional>
+#include <future>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
+#include <thread>
+#include <tuple>
 
 #include "host/tree_settings.h"
 #include "testbench/compare.h"
 #include "testbench/cycle_render.h"
+#include "testbench/heartbeat.h"
 #include "testbench/image_io.h"
+#include "testbench/mpi_ranks.h"
+#include "testbench/run_dir.h"
 #include "units/cycle_params.h"
 
 namespace saarcor {
@@ -111,51 +124,179 @@ void check_sweep_point(const FrameResult& frame, const FrameResult& reference,
   }
 }
 
+std::pair<std::size_t, std::size_t> parse_shard(const std::string& text) {
+  const auto slash = text.find('/');
+  auto number = [](const std::string& t, std::size_t& out) {
+    if (t.empty() || t.size() > 4) return false;
+    for (char c : t)
+      if (c < '0' || c > '9') return false;
+    out = std::stoul(t);
+    return true;
+  };
+  std::size_t k = 0, n = 0;
+  if (slash == std::string::npos || !number(text.substr(0, slash), k) ||
+      !number(text.substr(slash + 1), n))
+    throw std::runtime_error("bad --shard '" + text + "': expected K/N, e.g. 2/8");
+  if (k < 1 || k > n || n > kMaxSweepPoints)
+    throw std::runtime_error("bad --shard '" + text +
+                             "': expected 1 <= K <= N <= " + std::to_string(kMaxSweepPoints));
+  return {k - 1, n};
+}
+
+namespace {
+
+// Runs task(0..n-1) on `jobs` threads. A task that throws stops the tasks after it (in index
+// order) from starting, the ones before it still run, and the exception of the lowest index is
+// rethrown: the error a serial run (jobs = 1) would give.
+void run_tasks(std::size_t n, int jobs, const std::function<void(std::size_t)>& task) {
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> first_error{n};
+  std::vector<std::exception_ptr> errors(n);
+  auto worker = [&] {
+    for (std::size_t i = next++; i < n; i = next++) {
+      if (i > first_error.load()) continue;
+      try {
+        task(i);
+      } catch (...) {
+        errors[i] = std::current_exception();
+        std::size_t e = first_error.load();
+        while (i < e && !first_error.compare_exchange_weak(e, i)) {
+        }
+      }
+    }
+  };
+  const int threads = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(jobs), n));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t)
+    pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool)
+    t.join();
+  if (first_error.load() < n) std::rethrow_exception(errors[first_error.load()]);
+}
+
+}  // namespace
+
 SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedScene& prepared,
-                             const RenderSettings& settings) {
+                             const RenderSettings& settings, const SweepRun& run) {
   SweepResult r;
   r.axes = axes;
+  r.shard = run.shard;
+  r.shards = run.shards;
   const std::vector<std::vector<std::string>> points = sweep_points(axes, settings.cycle);
+  r.total_points = points.size();
   // The image's format picks the pair: fp24 and the prototype's cycle model, or both in e7m23.
   const bool wide = prepared.built.params.format == ff::Format{7, 23};
   r.functional_model = wide ? "e7m23" : "fp24";
   const ModelSpec cycle = parse_model(wide ? "cycle-e7m23" : "cycle");
-  progress("functional " + r.functional_model + " model: the reference frame");
-  FrameResult reference = render_model(parse_model(r.functional_model), prepared, settings);
-  r.functional_rays = reference.rays;
-  // A point that varies kd.* keys has its own trees: its image is rebuilt, and its functional
-  // reference frame rendered on it (points in a row with the same trees share both).
-  std::optional<PreparedScene> rebuilt;
-  std::string trees_of_rebuilt;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::string where = join_words(points[i]);
-    progress("point " + std::to_string(i + 1) + " / " + std::to_string(points.size()) + ": " +
-             where);
-    RenderSettings s = settings;
-    s.cycle.set.insert(s.cycle.set.end(), points[i].begin(), points[i].end());
+  const ModelSpec functional = parse_model(r.functional_model);
+  const int jobs = std::max(1, run.jobs);
+
+  // Points are grouped by the trees they build: a point that varies kd.* keys has its own image
+  // and its own functional reference frame (points with the same trees share both). The group
+  // without kd.* keys reads `prepared`, and its reference gives functional_rays even when no
+  // point of this shard belongs to it. One group's image is alive at a time.
+  struct Group {
+    std::string trees;
+    std::vector<std::size_t> points;
+  };
+  std::vector<Group> groups = {{"", {}}};
+  for (std::size_t i = run.shard; i < points.size(); i += run.shards) {
     std::string trees;
     for (const std::string& kv : points[i])
       if (host::is_tree_setting(kv)) trees += kv + " ";
-    if (!trees.empty() && (!rebuilt || trees != trees_of_rebuilt)) {
-      if (!rebuilt) rebuilt = prepared;
-      build_prepared_image(*rebuilt, s, prepared.built.params.format);
-      trees_of_rebuilt = trees;
-      reference = render_model(parse_model(r.functional_model), *rebuilt, s);
-    } else if (trees.empty() && rebuilt) {
-      rebuilt.reset();
-      reference = render_model(parse_model(r.functional_model), prepared, settings);
+    auto g = std::ranges::find_if(groups, [&](const Group& x) { return x.trees == trees; });
+    if (g == groups.end()) {
+      groups.push_back({trees, {}});
+      g = groups.end() - 1;
     }
-    const FrameResult f = render_model(cycle, rebuilt ? *rebuilt : prepared, s);
-    check_sweep_point(f, reference, where);
-    SweepPoint p;
-    p.settings = points[i];
-    p.cycle = f.cycle;
-    const double first = r.points.empty() ? f.cycle["cycles"].get<double>()
-                                          : r.points.front().cycle["cycles"].get<double>();
-    p.speedup = first / f.cycle["cycles"].get<double>();
-    r.points.push_back(std::move(p));
+    g->points.push_back(i);
   }
+
+  Heartbeat beat("sweep", run.heartbeat && heartbeat_enabled());
+  std::atomic<std::size_t> done{0};
+  std::size_t selected = 0;
+  for (const Group& g : groups)
+    selected += g.points.size();
+  std::vector<SweepPoint> results;
+  for (const Group& g : groups) {
+    std::optional<PreparedScene> rebuilt;
+    RenderSettings group_settings = settings;
+    group_settings.heartbeat = false;  // the sweep's heartbeat counts points instead of packets
+    if (!g.trees.empty()) {
+      const std::vector<std::string>& first = points[g.points.front()];
+      group_settings.cycle.set.insert(group_settings.cycle.set.end(), first.begin(), first.end());
+      rebuilt = prepared;
+      build_prepared_image(*rebuilt, group_settings, prepared.built.params.format);
+    }
+    const PreparedScene& prep = rebuilt ? *rebuilt : prepared;
+    progress("functional " + r.functional_model + " model: the reference frame" +
+             (g.trees.empty() ? "" : " (" + g.trees.substr(0, g.trees.size() - 1) + ")"));
+    // Task 0 renders the reference; tasks 1.. the points, which wait for it only to compare.
+    std::promise<FrameResult> reference_promise;
+    std::shared_future<FrameResult> reference = reference_promise.get_future().share();
+    std::vector<SweepPoint> group_points(g.points.size());
+    run_tasks(g.points.size() + 1, jobs, [&](std::size_t task) {
+      if (task == 0) {
+        try {
+          reference_promise.set_value(render_model(functional, prep, group_settings));
+        } catch (...) {
+          reference_promise.set_exception(std::current_exception());
+          throw;
+        }
+        return;
+      }
+      const std::size_t i = g.points[task - 1];
+      RenderSettings s = settings;
+      s.heartbeat = group_settings.heartbeat;
+      s.cycle.set.insert(s.cycle.set.end(), points[i].begin(), points[i].end());
+      // Two frames per core would run slower than one: with several jobs each frame keeps its
+      // thread programs on its own worker thread (same results, docs/cycle-model.md).
+      if (jobs > 1 && s.cycle.host_threads == 0) s.cycle.host_threads = 1;
+      const FrameResult f = render_model(cycle, prep, s);
+      check_sweep_point(f, reference.get(), join_words(points[i]));
+      SweepPoint& p = group_points[task - 1];
+      p.index = i;
+      p.settings = points[i];
+      p.cycle = f.cycle;
+      beat.beat("points " + std::to_string(++done) + " / " + std::to_string(selected) +
+                (jobs > 1 ? ", " + std::to_string(jobs) + " at once" : ""));
+    });
+    if (g.trees.empty()) r.functional_rays = reference.get().rays;
+    for (SweepPoint& p : group_points)
+      results.push_back(std::move(p));
+  }
+  beat.finish();
+  std::ranges::sort(results, {}, &SweepPoint::index);
+  r.points = std::move(results);
+  set_speedups(r);
   return r;
+}
+
+void set_speedups(SweepResult& sweep) {
+  if (sweep.points.empty()) return;
+  const double first = sweep.points.front().cycle["cycles"].get<double>();
+  for (SweepPoint& p : sweep.points)
+    p.speedup = first / p.cycle["cycles"].get<double>();
+}
+
+nlohmann::json sweep_points_json(const SweepResult& sweep) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const SweepPoint& p : sweep.points)
+    a.push_back({{"index", p.index}, {"settings", p.settings}, {"cycle", p.cycle}});
+  return a;
+}
+
+std::vector<SweepPoint> sweep_points_from_json(const nlohmann::json& j) {
+  std::vector<SweepPoint> points;
+  for (const nlohmann::json& e : j) {
+    SweepPoint p;
+    p.index = e.at("index").get<std::size_t>();
+    p.settings = e.at("settings").get<std::vector<std::string>>();
+    p.cycle = e.at("cycle");
+    points.push_back(std::move(p));
+  }
+  return points;
 }
 
 namespace {
@@ -246,7 +387,8 @@ std::string sweep_table(const SweepResult& sweep) {
 }
 
 std::string sweep_csv(const SweepResult& sweep) {
-  std::string s;
+  const bool shard = sweep.shards > 1;
+  std::string s = shard ? "point,points," : "";
   for (const SweepAxis& a : sweep.axes) {
     s += a.key + ",";
   }
@@ -255,6 +397,7 @@ std::string sweep_csv(const SweepResult& sweep) {
   }
   char buf[64];
   for (const SweepPoint& p : sweep.points) {
+    if (shard) s += std::to_string(p.index) + "," + std::to_string(sweep.total_points) + ",";
     for (const std::string& v : point_values(p)) {
       s += v + ",";
     }
@@ -281,9 +424,14 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
   j["functional_model"] = sweep.functional_model;
   j["bit_identical_to_functional_model"] = true;  // run_sweep_points throws otherwise
   j["functional_rays"] = sweep.functional_rays;
+  if (sweep.shards > 1) {
+    j["shard"] = std::to_string(sweep.shard + 1) + "/" + std::to_string(sweep.shards);
+    j["total_points"] = sweep.total_points;
+  }
   nlohmann::json points = nlohmann::json::array();
   for (const SweepPoint& p : sweep.points) {
     nlohmann::json e;
+    if (sweep.shards > 1) e["index"] = p.index;
     const std::vector<std::string> v = point_values(p);
     for (std::size_t a = 0; a < v.size(); ++a) {
       e["values"][sweep.axes[a].key] = v[a];
@@ -296,43 +444,273 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
   return j;
 }
 
+namespace {
+
+// A CSV's lines and cells (the sweep's own CSVs: no quoting, one row a line).
+std::vector<std::vector<std::string>> csv_cells(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::size_t from = 0;
+  while (from < text.size()) {
+    std::size_t eol = text.find('\n', from);
+    if (eol == std::string::npos) eol = text.size();
+    std::vector<std::string> cells;
+    std::size_t c = from;
+    while (true) {
+      const std::size_t comma = text.find(',', c);
+      if (comma == std::string::npos || comma >= eol) {
+        cells.push_back(text.substr(c, eol - c));
+        break;
+      }
+      cells.push_back(text.substr(c, comma - c));
+      c = comma + 1;
+    }
+    rows.push_back(std::move(cells));
+    from = eol + 1;
+  }
+  return rows;
+}
+
+std::string csv_line(const std::vector<std::string>& cells, std::size_t from) {
+  std::string s;
+  for (std::size_t i = from; i < cells.size(); ++i)
+    s += cells[i] + (i + 1 == cells.size() ? "\n" : ",");
+  return s;
+}
+
+// --out-dir for a sweep: the CSV, the report without host timing (host.json has it), each point's
+// resolved configuration (config.json), each point's statistics as one block (stats.txt) and the
+// command line.
+void write_sweep_dir(const SweepOptions& opts, const SweepResult& sweep, const RenderSettings& rs,
+                     int jobs, int ranks) {
+  nlohmann::json report = sweep_json(sweep, opts);
+  nlohmann::json host;
+  host["jobs"] = jobs;
+  host["mpi_ranks"] = ranks;
+  nlohmann::json config;
+  config["scene"] = opts.scene;
+  config["model"] = opts.model;
+  config["resolution"] = opts.res;
+  config["time"] = rs.time;
+  config["shadows"] = rs.shadows;
+  config["depth"] = rs.depth;
+  config["bank_mb"] = rs.bank_mb;
+  config["preset"] = opts.preset;
+  config["set"] = opts.set;
+  for (const SweepAxis& a : sweep.axes)
+    config["vary"].push_back({{"key", a.key}, {"values", a.values}});
+  if (sweep.shards > 1) config["shard"] = report["shard"];
+  std::vector<std::pair<std::string, std::vector<StatLine>>> blocks;
+  for (std::size_t i = 0; i < sweep.points.size(); ++i) {
+    nlohmann::json& point = report["points"][i];
+    host["points"].push_back(
+        {{"values", point["values"]}, {"host", take_cycle_host(point["report"])}});
+    config["points"].push_back(
+        {{"values", point["values"]}, {"configuration", point["report"]["configuration"]}});
+    std::vector<StatLine> lines;
+    append_cycle_stats(lines, sweep.points[i].cycle);
+    blocks.push_back({"point " + std::to_string(sweep.points[i].index + 1) + " of " +
+                          std::to_string(sweep.total_points) + ": " +
+                          join_words(sweep.points[i].settings),
+                      std::move(lines)});
+  }
+  write_text_file(run_file(opts.out_dir, "sweep.csv"), sweep_csv(sweep));
+  write_text_file(run_file(opts.out_dir, "report.json"), report.dump(2) + "\n");
+  write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text_blocks(blocks));
+  write_text_file(run_file(opts.out_dir, "config.json"), config.dump(2) + "\n");
+  write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
+  write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
+}
+
+}  // namespace
+
+std::string merge_sweep_csv(const std::vector<std::pair<std::string, std::string>>& parts) {
+  if (parts.empty()) throw std::runtime_error("sweep-merge needs at least one shard CSV");
+  std::vector<std::string> header;
+  std::size_t total = 0;
+  std::vector<std::optional<std::vector<std::string>>> rows;
+  for (const auto& [name, text] : parts) {
+    const auto cells = csv_cells(text);
+    if (cells.empty() || cells[0].size() < 3 || cells[0][0] != "point" || cells[0][1] != "points")
+      throw std::runtime_error(name +
+                               ": not a shard CSV (saarcor sweep --shard K/N): its header "
+                               "does not start with point,points");
+    if (header.empty()) {
+      header = cells[0];
+    } else if (cells[0] != header) {
+      throw std::runtime_error(name + ": its columns differ from " + parts.front().first + "'s");
+    }
+    for (std::size_t r = 1; r < cells.size(); ++r) {
+      const std::vector<std::string>& row = cells[r];
+      if (row.size() != header.size())
+        throw std::runtime_error(name + ": line " + std::to_string(r + 1) + " has " +
+                                 std::to_string(row.size()) + " cells, the header " +
+                                 std::to_string(header.size()));
+      const std::size_t index = std::stoul(row[0]), points = std::stoul(row[1]);
+      if (total == 0) {
+        total = points;
+        rows.resize(total);
+      }
+      if (points != total || index >= total)
+        throw std::runtime_error(name + ": line " + std::to_string(r + 1) + ": point " + row[0] +
+                                 " of " + row[1] + " in a sweep of " + std::to_string(total) +
+                                 " points");
+      if (rows[index])
+        throw std::runtime_error(name + ": point " + row[0] + " is in two shard files");
+      rows[index] = row;
+    }
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (!rows[i])
+      throw std::runtime_error("sweep-merge: point " + std::to_string(i) + " of " +
+                               std::to_string(total) +
+                               " is in none of the files (a shard missing)");
+  if (rows.empty()) throw std::runtime_error("sweep-merge: the shard files hold no rows");
+  // The speed-up column is over point 0 of the whole sweep: recomputed from the exact cycles.
+  const auto col = [&](const char* name) {
+    return static_cast<std::size_t>(std::ranges::find(header, name) - header.begin());
+  };
+  const std::size_t cycles = col("cycles"), speedup = col("speedup");
+  if (cycles == header.size() || speedup == header.size())
+    throw std::runtime_error(parts.front().first + ": no cycles or speedup column");
+  const double first = std::strtod((*rows[0])[cycles].c_str(), nullptr);
+  std::string out = csv_line(header, 2);
+  char buf[64];
+  for (auto& row : rows) {
+    std::snprintf(buf, sizeof buf, "%.17g", first / std::strtod((*row)[cycles].c_str(), nullptr));
+    (*row)[speedup] = buf;
+    out += csv_line(*row, 2);
+  }
+  return out;
+}
+
+int run_sweep_merge(const SweepMergeOptions& opts) {
+  if (opts.out.empty() || !opts.out.ends_with(".csv"))
+    throw std::runtime_error("bad -o '" + opts.out + "': expected a .csv file name");
+  std::vector<std::pair<std::string, std::string>> parts;
+  for (const std::string& p : opts.parts) {
+    require_readable_file(p);
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    parts.push_back({p, ss.str()});
+  }
+  const std::string merged = merge_sweep_csv(parts);
+  write_text_file(opts.out, merged);
+  std::printf("saarcor sweep-merge: %zu shard files, %zu points -> %s\n", parts.size(),
+              static_cast<std::size_t>(std::count(merged.begin(), merged.end(), '\n') - 1),
+              opts.out.c_str());
+  return 0;
+}
+
 int run_sweep(const SweepOptions& opts) {
-  RenderSettings settings =
-      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
-  settings.cycle.preset = opts.preset;
-  settings.cycle.set = opts.set;
-  settings.cycle.host_threads = opts.host_threads;
-  const ModelSpec model = parse_model(opts.model);
-  if (model.kind != ModelKind::kCycle) {
-    throw std::runtime_error("bad --model " + opts.model + ": a sweep runs cycle or cycle-e7m23");
+  // Under mpirun every rank runs this; rank 0 gathers and alone prints and writes. Every failure
+  // of any rank, bad input included, reaches rank 0 as text, so no rank waits for a dead one and
+  // the error is printed once.
+  MpiRanks ranks;
+  std::string error;
+  SweepResult sweep;
+  RenderSettings settings;
+  std::size_t count = 0;
+  int jobs = opts.jobs;
+  try {
+    settings = frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
+    settings.cycle.preset = opts.preset;
+    settings.cycle.set = opts.set;
+    settings.cycle.host_threads = opts.host_threads;
+    const ModelSpec model = parse_model(opts.model);
+    if (model.kind != ModelKind::kCycle) {
+      throw std::runtime_error("bad --model " + opts.model + ": a sweep runs cycle or cycle-e7m23");
+    }
+    std::vector<SweepAxis> axes;
+    for (const std::string& v : opts.vary) {
+      axes.push_back(parse_sweep_axis(v));
+    }
+    // Every bad input fails here, before the scene loads and before any frame runs.
+    count = sweep_points(axes, settings.cycle).size();
+    if (!opts.report.empty() && !opts.report.ends_with(".json")) {
+      throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
+    }
+    if (!opts.csv.empty() && !opts.csv.ends_with(".csv")) {
+      throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
+    }
+    if (!opts.out_dir.empty()) {
+      check_out_dir(opts.out_dir);
+      if (!opts.csv.empty() || !opts.report.empty())
+        throw std::runtime_error(
+            "--out-dir names every file it writes (sweep.csv, report.json): drop --csv and "
+            "--report");
+    }
+    if (jobs < 0) throw std::runtime_error("bad --jobs " + std::to_string(jobs) + ": 1 or more");
+    SweepRun run;
+    if (!opts.shard.empty()) std::tie(run.shard, run.shards) = parse_shard(opts.shard);
+    if (ranks.size() > 1) {
+      if (!opts.shard.empty())
+        throw std::runtime_error("--shard and mpirun both split the sweep: give one of them");
+      run.shard = static_cast<std::size_t>(ranks.rank());
+      run.shards = static_cast<std::size_t>(ranks.size());
+    }
+    if (jobs == 0) {
+      // The host's cores, shared by the ranks on it.
+      const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+      jobs = std::max(1, cores / ranks.local_size());
+    }
+    run.jobs = jobs;
+    run.heartbeat = ranks.rank() == 0;
+    const PreparedScene prep = prepare_scene(opts.scene, settings, ff::Format{7, model.mantissa});
+    sweep = run_sweep_points(axes, prep, settings, run);
+  } catch (const std::exception& e) {
+    error = e.what();
   }
-  std::vector<SweepAxis> axes;
-  for (const std::string& v : opts.vary) {
-    axes.push_back(parse_sweep_axis(v));
+  if (ranks.size() > 1) {
+    nlohmann::json mine;
+    if (!error.empty()) {
+      mine["error"] = error;
+    } else {
+      mine["points"] = sweep_points_json(sweep);
+    }
+    const std::vector<std::string> all = ranks.gather(mine.dump());
+    if (ranks.rank() != 0) return error.empty() ? 0 : 1;
+    // The first failing rank's error; otherwise every rank's points, in sweep order.
+    std::vector<SweepPoint> points;
+    for (std::size_t r = 0; r < all.size() && error.empty(); ++r) {
+      const nlohmann::json j = nlohmann::json::parse(all[r]);
+      if (j.contains("error")) {
+        error = j["error"].get<std::string>();
+        break;
+      }
+      for (SweepPoint& p : sweep_points_from_json(j["points"]))
+        points.push_back(std::move(p));
+    }
+    if (error.empty()) {
+      std::ranges::sort(points, {}, &SweepPoint::index);
+      sweep.points = std::move(points);
+      sweep.shard = 0;
+      sweep.shards = 1;
+      set_speedups(sweep);
+    }
   }
-  // Every bad input fails here, before the scene loads and before any frame runs.
-  const std::size_t count = sweep_points(axes, settings.cycle).size();
-  if (!opts.report.empty() && !opts.report.ends_with(".json")) {
-    throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
-  }
-  if (!opts.csv.empty() && !opts.csv.ends_with(".csv")) {
-    throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
-  }
+  if (!error.empty()) throw std::runtime_error(error);
 
-  const PreparedScene prep = prepare_scene(opts.scene, settings, ff::Format{7, model.mantissa});
-  const SweepResult sweep = run_sweep_points(axes, prep, settings);
-
+  if (!opts.out_dir.empty()) write_sweep_dir(opts, sweep, settings, jobs, ranks.size());
   if (!opts.report.empty()) {
     write_text_file(opts.report, sweep_json(sweep, opts).dump(2) + "\n");
   }
   if (!opts.csv.empty()) {
     write_text_file(opts.csv, sweep_csv(sweep));
   }
+  const std::string shard =
+      sweep.shards > 1 ? ", shard " + opts.shard + ": " + std::to_string(sweep.points.size()) : "";
   std::printf(
-      "saarcor sweep: %s, model %s, %dx%d, %zu points, every one bit-identical to the functional "
-      "%s model (hit records and image, %" PRIu64 " rays)\n",
+      "saarcor sweep: %s, model %s, %dx%d, %zu points%s, every one bit-identical to the "
+      "functional %s model (hit records and image, %" PRIu64 " rays)\n",
       opts.scene.c_str(), opts.model.c_str(), settings.res.width, settings.res.height, count,
-      sweep.functional_model.c_str(), sweep.functional_rays);
+      shard.c_str(), sweep.functional_model.c_str(), sweep.functional_rays);
+  if (!opts.out_dir.empty()) {
+    std::printf(
+        "  run folder: %s (sweep.csv, report.json, stats.txt, config.json, command.txt, "
+        "host.json)\n",
+        opts.out_dir.c_str());
+  }
   if (!opts.report.empty()) {
     std::printf("  report:    %s\n", opts.report.c_str());
   }

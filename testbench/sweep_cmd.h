@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "testbench/render_cmd.h"
@@ -46,11 +47,20 @@ struct SweepOptions {
   int host_threads = 0;
   std::string report;  // JSON path, optional
   std::string csv;     // CSV path, optional
+  // Frames at once on this host (worker threads); 0 = the hardware's cores (under MPI: the cores
+  // over the ranks on this host). The rows are the same for every count.
+  int jobs = 0;
+  std::string shard;  // "K/N": only the points of shard K of N (1 <= K <= N), for array jobs
+  // --out-dir DIR (testbench/run_dir.h): sweep.csv, report.json, stats.txt, config.json,
+  // command.txt, host.json; --csv and --report are refused with it.
+  std::string out_dir;
+  std::vector<std::string> argv;  // the command line, for command.txt
 };
 
 // (bugprone-exception-escape: nlohmann::json's default constructor is not declared noexcept; a
 // null json allocates nothing.)
 struct SweepPoint {                   // NOLINT(bugprone-exception-escape)
+  std::size_t index = 0;              // the point's place in the whole sweep (0-based)
   std::vector<std::string> settings;  // the KEY=VALUE the point adds
   nlohmann::json cycle;               // the frame's cycle report (cycle_report_json)
   double speedup = 1.0;               // the first point's cycles over this point's
@@ -60,19 +70,59 @@ struct SweepResult {
   std::vector<SweepPoint> points;
   std::string functional_model;       // the reference: "fp24", or "e7m23" for cycle-e7m23
   std::uint64_t functional_rays = 0;  // its frame's rays
+  // A shard holds every `shards`-th point from `shard` on (points i with i % shards == shard) of
+  // the sweep's `total_points`; its CSV starts with the columns point and points, which
+  // merge_sweep_csv needs. One shard of one is the whole sweep.
+  std::size_t shard = 0;
+  std::size_t shards = 1;
+  std::size_t total_points = 0;
 };
+
+// How run_sweep_points runs: `jobs` frames at once, the points of one shard.
+struct SweepRun {
+  int jobs = 1;
+  std::size_t shard = 0;
+  std::size_t shards = 1;
+  bool heartbeat = true;  // points done / total on the terminal (testbench/heartbeat.h)
+};
+// "K/N" with 1 <= K <= N <= kMaxSweepPoints -> {K - 1, N}; throws "bad --shard 'TEXT': ...".
+std::pair<std::size_t, std::size_t> parse_shard(const std::string& text);
 
 // Throws "sweep point WHERE: ..." unless the cycle model's frame has the reference's hit records
 // (every bit), image and ray count.
 void check_sweep_point(const FrameResult& frame, const FrameResult& reference,
                        const std::string& where);
 
-// Runs every point; throws naming the first point whose hit records or image differ from the
-// functional fp24 model's.
+// Runs every point of the run's shard, `run.jobs` frames at once (the model keeps no global state:
+// each frame owns its kernel, units and caches and reads the shared memory image). With jobs > 1
+// each frame's thread programs run on its worker's thread (--host-threads 1) unless --host-threads
+// says otherwise. The points come back in sweep order whatever finishes first; throws naming the
+// first point (in sweep order) whose hit records or image differ from the functional fp24
+// model's, as a serial run would.
 SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedScene& prepared,
-                             const RenderSettings& settings);
+                             const RenderSettings& settings, const SweepRun& run = {});
+// Every point's speed-up over the first point held (the sweep's first point in a whole sweep).
+void set_speedups(SweepResult& sweep);
 
-// The printed table, the CSV text and the JSON report of a sweep.
+// The points of a result as JSON ({"index", "settings", "cycle"} each) and back: what MPI ranks
+// send rank 0 (doubles survive the round trip bit for bit).
+nlohmann::json sweep_points_json(const SweepResult& sweep);
+std::vector<SweepPoint> sweep_points_from_json(const nlohmann::json& j);
+
+// Shard CSVs (named for the messages) -> the CSV of the whole sweep, byte for byte the one a
+// single process writes: rows in point order, speed-ups over point 0 recomputed from the cycles.
+// Throws naming the file on a header that differs, a file that is not a shard CSV, or a point
+// missing or given twice.
+std::string merge_sweep_csv(const std::vector<std::pair<std::string, std::string>>& shard_csvs);
+
+struct SweepMergeOptions {
+  std::vector<std::string> parts;  // shard CSVs
+  std::string out;                 // the merged CSV
+};
+int run_sweep_merge(const SweepMergeOptions& opts);
+
+// The printed table, the CSV text (a shard's with the columns point and points first) and the
+// JSON report of a sweep.
 std::string sweep_table(const SweepResult& sweep);
 std::string sweep_csv(const SweepResult& sweep);
 nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts);

@@ -270,5 +270,118 @@ TEST(SaarcorBinary, SweepEndToEndAndBadInput) {
   EXPECT_FALSE(fs::exists(csv));
 }
 
+// --jobs: the same rows in the same order as one job, whatever finishes first; the kd.* groups
+// (own image, own reference) too, and a failing point is named as a serial run names it.
+TEST(SweepParallel, JobsGiveTheSerialRows) {
+  RenderSettings s;
+  s.res = {64, 48};
+  const std::vector<SweepAxis> axes = {parse_sweep_axis("threads=1,4,16"),
+                                       parse_sweep_axis("packet=1,4")};
+  SweepRun serial;
+  serial.jobs = 1;
+  SweepRun parallel;
+  parallel.jobs = 3;
+  const SweepResult a = run_sweep_points(axes, room(), s, serial);
+  const SweepResult b = run_sweep_points(axes, room(), s, parallel);
+  ASSERT_EQ(b.points.size(), 6u);
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    EXPECT_EQ(b.points[i].index, i);
+    EXPECT_EQ(b.points[i].settings, a.points[i].settings);
+    EXPECT_EQ(b.points[i].cycle["cycles"], a.points[i].cycle["cycles"]);
+  }
+  EXPECT_EQ(sweep_csv(b), sweep_csv(a));
+  EXPECT_EQ(b.functional_rays, 64u * 48u);
+
+  const std::vector<SweepAxis> trees = {parse_sweep_axis("threads=8,32"),
+                                        parse_sweep_axis("kd.traversal_cost=10,60")};
+  EXPECT_EQ(sweep_csv(run_sweep_points(trees, room(), s, parallel)),
+            sweep_csv(run_sweep_points(trees, room(), s, serial)));
+}
+
+TEST(SweepParallel, ShardsMergeIntoTheWholeSweepsCsv) {
+  RenderSettings s;
+  s.res = {32, 24};
+  const std::vector<SweepAxis> axes = {parse_sweep_axis("threads=2,8,32"),
+                                       parse_sweep_axis("packet=4,16")};
+  const std::string whole = sweep_csv(run_sweep_points(axes, room(), s));
+  std::vector<std::pair<std::string, std::string>> parts;
+  for (std::size_t k = 0; k < 4; ++k) {
+    SweepRun run;
+    run.shard = k;
+    run.shards = 4;
+    const SweepResult shard = run_sweep_points(axes, room(), s, run);
+    // Shard k of 4 holds points k, k + 4, ...: 6 points give 2, 2, 1, 1.
+    ASSERT_EQ(shard.points.size(), k < 2 ? 2u : 1u);
+    EXPECT_EQ(shard.points[0].index, k);
+    parts.push_back({"part" + std::to_string(k) + ".csv", sweep_csv(shard)});
+  }
+  EXPECT_EQ(parts[1].second.substr(0, parts[1].second.find('\n')),
+            "point,points,threads,packet,cycles,fps,mrays_per_s,speedup,usage_traversal,"
+            "usage_list,usage_transformation,usage_intersection,cache_hit_traversal,"
+            "cache_hit_list,cache_hit_transformation,bandwidth_mb_s_total,cycles_per_packet,"
+            "simd_efficiency");
+  EXPECT_EQ(parts[1].second.substr(parts[1].second.find('\n') + 1, 6), "1,6,2,");
+  // In any order of the files: the bytes of the one-process CSV (speed-ups over point 0 again).
+  std::swap(parts[0], parts[3]);
+  EXPECT_EQ(merge_sweep_csv(parts), whole);
+
+  auto without = parts;
+  without.pop_back();
+  EXPECT_EQ(error_of([&] { merge_sweep_csv(without); }),
+            "sweep-merge: point 0 of 6 is in none of the files (a shard missing)");
+  auto twice = parts;
+  twice.push_back({"again.csv", parts[1].second});
+  EXPECT_EQ(error_of([&] { merge_sweep_csv(twice); }), "again.csv: point 1 is in two shard files");
+  EXPECT_EQ(error_of([&] {
+              merge_sweep_csv({{"whole.csv", whole}});
+            }),
+            "whole.csv: not a shard CSV (saarcor sweep --shard K/N): its header does not start "
+            "with point,points");
+}
+
+TEST(SweepParallel, ShardGrammar) {
+  EXPECT_EQ(parse_shard("1/1"), (std::pair<std::size_t, std::size_t>{0, 1}));
+  EXPECT_EQ(parse_shard("3/8"), (std::pair<std::size_t, std::size_t>{2, 8}));
+  EXPECT_EQ(error_of([] { parse_shard("0/4"); }), "bad --shard '0/4': expected 1 <= K <= N <= 256");
+  EXPECT_EQ(error_of([] { parse_shard("5/4"); }), "bad --shard '5/4': expected 1 <= K <= N <= 256");
+  EXPECT_EQ(error_of([] { parse_shard("2"); }), "bad --shard '2': expected K/N, e.g. 2/8");
+  EXPECT_EQ(error_of([] { parse_shard("a/b"); }), "bad --shard 'a/b': expected K/N, e.g. 2/8");
+}
+
+TEST(SaarcorBinary, SweepShardsAndMergeEndToEnd) {
+  const fs::path d = test_support::scratch_dir("sweep_shard");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string args = "sweep builtin:cube --res 16x12 --vary threads=1,2,4 --jobs 2";
+  ASSERT_EQ(test_support::run_saarcor(args + " --csv " + (d / "whole.csv").string()).status, 0);
+  for (int k = 1; k <= 2; ++k) {
+    const test_support::CliRun r =
+        test_support::run_saarcor(args + " --shard " + std::to_string(k) + "/2 --csv " +
+                                  (d / ("part" + std::to_string(k) + ".csv")).string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("3 points, shard " + std::to_string(k) + "/2: " + (k == 1 ? "2" : "1")),
+              std::string::npos)
+        << r.out;
+  }
+  const test_support::CliRun m =
+      test_support::run_saarcor("sweep-merge " + (d / "part2.csv").string() + " " +
+                                (d / "part1.csv").string() + " -o " + (d / "merged.csv").string());
+  ASSERT_EQ(m.status, 0) << m.err;
+  EXPECT_NE(m.out.find("2 shard files, 3 points"), std::string::npos) << m.out;
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(slurp(d / "merged.csv"), slurp(d / "whole.csv"));
+  test_support::expect_one_line_error(test_support::run_saarcor(args + " --shard 3/2"),
+                                      "bad --shard '3/2'");
+  test_support::expect_one_line_error(
+      test_support::run_saarcor("sweep-merge " + (d / "whole.csv").string() + " -o " +
+                                (d / "x.csv").string()),
+      "not a shard CSV");
+}
+
 }  // namespace
 }  // namespace saarcor
