@@ -84,7 +84,9 @@ INSTANTIATE_TEST_SUITE_P(Scenes, RtlUnitsOnModels,
                                            "DamagedHelmet/DamagedHelmet.gltf",
                                            "2CylinderEngine/2CylinderEngine.gltf",
                                            "SpheresScaledInstances/spheres_scaled_instances.gltf",
-                                           "BoxAnimated/BoxAnimated.gltf"),
+                                           "BoxAnimated/BoxAnimated.gltf",
+                                           "RiggedSimple/RiggedSimple.gltf",
+                                           "CesiumMan/CesiumMan.gltf"),
                          [](const ::testing::TestParamInfo<const char*>& i) {
                            std::string n = i.param;
                            return n.substr(0, n.find('/'));
@@ -163,10 +165,13 @@ TEST(RtlUnits, AcceptanceIsTheDatapathsRule) {
   EXPECT_LT(static_cast<std::size_t>(accepted), inputs.size() / 2);
 }
 
-// saarcor-rtl check: exit 0 on a file the RTL reproduces, 2 with the differing line listed when
-// an output is changed, 1 for a malformed file; --out writes the RTL's outputs.
+// saarcor-rtl check on a scene no other RTL test uses: exit 0 on a file the RTL reproduces, 2
+// with the differing line listed when an output is changed, 1 for a malformed file; --out writes
+// the RTL's outputs.
 TEST(RtlUnits, SaarcorRtlCheck) {
-  const std::string path = generate("builtin:room", VectorUnit::kTransformation, 300);
+  const std::string path =
+      generate(std::string(SAARCOR_SHARED_SCENES) + "/AnimatedCube/AnimatedCube.gltf",
+               VectorUnit::kTransformation, 300);
   const std::string bin = std::string(SAARCOR_BIN_DIR) + "/saarcor-rtl";
   const std::string out = temp_path("check_out.txt");
   auto run = [&](const std::string& file, std::string* output) {
