@@ -29,7 +29,8 @@ add_subdirectory(host)
 add_library(saarcor_fuzz_units STATIC
   ${PROJECT_SOURCE_DIR}/units/cycle_params.cpp
   ${PROJECT_SOURCE_DIR}/units/unit_vectors.cpp
-  ${PROJECT_SOURCE_DIR}/units/functional_model.cpp)
+  ${PROJECT_SOURCE_DIR}/units/functional_model.cpp
+  ${PROJECT_SOURCE_DIR}/units/request_trace.cpp)
 target_include_directories(saarcor_fuzz_units PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(saarcor_fuzz_units PUBLIC saarcor::memif saarcor::fixedfloat
   PRIVATE saarcor_warnings)
