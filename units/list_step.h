@@ -4,7 +4,7 @@
 // ray" (and, with triangle_mailbox > 0, triangles). An entry some ray still needs goes to the
 // transformation unit (path d); the end of the list returns the packet to the traversal unit.
 // Timing: units/list_unit.cpp (depth: the mailbox compare); exact-cycle test:
-// units/unit_timing_test.cpp (ListUnit*).
+// units/unit_timing_test.cpp (UnitTimingList.*).
 #pragma once
 
 #include <cstdint>

@@ -4,7 +4,7 @@
 // triangle's T_delta. A ray transformation takes n+1 steps for a packet with one origin, 2n
 // otherwise, whatever the mask (D30: a masked lane fires and its result is discarded). Timing:
 // units/transformation.cpp (depth: fp mul + two adds); exact-cycle test:
-// units/unit_timing_test.cpp (TransformationUnit*).
+// units/unit_timing_test.cpp (UnitTimingTransformation.*).
 #pragma once
 
 #include <cstdint>

@@ -3,7 +3,7 @@
 // the sign groups, one kd-node step per request (early termination at node entry, near and far
 // child, the push of the far child), the stack shared by both levels with its drops at the pop,
 // and the end of a level. Its timing (node fetch, chain rule, pipeline depth: fp add + div + cmp)
-// is units/traversal.cpp; its exact-cycle test units/unit_timing_test.cpp (TraversalUnit*).
+// is units/traversal.cpp; its exact-cycle test units/unit_timing_test.cpp (UnitTimingTraversal.*).
 // The steps take the binary64 paths of units/fast_paths.h where they decide and redo a lane on
 // encodings (units/datapath.h) where they do not.
 #pragma once
