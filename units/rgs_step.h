@@ -6,7 +6,8 @@
 // transformation unit and the cosines on the RGS FP helper (mul, sqrt, div), specular highlights,
 // then reflection and transparency children, traced last in, first out. Dot products and normals
 // run on the transformation unit and are counted there. Timing: units/ray_source.cpp (the RGC's
-// admission and the final hits); exact-cycle test: units/unit_timing_test.cpp (UnitTimingRaySource.*).
+// admission and the final hits); exact-cycle test: units/unit_timing_test.cpp
+// (UnitTimingRaySource.*).
 #pragma once
 
 #include <algorithm>
