@@ -93,12 +93,7 @@ inline FunctionalParams shading_of(const Config& c) {
 }
 
 inline FunctionalParams functional_of(const Config& c, const CycleParams& p) {
-  FunctionalParams f = shading_of(c);
-  f.packet = p.packet;
-  f.stack_depth = p.stack;
-  f.mailbox = p.mailbox;
-  f.shared_origin = p.shared_origin;
-  return f;
+  return functional_params(p, shading_of(c));
 }
 
 inline bool same_record(const FrameSink::Pixel& a, const FrameSink::Pixel& b) {

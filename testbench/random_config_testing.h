@@ -154,21 +154,6 @@ inline RandomConfig random_config(std::uint64_t seed, const std::vector<StressSc
   return c;
 }
 
-// The functional model run with the thread-program parameters the cycle model gives its threads
-// (units/dynrtp.cpp run_cycle_format): the per-ray counters then match too, not only the hits.
-inline units::FunctionalParams functional_like(const units::CycleParams& p,
-                                               units::FunctionalParams shading) {
-  shading.packet = p.packet;
-  shading.stack_depth = p.stack;
-  shading.mailbox = p.mailbox;
-  shading.triangle_mailbox = p.triangle_mailbox;
-  shading.clip_exit_only = p.clip_exit_only;
-  shading.skip_empty = p.skip_empty;
-  shading.clip_faces_per_step = p.clip_faces_per_step;
-  shading.shared_origin = p.shared_origin;
-  return shading;
-}
-
 struct StressTotals {
   std::uint64_t configs = 0, rays = 0, cycles = 0;
   double seconds = 0.0;
@@ -210,7 +195,7 @@ class StressRunner {
       return;
     }
     const units::FunctionalFrame fn =
-        units::run_functional(prep.built.image, functional_like(cy.params, shading));
+        units::run_functional(prep.built.image, units::functional_params(cy.params, shading));
     expect_same_frame(cy, fn);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -98,9 +98,8 @@ std::string functional_trace(const memif::MemoryImage& image, units::FunctionalP
   units::CycleParams p = units::prototype_params();
   for (const std::string& kv : set)
     units::apply_cycle_setting(p, kv);
-  fp.packet = p.packet;
   std::ostringstream out;
-  units::run_functional<ff::fp24>(image, fp, {}, nullptr, &out);
+  units::run_functional<ff::fp24>(image, units::functional_params(p, fp), {}, nullptr, &out);
   return out.str();
 }
 

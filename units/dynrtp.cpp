@@ -237,20 +237,6 @@ std::string thread_report(RecordedThreads<F, kLanes>& threads, const CycleParams
   return s.str();
 }
 
-// The functional parameters every thread program of a cycle-model run gets.
-FunctionalParams functional_params(const CycleParams& p, const CycleRunOptions& opt) {
-  FunctionalParams fp = opt.shading;
-  fp.packet = p.packet;
-  fp.stack_depth = p.stack;
-  fp.mailbox = p.mailbox;
-  fp.triangle_mailbox = p.triangle_mailbox;
-  fp.clip_exit_only = p.clip_exit_only;
-  fp.skip_empty = p.skip_empty;
-  fp.clip_faces_per_step = p.clip_faces_per_step;
-  fp.shared_origin = p.shared_origin;
-  return fp;
-}
-
 // Runs the kernel until the chip has retired every packet, sampling the figures every
 // opt.interval cycles into out.series and reporting progress.
 template <class F, int kLanes>
@@ -342,8 +328,9 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
     throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
                              std::to_string(opt.ahead_packets) + ")");
-  RecordedThreads<F, kLanes> threads(image, functional_params(p, opt), p.pipelines * p.threads,
-                                     opt.programs, opt.ahead_packets, opt.trace);
+  RecordedThreads<F, kLanes> threads(image, functional_params(p, opt.shading),
+                                     p.pipelines * p.threads, opt.programs, opt.ahead_packets,
+                                     opt.trace);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   kc.shuffle_seed = opt.shuffle_seed;
@@ -386,6 +373,18 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
 }
 
 }  // namespace
+
+FunctionalParams functional_params(const CycleParams& p, FunctionalParams shading) {
+  shading.packet = p.packet;
+  shading.stack_depth = p.stack;
+  shading.mailbox = p.mailbox;
+  shading.triangle_mailbox = p.triangle_mailbox;
+  shading.clip_exit_only = p.clip_exit_only;
+  shading.skip_empty = p.skip_empty;
+  shading.clip_faces_per_step = p.clip_faces_per_step;
+  shading.shared_origin = p.shared_origin;
+  return shading;
+}
 
 // The CycleParams as the memory system's parameters (every memif knob of the table).
 memif::MemorySystemConfig memory_system_config(const CycleParams& p) {

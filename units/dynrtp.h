@@ -98,6 +98,11 @@ struct CycleFrame {
 // Renders the image's frame: an fp24 image (the prototype), or e7m23 (the same units 31 bits wide,
 // for the width study). Throws std::runtime_error for a bad configuration or image, and when the
 // watchdog fires (the message names every thread and where it waits).
+// The functional parameters a thread program of a cycle-model run with `p` gets: `shading`'s
+// RGS settings with the packet, stack, mailboxes, clip and traversal rules of `p`. The functional
+// model run with them is the cycle model's bit-exact reference.
+FunctionalParams functional_params(const CycleParams& p, FunctionalParams shading = {});
+
 CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
                      const CycleRunOptions& options = {});
 
