@@ -16,6 +16,9 @@
 #include <string>
 #include <system_error>
 
+#include "host/image_builder.h"
+#include "host/scene.h"
+
 namespace saarcor::fuzz {
 
 // A finding the sanitizers cannot see (a broken promise of the code under test): printed, then
@@ -114,5 +117,31 @@ class ScratchDir {
 
   std::filesystem::path dir_;
 };
+
+// What `saarcor` does with a scene file, for the loader harnesses: load it (load_scene), evaluate
+// its animation at the middle, and for scenes up to 20,000 triangle slots after instancing (a few
+// milliseconds each in the instrumented build) build the memory image with 1 MB banks (larger
+// scenes take the "does not fit" error path) and decode it: a built image is the contract with
+// the hardware, so decoding it must succeed.
+inline void exercise_scene_file(const std::string& path) {
+  using namespace saarcor::host;
+  constexpr std::uint64_t kBuildTriangles = 20000;
+  Scene scene = load_scene(path);
+  if (scene.animation_seconds > 0.0) scene.set_time(0.5 * scene.animation_seconds);
+  if (scene.instanced_triangles() > kBuildTriangles) return;
+  ImageParams ip;
+  ip.width = 16;
+  ip.height = 12;
+  ip.bank_words = 1u << 18;
+  const BuiltImage built = build_image(scene, ip);
+  try {
+    const DecodedImage d = decode_image(built.image);
+    if (d.instances.size() != built.instances.size())
+      finding("decoded image has " + std::to_string(d.instances.size()) +
+              " instances, the builder wrote " + std::to_string(built.instances.size()));
+  } catch (const std::runtime_error& e) {
+    finding(std::string("a built image does not decode: ") + e.what());
+  }
+}
 
 }  // namespace saarcor::fuzz

@@ -12,8 +12,6 @@
 #include <cstdint>
 
 #include "host/fuzz_support.h"
-#include "host/image_builder.h"
-#include "host/scene.h"
 
 namespace {
 
@@ -21,32 +19,6 @@ namespace fs = std::filesystem;
 using saarcor::fuzz::ScratchDir;
 
 ScratchDir* scratch = nullptr;
-
-// Scenes up to this many triangle slots after instancing are built into an image (a few
-// milliseconds each in the instrumented build).
-constexpr std::uint64_t kBuildTriangles = 20000;
-
-void exercise(const std::string& path) {
-  using namespace saarcor::host;
-  Scene scene = load_scene(path);
-  if (scene.animation_seconds > 0.0) scene.set_time(0.5 * scene.animation_seconds);
-  if (scene.instanced_triangles() > kBuildTriangles) return;
-  ImageParams ip;
-  ip.width = 16;
-  ip.height = 12;
-  ip.bank_words = 1u << 18;  // 1 MB banks: larger scenes take the "does not fit" error path
-  const BuiltImage built = build_image(scene, ip);
-  // A built image is the contract with the hardware: decoding it must succeed.
-  try {
-    const DecodedImage d = decode_image(built.image);
-    if (d.instances.size() != built.instances.size())
-      saarcor::fuzz::finding("decoded image has " + std::to_string(d.instances.size()) +
-                             " instances, the builder wrote " +
-                             std::to_string(built.instances.size()));
-  } catch (const std::runtime_error& e) {
-    saarcor::fuzz::finding(std::string("a built image does not decode: ") + e.what());
-  }
-}
 
 }  // namespace
 
@@ -64,6 +36,6 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = scratch->write("input.gltf", data, size);
-  saarcor::fuzz::documented_errors_only([&] { exercise(path); });
+  saarcor::fuzz::documented_errors_only([&] { saarcor::fuzz::exercise_scene_file(path); });
   return 0;
 }
