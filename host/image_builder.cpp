@@ -568,6 +568,7 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
       rec.reflectivity = to8(mat.reflectivity);
       rec.transparency = to8(mat.transparency);
     }
+    rec.bilinear = b.params.bilinear;
     const auto w = memif::encode_material(rec);
     std::copy(w.begin(), w.end(),
               bank.begin() + static_cast<std::ptrdiff_t>(memif::kMaterialWords * m));

@@ -54,6 +54,9 @@ struct ImageParams {
   // When the shading bank overflows, halve the largest texture until it fits (counted in
   // ImageStats::texture_halvings) instead of refusing the scene.
   bool fit_textures = true;
+  // Texture filter written into every material record (the RGS reads 4 texels per textured hit
+  // with bilinear filtering, 1 without; the paper rendered Scene6 and Office unfiltered).
+  bool bilinear = true;
 };
 
 struct InstanceInfo {

@@ -56,6 +56,12 @@ const std::vector<Binding>& bindings() {
         "traversal stack entries the trees are built for (both levels share them)", 2, 4096},
        true,
        SAARCOR_TREE_FIELD(stack_entries, int)},
+      {{"image.bilinear", 0, "bool",
+        "texture filter of every material record: 1 = bilinear (4 texels per hit), 0 = nearest "
+        "(1 texel; the paper's Scene6 and Office runs)",
+        0, 1},
+       true,
+       SAARCOR_TREE_FIELD(bilinear, bool)},
   };
   return table;
 }
@@ -74,7 +80,7 @@ std::vector<TreeSettingInfo> tree_setting_table() {
 }
 
 bool is_tree_setting(const std::string& key_value) {
-  return key_value.rfind("kd.", 0) == 0;
+  return key_value.rfind("kd.", 0) == 0 || key_value.rfind("image.", 0) == 0;
 }
 
 void apply_tree_setting(ImageParams& params, const std::string& key_value) {

@@ -21,7 +21,7 @@ struct TreeSettingInfo {
 
 // Every tree key with its default (ImageParams{}'s values).
 std::vector<TreeSettingInfo> tree_setting_table();
-// True when "KEY=VALUE" names a tree key (its key starts with "kd.").
+// True when "KEY=VALUE" names a tree or image key (its key starts with "kd." or "image.").
 bool is_tree_setting(const std::string& key_value);
 // Applies "kd.KEY=VALUE" to params; throws std::runtime_error naming the key for an unknown key,
 // a value that is not a number, or one out of range.

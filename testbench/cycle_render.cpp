@@ -83,12 +83,34 @@ nlohmann::json figures_json(const units::CycleFigures& f) {
   for (int c = 0; c < units::kCacheUnits; ++c)
     j["cache_hit"][units::cache_unit_name(units::CacheUnit(c))] =
         f.cache_hit[static_cast<std::size_t>(c)];
-  j["bandwidth_mb_s"] = {{"dynrtc", f.bw_dynrtc}, {"shading", f.bw_shading}, {"total", f.bw_total}};
+  j["bandwidth_mb_s"] = {{"dynrtc", f.bw_dynrtc},
+                         {"shading", f.bw_shading},
+                         {"frame_buffer", f.bw_frame},
+                         {"total", f.bw_total}};
   return j;
 }
 
 double per(std::uint64_t a, std::uint64_t b) {
   return b == 0 ? 0.0 : static_cast<double>(a) / static_cast<double>(b);
+}
+
+// The RGS's traffic (the table's "shade" column is shading reads + frame-buffer writes, as the
+// paper's shading bandwidth), with the paper's bytes per pixel beside it: its shading MB/s over
+// its frame rate at 1024x768.
+std::string rgs_text(const units::CycleFrame& c, const Table4Row* paper) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "RGS: shading reads %.0f MB/s, frame-buffer writes %.0f MB/s, %.1f bytes per pixel "
+                "(frame in bank %d)",
+                c.figures.bw_shading, c.figures.bw_frame, c.shading_bytes_per_pixel, c.frame_bank);
+  std::string s = buf;
+  if (paper != nullptr && paper->fps > 0) {
+    const double paper_bpp = paper->bw[1] * 1048576.0 / (paper->fps * 1024.0 * 768.0);
+    std::snprintf(buf, sizeof buf, "; paper %s %.0f MB/s, %.1f bytes per pixel (ratio %.2f)",
+                  paper->scene, paper->bw[1], paper_bpp, c.shading_bytes_per_pixel / paper_bpp);
+    s += buf;
+  }
+  return s + "\n";
 }
 
 }  // namespace
@@ -97,6 +119,10 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
   nlohmann::json j = figures_json(c.figures);
   j["cycles"] = c.cycles;
   j["fps"] = c.fps;
+  j["rgs"] = {{"shading_bytes", c.shading_bytes},
+              {"frame_buffer_bytes", c.frame_bytes},
+              {"shading_bytes_per_pixel", c.shading_bytes_per_pixel},
+              {"frame_bank", c.frame_bank}};
   j["rays"] = c.rays;
   j["rays_per_s"] = c.rays_per_s;
   j["packets"] = c.packets;
@@ -211,7 +237,8 @@ std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
                 "| %7.1f | %5.2f\n",
                 ("model " + scene).substr(0, 22).c_str(), c.fps, f.usage[0], f.usage[1], f.usage[2],
                 f.usage[3], f.cache_hit[0], f.cache_hit[1], f.cache_hit[2], f.bw_dynrtc,
-                f.bw_shading, f.bw_total, per(c.cycles, c.packets), c.rays_per_s / 1e6);
+                f.bw_shading + f.bw_frame, f.bw_total, per(c.cycles, c.packets),
+                c.rays_per_s / 1e6);
   s += buf;
   if (const Table4Row* r = paper_row_for(scene)) {
     // The paper's cycles per packet and rays/s follow from its fps at 1024x768 and 4-ray packets.
@@ -227,6 +254,7 @@ std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
                   r->bw[2], 90e6 / (rays / 4.0), rays / 1e6);
     s += buf;
   }
+  s += rgs_text(c, paper_row_for(scene));
   const units::UnitStats& u = c.frame.units;
   std::snprintf(buf, sizeof buf,
                 "per ray: %.2f traversal steps, %.2f list entries, %.2f mailbox skips, %.2f "

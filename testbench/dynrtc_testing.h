@@ -22,12 +22,14 @@ constexpr bool kSanitized = true;  // the ASan/UBSan build: smaller frames, fewe
 constexpr bool kSanitized = false;
 #endif
 
-inline host::BuiltImage build(const std::string& spec, int w, int h, std::uint32_t bank_mb = 4) {
+inline host::BuiltImage build(const std::string& spec, int w, int h, std::uint32_t bank_mb = 4,
+                              bool bilinear = true) {
   const host::Scene scene = host::load_scene(spec);
   host::ImageParams ip;
   ip.width = w;
   ip.height = h;
   ip.bank_words = bank_mb * 262144u;
+  ip.bilinear = bilinear;
   return host::build_image(scene, ip);
 }
 

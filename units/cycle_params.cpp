@@ -142,7 +142,7 @@ std::vector<Binding> memory_bindings() {
   };
 }
 
-// The float operators, the clock and the watchdog.
+// The float operators, the RGS's shading pipeline, the clock and the watchdog.
 std::vector<Binding> operator_bindings() {
   return {
       {{"lat.add", 3, "cycles", "fp adder latency (D7)", 1, 64, false},
@@ -152,6 +152,11 @@ std::vector<Binding> operator_bindings() {
       {{"lat.div", 8, "cycles", "fp divider latency", 1, 64, false}, SAARCOR_FIELD(lat_div, int)},
       {{"lat.cmp", 1, "cycles", "fp comparator latency (D7)", 1, 64, false},
        SAARCOR_FIELD(lat_cmp, int)},
+      {{"rgs.depth", 8, "cycles",
+        "the RGS's shading pipeline: from a request's issue, or from the last shading-bank word "
+        "it read, to its result (integer texture filter, colour products, accumulation)",
+        1, 1000, false},
+       SAARCOR_FIELD(rgs_depth, int)},
       {{"clock_mhz", 90, "MHz", "modelled clock (the prototype's 90 MHz)", 0.001, 100000, false},
        SAARCOR_FIELD(clock_mhz, double)},
       {{"watchdog", 100000, "cycles", "cycles without progress that stop a run", 1, 1e12, false},

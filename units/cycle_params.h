@@ -55,6 +55,7 @@ struct CycleParams {
   double hostbus_mb_s = 0.0;    // host-bus upload bandwidth, MB = 2^20 bytes (D40)
   int hostbus_burst_words = 0;  // words per host-bus write burst
   int lat_add = 0, lat_mul = 0, lat_div = 0, lat_cmp = 0;  // fp unit latencies (D7)
+  int rgs_depth = 0;  // RGS shading pipeline (cycles after issue or after the last shading word)
   double clock_mhz = 0.0;
   std::uint64_t watchdog = 0;  // cycles without progress that stop a run
 

@@ -51,35 +51,37 @@ int CycleUnit::evaluate() {
 int CycleUnit::deliver() {
   int moved = 0;
   while (!pipeline_.empty() && pipeline_.front().done_at <= now()) {
-    const ThreadToken t = pipeline_.front().thread;
-    const Request& next = threads_.request(t);
-    if (next.unit == UnitId::kNone) {
-      pipeline_.pop_front();
-      --inside_;
-      if (observer_ != nullptr) [[unlikely]]
-        observer_->left(now(), t);
-      retire(t);
-      ++moved;
-      continue;
-    }
-    ThreadPath* out = outputs_[unit_index(next.unit)];
-    if (out == nullptr)
-      throw std::logic_error(name() + ": no path to the " + unit_name(next.unit) + " unit");
-    if (!out->can_push()) {
+    if (!leave(pipeline_.front().thread)) {
       stall();
       break;
     }
-    out->push(t);
-    if (observer_ != nullptr) [[unlikely]] {
-      observer_->left(now(), t);
-      observer_->queued(now(), next.unit, t);
-    }
     pipeline_.pop_front();
-    --inside_;
     ++moved;
   }
   deliver_at_ = pipeline_.empty() ? hw::kNever : pipeline_.front().done_at;
   return moved;
+}
+
+bool CycleUnit::leave(ThreadToken t) {
+  const Request& next = threads_.request(t);
+  if (next.unit == UnitId::kNone) {
+    --inside_;
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->left(now(), t);
+    retire(t);
+    return true;
+  }
+  ThreadPath* out = outputs_[unit_index(next.unit)];
+  if (out == nullptr)
+    throw std::logic_error(name() + ": no path to the " + unit_name(next.unit) + " unit");
+  if (!out->can_push()) return false;
+  out->push(t);
+  if (observer_ != nullptr) [[unlikely]] {
+    observer_->left(now(), t);
+    observer_->queued(now(), next.unit, t);
+  }
+  --inside_;
+  return true;
 }
 
 int CycleUnit::issue() {
@@ -100,7 +102,10 @@ int CycleUnit::issue() {
     steps_left_ = r.steps < 1 ? 1 : r.steps;
     const Request& next = threads_.request(t);
     std::uint64_t done_at = 0;
-    if (next.unit == id_ && chains(r, next)) {
+    if (hold(t)) {
+      // The unit keeps the thread for memory traffic and lets it leave itself (leave()); a trace
+      // shows the request as issuing until it left (done_at 0, as a chain).
+    } else if (next.unit == id_ && chains(r, next)) {
       chained_ = true;
       chain_thread_ = t;
     } else {

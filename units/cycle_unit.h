@@ -48,6 +48,12 @@ class ThreadTable {
     static const TracedStep kNothing;
     return kNothing;
   }
+  // The memory accesses of the RGS request thread `thread` executed last (shading-bank reads,
+  // frame-buffer writes; units/program_types.h RgsAccess). Empty for a table without them.
+  virtual const std::vector<RgsAccess>& rgs_memory(std::uint32_t /*thread*/) const {
+    static const std::vector<RgsAccess> kNone;
+    return kNone;
+  }
 
  protected:
   std::vector<Request> requests_;  // one per thread
@@ -151,6 +157,13 @@ class CycleUnit : public hw::Module {
   // overrides it sets has_extra_).
   virtual int extra() { return 0; }
   virtual std::uint64_t extra_wakeup(std::uint64_t /*now*/) const { return hw::kNever; }
+  // Called at issue, after the thread's request executed: true if the unit keeps the thread
+  // outside the pipeline (the RGS, while its memory accesses are served) and lets it go with
+  // leave() itself.
+  virtual bool hold(ThreadToken /*thread*/) { return false; }
+  // Thread t leaves the unit: on the path to its next request's unit, or retired when it is done.
+  // False (nothing changed) if that path is full.
+  bool leave(ThreadToken t);
 
   // The cycle, as a script (evaluate() calls these in this order).
   int deliver();  // threads whose pipeline latency elapsed leave on their next path

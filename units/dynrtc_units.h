@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "memif/memory_controller.h"
 #include "units/cycle_unit.h"
 
 namespace saarcor::units {
@@ -94,14 +95,30 @@ class RayGenerationController {
   std::uint64_t taken_at_ = hw::kNever;
 };
 
-// Ray source and hit sink of one DynRTP (path g in, a out): in a cycle the RGC grants it, a new
-// primary packet goes to a free thread of this pipeline; returning packets run their RGS phases
-// one per cycle (shading proper and its memory traffic come with the RGS issue) and free their
-// thread. The pipeline's threads are `count` consecutive ids from `first` in the shared table.
+// The RGS's two memory ports (memif::MemorySystem::shading_port / frame_port): uncached reads of
+// the shading bank, writes into the frame-buffer banks, each under its own bandwidth client.
+struct RgsPorts {
+  memif::MemoryController::Port* shading = nullptr;
+  memif::MemoryController::Port* frame = nullptr;
+  std::uint16_t shading_client = 0, frame_client = 0;
+};
+
+// The ray generation and shading unit of one DynRTP with the RGC's admission (path g in, a out):
+// in a cycle the RGC grants it, a new primary packet goes to a free thread of this pipeline;
+// returning packets run their RGS phases and the finished packet frees its thread. An RGS request
+// that touches memory (the thread program lists its accesses: units/program_types.h RgsAccess)
+// keeps its thread: the shading-bank reads go out one per cycle on the shading port in dependent
+// waves (record and light, material, texels), the shading takes `depth` cycles after the last
+// word arrived, then the finished pixels go to the frame port one word per cycle, and the thread
+// leaves (or is freed) as its last write goes out. A request without accesses takes `depth`
+// cycles after its issue cycle, as every unit's. The pipeline's threads are `count` consecutive
+// ids from `first` in the shared table. Exact-cycle tests: units/unit_timing_test.cpp
+// (UnitTimingRaySource.*, UnitTimingRgs.*).
 class RaySource : public CycleUnit {
  public:
   RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
-            RayGenerationController& rgc, int pipeline, ThreadToken first, int count);
+            RayGenerationController& rgc, int pipeline, ThreadToken first, int count,
+            RgsPorts ports = {});
 
   // Every thread of this pipeline free (checked between cycles).
   bool idle() const { return free_ == count_; }
@@ -114,15 +131,44 @@ class RaySource : public CycleUnit {
   void retire(ThreadToken thread) override;
   int extra() override;
   std::uint64_t extra_wakeup(std::uint64_t now) const override;
+  bool hold(ThreadToken thread) override;
 
  private:
+  // A thread the RGS keeps while its request's accesses are served.
+  struct Held {
+    enum class Stage : std::uint8_t { kReading, kShading, kWriting, kLeaving };
+    std::vector<RgsAccess> access;  // the reads, then the writes (as the program lists them)
+    std::size_t reads = 0;          // access[0, reads) are reads
+    std::size_t next = 0;           // the next access to issue
+    int outstanding = 0;            // reads issued and not answered
+    std::uint8_t wave = 0;          // the wave of the reads in flight
+    std::uint64_t due = 0;          // kShading: the cycle the shading is done
+    Stage stage = Stage::kReading;
+  };
+  Held& held(ThreadToken t) { return held_[t - first_]; }
+  const Held& held(ThreadToken t) const { return held_[t - first_]; }
+  int admit();
+  int receive_shading();
+  int serve_held();
+  bool can_read(const Held& h) const {
+    return h.next < h.reads && (h.outstanding == 0 || h.access[h.next].wave == h.wave);
+  }
+  void issue_access(memif::MemoryController::Port& port, std::uint16_t client, ThreadToken t,
+                    Held& h);
+
   RayGenerationController& rgc_;
   int pipeline_;
+  ThreadToken first_;
   int count_;
   Ring<ThreadToken> free_list_;
   int free_;
+  RgsPorts ports_;
+  std::vector<Held> held_;           // by thread (minus first_)
+  std::vector<ThreadToken> active_;  // held threads, oldest first
   hw::Counter* retired_;
   hw::Counter* admitted_;
+  hw::Counter* reads_;
+  hw::Counter* writes_;
 };
 
 }  // namespace saarcor::units

@@ -78,6 +78,32 @@ std::vector<UnitId> input_order(UnitId u) {
   }
 }
 
+// The frame buffer: one word per pixel from word 0 of the back bank (FrameRegisters::frame_bank).
+void check_frame_buffer(const memif::MemoryImage& image) {
+  const auto& r = image.registers();
+  if (r.frame_bank != memif::kFrameBank0 && r.frame_bank != memif::kFrameBank1)
+    throw std::runtime_error("cycle model: frame_bank " + std::to_string(r.frame_bank) +
+                             " is not a frame-buffer bank (0 or 1)");
+  const std::uint64_t words = std::uint64_t{r.width} * r.height;
+  if (words > image.bank_words())
+    throw std::runtime_error("cycle model: a " + std::to_string(r.width) + "x" +
+                             std::to_string(r.height) + " frame needs " + std::to_string(words) +
+                             " frame-buffer words, a bank holds " +
+                             std::to_string(image.bank_words()) + " (raise --bank-mb)");
+}
+
+// The frame's image as the hardware left it: the words the RGS wrote into the back bank.
+void read_frame_buffer(const memif::MemoryImage& image, CycleFrame& out) {
+  const int bank = static_cast<int>(image.registers().frame_bank);
+  const std::vector<std::uint32_t>& fb = image.bank(bank);
+  auto& rgb = out.frame.rgb;
+  rgb.resize(out.frame.pixels.size() * 3u);
+  for (std::size_t i = 0; i < out.frame.pixels.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k)
+      rgb[3 * i + k] = static_cast<std::uint8_t>((fb[i] >> (8 * k)) & 255u);
+  out.frame_bank = bank;
+}
+
 double mb_per_s(std::uint64_t bytes, std::uint64_t cycles, double clock_mhz) {
   if (cycles == 0) return 0.0;
   return static_cast<double>(bytes) * clock_mhz * 1e6 / static_cast<double>(cycles) / 1048576.0;
@@ -94,8 +120,10 @@ class DynRtp {
   DynRtp(hw::Kernel& k, memif::MemorySystem& mi, const CycleParams& p, ThreadTable& threads,
          RayGenerationController& rgc, int pipeline) {
     const std::string pre = "dynrtp" + std::to_string(pipeline) + ".";
-    rgs_ = &k.make<RaySource>(pre + "rgs", threads, 1, rgc, pipeline,
-                              static_cast<ThreadToken>(pipeline * p.threads), p.threads);
+    const RgsPorts ports{&mi.shading_port(pipeline), &mi.frame_port(pipeline),
+                         mi.shading_client(pipeline), mi.frame_client(pipeline)};
+    rgs_ = &k.make<RaySource>(pre + "rgs", threads, p.rgs_depth, rgc, pipeline,
+                              static_cast<ThreadToken>(pipeline * p.threads), p.threads, ports);
     units_[unit_index(UnitId::kRgs)] = rgs_;
     units_[unit_index(UnitId::kTraversal)] =
         &k.make<TraversalUnit>(pre + "traversal", threads, p.traversal_depth(),
@@ -144,12 +172,13 @@ class Chip {
       pipes_.push_back(std::make_unique<DynRtp>(k, mi_, p, threads, rgc_, i));
   }
 
-  // Every packet handed out and every thread free again (checked between cycles).
+  // Every packet handed out, every thread free again and the last pixels written into the frame
+  // buffer (checked between cycles).
   bool finished() const {
     if (!rgc_.all_handed_out()) return false;
     for (const auto& d : pipes_)
       if (!d->rgs().idle()) return false;
-    return true;
+    return mi_.idle();
   }
   std::uint64_t packets_retired() const {
     std::uint64_t n = 0;
@@ -176,7 +205,7 @@ struct Snapshot {
   std::uint64_t cycle = 0;
   std::array<std::uint64_t, kTable4Units> issued{};
   std::array<std::uint64_t, kCacheUnits> requests{}, hits{}, bytes{};
-  std::uint64_t shading_bytes = 0;
+  std::uint64_t shading_bytes = 0, frame_bytes = 0;
   int pipelines = 1;  // usage is per unit: issue cycles over cycles x pipelines
 };
 
@@ -196,8 +225,8 @@ Snapshot snapshot(hw::Kernel& k, Chip& chip) {
           k.stats().get_counter(cache.name() + ".mem_bytes").value;
     }
     const std::string pre = "dynrtp" + std::to_string(p) + ".";
-    s.shading_bytes += k.stats().get_counter(pre + "shading.mem_bytes").value +
-                       k.stats().get_counter(pre + "frame.mem_bytes").value;
+    s.shading_bytes += k.stats().get_counter(pre + "shading.mem_bytes").value;
+    s.frame_bytes += k.stats().get_counter(pre + "frame.mem_bytes").value;
   }
   return s;
 }
@@ -216,7 +245,8 @@ CycleFigures figures(const Snapshot& a, const Snapshot& b, double clock_mhz) {
   }
   f.bw_dynrtc = mb_per_s(dyn, n, clock_mhz);
   f.bw_shading = mb_per_s(b.shading_bytes - a.shading_bytes, n, clock_mhz);
-  f.bw_total = f.bw_dynrtc + f.bw_shading;
+  f.bw_frame = mb_per_s(b.frame_bytes - a.frame_bytes, n, clock_mhz);
+  f.bw_total = f.bw_dynrtc + f.bw_shading + f.bw_frame;
   return f;
 }
 
@@ -322,9 +352,10 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
                             const CycleRunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   check_cycle_params(p);
-  // The memory system takes the image mutable for host uploads and frame-buffer writes; this run
-  // does neither (no upload, no frame port traffic), so the caller's image stays unchanged.
-  memif::MemoryImage& image = const_cast<memif::MemoryImage&>(image_in);
+  check_frame_buffer(image_in);
+  // The chip's memory: the RGS writes the frame-buffer bank, the caller's image stays unchanged
+  // (several runs may share it, as a sweep's points do).
+  memif::MemoryImage image = image_in;
   if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
     throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
                              std::to_string(opt.ahead_packets) + ")");
@@ -355,6 +386,12 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
 
   threads.finish();
   collect(out.frame, threads);
+  read_frame_buffer(image, out);
+  out.shading_bytes = end.shading_bytes;
+  out.frame_bytes = end.frame_bytes;
+  const double pixels = static_cast<double>(out.frame.width) * out.frame.height;
+  out.shading_bytes_per_pixel =
+      pixels > 0 ? static_cast<double>(end.shading_bytes + end.frame_bytes) / pixels : 0.0;
   out.cycles = k.now();
   out.figures = figures(start, end, p.clock_mhz);
   collect_units(k, chip, end, out);

@@ -59,10 +59,12 @@ struct CycleRunOptions {
 
 // Unit usage, cache hit rates and bandwidth over a span of cycles.
 struct CycleFigures {
-  std::uint64_t cycle = 0;                             // end of the span
-  std::array<double, kTable4Units> usage{};            // percent of cycles issuing a step
-  std::array<double, kCacheUnits> cache_hit{};         // percent, (hits + merges) / requests
-  double bw_dynrtc = 0, bw_shading = 0, bw_total = 0;  // MB/s (2^20 bytes) at the modelled clock
+  std::uint64_t cycle = 0;                      // end of the span
+  std::array<double, kTable4Units> usage{};     // percent of cycles issuing a step
+  std::array<double, kCacheUnits> cache_hit{};  // percent, (hits + merges) / requests
+  // MB/s (2^20 bytes) at the modelled clock: the DynRTC's caches, the RGS's shading-bank reads,
+  // its frame-buffer writes, all three.
+  double bw_dynrtc = 0, bw_shading = 0, bw_frame = 0, bw_total = 0;
 };
 
 struct CycleFrame {
@@ -77,6 +79,11 @@ struct CycleFrame {
     std::uint64_t requests = 0, hits = 0, misses = 0, merges = 0, mem_bytes = 0;
   };
   std::array<CacheCount, kCacheUnits> caches{};
+  // The RGS's memory traffic over the frame (docs/shading.md "Shading traffic"): shading-bank
+  // bytes read (records, materials, texels, lights) and frame-buffer bytes written.
+  std::uint64_t shading_bytes = 0, frame_bytes = 0;
+  double shading_bytes_per_pixel = 0;   // (shading + frame bytes) / pixels
+  int frame_bank = memif::kFrameBank0;  // the bank the frame was written into
   // Per DynRTP: the packets the RGC handed it and its units' issue cycles (the load balance).
   struct PipelineCount {
     std::uint64_t packets = 0;
@@ -96,8 +103,11 @@ struct CycleFrame {
 };
 
 // Renders the image's frame: an fp24 image (the prototype), or e7m23 (the same units 31 bits wide,
-// for the width study). Throws std::runtime_error for a bad configuration or image, and when the
-// watchdog fires (the message names every thread and where it waits).
+// for the width study), on a copy of `image` (the chip's memory: the RGS writes the frame into its
+// back frame-buffer bank, FrameRegisters::frame_bank). The frame's image (frame.rgb) is read back
+// from that bank: the words the hardware wrote. Throws std::runtime_error for a bad configuration
+// or image (a frame-buffer bank too small for the frame), and when the watchdog fires (the message
+// names every thread and where it waits).
 // The functional parameters a thread program of a cycle-model run with `p` gets: `shading`'s
 // RGS settings with the packet, stack, mailboxes, clip and traversal rules of `p`. The functional
 // model run with them is the cycle model's bit-exact reference.

@@ -6,12 +6,14 @@
 // its own *_step.h.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include "fixedfloat/float.h"
 #include "memif/image_format.h"
+#include "memif/request.h"
 #include "units/datapath.h"
 #include "units/huge_pages.h"
 #include "units/unit_fp.h"
@@ -144,6 +146,31 @@ struct Request {
   int steps = 0;           // transformation steps (n+1 or 2n), intersection cycles (P), else 1
   std::uint64_t mask = 0;  // the rays concerned
 };
+
+// One memory access of the RGS (DESIGN.md sections 4, 6 and 7; docs/shading.md "Shading
+// traffic"): a read of `words` consecutive shading-bank words, or a one-word write of a finished
+// pixel into a frame-buffer bank. Reads come in dependent waves: the shading record and the light
+// records (0) name the material (1), which names the texels (2); a wave is read once the one
+// before it has arrived. The thread program lists a request's accesses as it executes it
+// (RgsStep::memory()); the cycle model's RGS issues them through the memory controller.
+struct RgsAccess {
+  std::uint32_t offset = 0;  // word offset within `bank`
+  std::uint32_t data = 0;    // the word written (writes only)
+  std::uint8_t bank = memif::kShadingBank;
+  std::uint8_t words = 1;  // 1..memif::kMaxRequestWords (writes: 1)
+  std::uint8_t wave = 0;   // read dependency wave: 0 record/light, 1 material, 2 texels
+  bool write = false;
+};
+
+// A finished pixel as the RGS writes it into the frame buffer: R, G, B in bits 0..7, 8..15,
+// 16..23 (the shading bank's RGB8 packing), each channel the rounded, clamped weighted sum /255.
+inline std::uint32_t pixel_word(const std::array<std::uint32_t, 3>& colour_sum) {
+  std::uint32_t w = 0;
+  for (int k = 0; k < 3; ++k)
+    w |= std::min<std::uint32_t>(255u, (colour_sum[static_cast<std::size_t>(k)] + 127u) / 255u)
+         << (8 * k);
+  return w;
+}
 
 // Unit transactions as the datapaths see them (units/unit_vectors.h: the vectors an RTL unit is
 // checked against; units/request_trace.h: the per-request trace). Null in every model run but a

@@ -1,25 +1,41 @@
-// Ray source and hit sink of the DynRTP (paper section 3.1: the RGC schedules packets to free
-// threads, path a; path g returns the final hits to the RGS; DESIGN.md sections 5 and 7; DIGEST
-// D24, D25). For this model the RGS phases take one cycle each and read no memory.
+// The ray generation and shading unit with the RGC's admission (paper section 3.1: the RGC
+// schedules packets to free threads, path a; path g returns the final hits to the RGS, which
+// shades them, spawns secondary rays and writes the finished pixels into the frame buffer;
+// DESIGN.md sections 5, 6 and 7; docs/shading.md "Shading traffic"; DIGEST D24, D25).
+#include <algorithm>
+
 #include "units/dynrtc_units.h"
 
 namespace saarcor::units {
 
 RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
-                     RayGenerationController& rgc, int pipeline, ThreadToken first, int count)
+                     RayGenerationController& rgc, int pipeline, ThreadToken first, int count,
+                     RgsPorts ports)
     : CycleUnit(k, std::move(name), UnitId::kRgs, t, depth, nullptr),
       rgc_(rgc),
       pipeline_(pipeline),
+      first_(first),
       count_(count),
       free_list_(count),
-      free_(count) {
+      free_(count),
+      ports_(ports),
+      held_(static_cast<std::size_t>(count)) {
   has_extra_ = true;
   for (int i = 0; i < count; ++i)
     free_list_.push_back(first + static_cast<ThreadToken>(i));
+  if (ports_.shading != nullptr) {
+    produces(ports_.shading->requests);
+    consumes(ports_.shading->responses);
+  }
+  if (ports_.frame != nullptr) produces(ports_.frame->requests);
   retired_ = &stats().counter(this->name() + ".packets_retired", "packets",
                               "primary packets whose thread was freed");
   admitted_ = &stats().counter(this->name() + ".packets_admitted", "packets",
                                "primary packets handed to a free thread");
+  reads_ = &stats().counter(this->name() + ".shading_reads", "requests",
+                            "shading-bank read requests (records, materials, texels, lights)");
+  writes_ = &stats().counter(this->name() + ".frame_writes", "words",
+                             "finished pixels written into the frame buffer");
 }
 
 CycleUnit::Fetch RaySource::fetch(const Request&) const {
@@ -36,9 +52,37 @@ void RaySource::retire(ThreadToken thread) {
   ++*retired_;
 }
 
+// A request with memory accesses keeps its thread (without memory ports, as in the unit tests
+// with mock neighbours, every request goes through the pipeline).
+bool RaySource::hold(ThreadToken thread) {
+  if (ports_.shading == nullptr || ports_.frame == nullptr) return false;
+  const std::vector<RgsAccess>& access = threads_.rgs_memory(thread);
+  if (access.empty()) return false;
+  Held& h = held(thread);
+  h.access.assign(access.begin(), access.end());
+  h.reads = static_cast<std::size_t>(
+      std::find_if(h.access.begin(), h.access.end(), [](const RgsAccess& a) { return a.write; }) -
+      h.access.begin());
+  h.next = 0;
+  h.outstanding = 0;
+  h.stage = Held::Stage::kReading;
+  if (h.reads == 0) {  // writes only: the colours are ready, shading done after the depth
+    h.stage = Held::Stage::kShading;
+    h.due = now() + static_cast<std::uint64_t>(depth());
+  }
+  active_.push_back(thread);
+  return true;
+}
+
+int RaySource::extra() {
+  int progress = 0;
+  if (!active_.empty()) progress += receive_shading() + serve_held();
+  return progress + admit();
+}
+
 // Admission: in a cycle the RGC grants this pipeline, the next primary packet goes to the oldest
 // free thread, on path a.
-int RaySource::extra() {
+int RaySource::admit() {
   if (free_list_.empty() || !rgc_.granted(pipeline_, now()) || !rgc_.packets_left(pipeline_, now()))
     return 0;
   ThreadPath* a = outputs_[unit_index(UnitId::kTransformation)];
@@ -54,9 +98,81 @@ int RaySource::extra() {
   return 1;
 }
 
+// One shading-bank response per cycle (the port's width); the thread's last one starts its
+// shading, which is done `depth` cycles later.
+int RaySource::receive_shading() {
+  auto& responses = ports_.shading->responses;
+  if (!responses.can_pop()) return 0;
+  const memif::MemResponse r = responses.pop();
+  Held& h = held(r.tag);
+  --h.outstanding;
+  if (h.outstanding == 0 && h.next == h.reads) {
+    h.stage = Held::Stage::kShading;
+    h.due = now() + static_cast<std::uint64_t>(depth());
+  }
+  return 1;
+}
+
+void RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t client,
+                             ThreadToken t, Held& h) {
+  const RgsAccess& a = h.access[h.next++];
+  memif::MemRequest m;
+  m.client = client;
+  m.tag = t;
+  m.bank = a.bank;
+  m.words = a.words;
+  m.write = a.write;
+  m.offset = a.offset;
+  m.data[0] = a.data;
+  port.requests.push(m);
+}
+
+// The held threads, oldest first: at most one read on the shading port and one write on the
+// frame port per cycle; a thread whose shading is done writes its pixels, then leaves.
+int RaySource::serve_held() {
+  int progress = 0;
+  bool read = !ports_.shading->requests.can_push(), wrote = !ports_.frame->requests.can_push();
+  for (std::size_t i = 0; i < active_.size();) {
+    const ThreadToken t = active_[i];
+    Held& h = held(t);
+    if (h.stage == Held::Stage::kReading && !read && can_read(h)) {
+      h.wave = h.access[h.next].wave;
+      ++h.outstanding;
+      issue_access(*ports_.shading, ports_.shading_client, t, h);
+      ++*reads_;
+      read = true;
+      ++progress;
+    }
+    if (h.stage == Held::Stage::kShading && h.due <= now())
+      h.stage = h.next < h.access.size() ? Held::Stage::kWriting : Held::Stage::kLeaving;
+    if (h.stage == Held::Stage::kWriting && !wrote) {
+      issue_access(*ports_.frame, ports_.frame_client, t, h);
+      ++*writes_;
+      wrote = true;
+      ++progress;
+      if (h.next == h.access.size()) h.stage = Held::Stage::kLeaving;
+    }
+    if (h.stage == Held::Stage::kLeaving && leave(t)) {
+      active_.erase(active_.begin() + static_cast<std::ptrdiff_t>(i));
+      ++progress;
+      continue;
+    }
+    ++i;
+  }
+  return progress;
+}
+
 std::uint64_t RaySource::extra_wakeup(std::uint64_t now) const {
-  if (free_list_.empty() || !rgc_.packets_left(pipeline_, now)) return hw::kNever;
-  return rgc_.next_grant(pipeline_, now);
+  std::uint64_t t = hw::kNever;
+  for (const ThreadToken thread : active_) {
+    const Held& h = held(thread);
+    if (h.stage == Held::Stage::kShading)
+      t = std::min(t, std::max(now + 1, h.due));
+    else if (h.stage != Held::Stage::kReading || can_read(h))
+      return now + 1;
+  }
+  if (free_list_.empty() || !rgc_.packets_left(pipeline_, now)) return t;
+  return std::min(t, rgc_.next_grant(pipeline_, now));
 }
 
 }  // namespace saarcor::units

@@ -71,6 +71,7 @@ class RecordedThreads final : public ThreadTable {
     for (std::size_t i = 0; i < slots_.size(); ++i)
       free_.push_back(i);
     cursor_.resize(static_cast<std::size_t>(threads));
+    rgs_mem_.resize(static_cast<std::size_t>(threads));
     programs_.push_back(std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
     for (int i = 0; i < threads; ++i)
       requests_[static_cast<std::size_t>(i)] = programs_.back()->request();
@@ -85,7 +86,14 @@ class RecordedThreads final : public ThreadTable {
       Cursor& c = cursor_[t];
       if (tracing_) [[unlikely]]
         note_replayed(t);
-      replay(t, slots_[c.slot].trace[++c.next]);
+      Slot& s = slots_[c.slot];
+      // The RGS's accesses, copied out before the replay of a final step releases the slot.
+      if (s.trace[c.next].unit == UnitId::kRgs) [[unlikely]] {
+        const std::uint32_t begin = c.rgs == 0 ? 0 : s.mem_end[c.rgs - 1];
+        rgs_mem_[t].assign(s.mem.begin() + begin, s.mem.begin() + s.mem_end[c.rgs]);
+        ++c.rgs;
+      }
+      replay(t, s.trace[++c.next]);
       return;
     }
     if (tracing_) [[unlikely]]
@@ -99,7 +107,7 @@ class RecordedThreads final : public ThreadTable {
   void start_primary(std::uint32_t t, int packet) override {
     if (mode_ == ProgramMode::kPacketFirst) {
       Cursor& c = cursor_[t];
-      c = {free_.back(), 0};
+      c = {free_.back(), 0, 0};
       free_.pop_back();
       record(slots_[c.slot], *programs_[0], packet);
       replay(t, slots_[c.slot].trace[0]);
@@ -107,7 +115,7 @@ class RecordedThreads final : public ThreadTable {
     }
     if (mode_ == ProgramMode::kAhead) {
       Cursor& c = cursor_[t];
-      c = {take(packet), 0};
+      c = {take(packet), 0, 0};
       // The trace was written on the other core: pull all of it towards this one now, while the
       // thread's first requests wait in the units (its entries are read one per step later).
       const std::vector<Step>& trace = slots_[c.slot].trace;
@@ -123,6 +131,9 @@ class RecordedThreads final : public ThreadTable {
   }
   const TracedStep& traced(std::uint32_t t) const override {
     return tracing_ ? traced_[t] : ThreadTable::traced(t);
+  }
+  const std::vector<RgsAccess>& rgs_memory(std::uint32_t t) const override {
+    return recorded_ ? rgs_mem_[t] : programs_[t]->rgs_memory();
   }
   int packets() const override { return tiling_.count(); }
   // The rays thread `t`'s current request concerns (for the watchdog's thread report; the units
@@ -165,12 +176,24 @@ class RecordedThreads final : public ThreadTable {
     // transactions.
     std::vector<RayKind> kinds;
     std::vector<std::string> txns;
+    // The RGS requests' memory accesses, request after request; mem_end[k] ends the k-th's.
+    std::vector<RgsAccess> mem;
+    std::vector<std::uint32_t> mem_end;
   };
+  // After program `p` executed request `r`: an RGS request's accesses into the slot.
+  static void note_memory(Slot& s, const ThreadProgram<F, kLanes>& p, const Request& r) {
+    if (r.unit != UnitId::kRgs) return;
+    const std::vector<RgsAccess>& m = p.rgs_memory();
+    s.mem.insert(s.mem.end(), m.begin(), m.end());
+    s.mem_end.push_back(static_cast<std::uint32_t>(s.mem.size()));
+  }
   // Runs packet `packet` on program `p` and records its request sequence into `s`.
   void record(Slot& s, ThreadProgram<F, kLanes>& p, int packet) {
     s.packet = packet;
     s.trace.clear();
     s.masks.clear();
+    s.mem.clear();
+    s.mem_end.clear();
     p.start_primary(packet_pixels(tiling_, w_, h_, packet));
     if (tracing_) [[unlikely]]
       return record_traced(s, p);
@@ -180,6 +203,8 @@ class RecordedThreads final : public ThreadTable {
       s.masks.push_back(r.mask);
       if (p.done()) break;
       p.execute();
+      if (r.unit == UnitId::kRgs) [[unlikely]]
+        note_memory(s, p, r);
     }
   }
   static Step step_of(const Request& r) {
@@ -205,6 +230,7 @@ class RecordedThreads final : public ThreadTable {
       s.kinds.push_back(p.kind());
       tap_.begin();
       p.execute();
+      note_memory(s, p, r);
       s.txns.push_back(capture ? tap_.take() : std::string());
     }
     units_.tap = nullptr;
@@ -248,6 +274,7 @@ class RecordedThreads final : public ThreadTable {
   }
   struct Cursor {
     std::size_t slot = 0, next = 0;
+    std::uint32_t rgs = 0;  // RGS requests replayed so far (index into the slot's mem_end)
   };
   struct PerStep {  // kPerStep: each thread's packet and its next request's position
     int packet = -1;
@@ -348,7 +375,8 @@ class RecordedThreads final : public ThreadTable {
   std::vector<std::unique_ptr<ThreadProgram<F, kLanes>>> programs_;
   std::vector<Slot> slots_;
   std::vector<Cursor> cursor_;
-  std::mutex mutex_;  // guards the slot lists and the flags below
+  std::vector<std::vector<RgsAccess>> rgs_mem_;  // recorded: each thread's last RGS accesses
+  std::mutex mutex_;                             // guards the slot lists and the flags below
   std::condition_variable to_programs_, to_simulation_;
   std::vector<std::size_t> free_;
   std::deque<std::size_t> finished_;  // in packet order

@@ -37,6 +37,8 @@ class RgsStep {
   // The RGC hands the thread the primary packet of pixels `pixel[i]` (memif::kNone = empty lane).
   void start_primary(State& t, const std::vector<std::uint32_t>& pixel) {
     pending_size_ = 0;
+    mem_.clear();
+    pixels_.assign(pixel.begin(), pixel.end());
     t.scene.refresh(t.image);
     normal_instance_ = memif::kNone;
     const auto width = static_cast<std::uint32_t>(t.sink.width);
@@ -63,6 +65,7 @@ class RgsStep {
 
   // A returning primary or secondary packet (path g): its surfaces, then the lights.
   void shade_surface(State& t) {
+    material_ = memif::kNone;
     account_counters(t);
     if (t.kind == RayKind::kPrimary) record_primary(t);
     if (!t.params.shade) return next_packet(t);
@@ -126,6 +129,14 @@ class RgsStep {
     account_counters(t);
     accumulate_light(t);
   }
+
+  // The memory accesses of the RGS request executed last, in the order the RGS makes them: the
+  // shading-bank reads its shading needed and, when the primary packet is finished, its pixels'
+  // frame-buffer writes (the cycle model's RGS issues them; docs/shading.md "Shading traffic").
+  const std::vector<RgsAccess>& memory() const { return mem_; }
+  // A new RGS request begins (the dispatcher calls this before shade_*: a phase may run the next
+  // one inline, as shade_light after the shadow-ray directions when no shadow rays are traced).
+  void begin_request() { mem_.clear(); }
 
  private:
   // The RGS's per-lane surface context while it shades a packet's hits.
@@ -238,9 +249,18 @@ class RgsStep {
     s.n = world_normal(t, h, s.rec);
     s.nn = shade_dot(t, s.n, s.n);
     t.u.shading_transformation_steps += 1;  // normal step; the dots count below
-    const memif::ShadingRecord rec = read_shading_record(t.image, h.shading_base + s.rec.triangle);
+    const std::uint32_t record = h.shading_base + s.rec.triangle;
+    const memif::ShadingRecord rec = read_shading_record(t.image, record);
+    read(t.image.registers().shading_record_base + memif::kShadingRecordWords * record,
+         memif::kShadingRecordWords, 0);
     s.mat = read_material(t.image, rec.material);
-    s.base = base_colour(t.image, rec, s.mat, fix16(s.rec.u), fix16(s.rec.v));
+    if (rec.material != material_) {  // the packet's hits mostly share a material: read once
+      material_ = rec.material;
+      read(t.image.registers().material_base + memif::kMaterialWords * rec.material,
+           memif::kMaterialWords, 1);
+    }
+    s.base = base_colour(t.image, rec, s.mat, fix16(s.rec.u), fix16(s.rec.v),
+                         [this](std::uint32_t a) { read(a, 1, 2); });
     const std::uint32_t shininess = s.mat.specular_rgb_shininess >> 24;
     s.spec_rgb = unpack_rgb(s.mat.specular_rgb_shininess);
     s.spec = shininess >= 1 && (s.mat.specular_rgb_shininess & 0xFFFFFFu) != 0;
@@ -288,6 +308,7 @@ class RgsStep {
     const auto& regs = t.image.registers();
     if (light_ >= regs.light_count || surface_hit_mask(t) == 0) return finish_surface(t);
     const std::uint32_t a = regs.light_base + memif::kLightWords * light_;
+    read(a, memif::kLightWords, 0);
     Vec3<F> pos;
     for (std::uint32_t k = 0; k < 3; ++k)
       pos[k] = F::from_bits(t.image.word(memif::kShadingBank, a + k));
@@ -400,6 +421,7 @@ class RgsStep {
   // The next child packet (last in, first out), or the thread is done.
   void next_packet(State& t) {
     if (pending_size_ == 0) {
+      write_pixels(t);
       t.phase = Phase::kDone;
       return;
     }
@@ -407,8 +429,38 @@ class RgsStep {
     t.transformation.load(t, pending_[pending_size_]);  // copied: the slot may be rebuilt
   }
 
+  // ---- the RGS's memory accesses ---------------------------------------------------------------
+  // A read of `words` shading-bank words from `offset`, in requests of at most kMaxRequestWords.
+  void read(std::uint32_t offset, std::uint32_t words, std::uint8_t wave) {
+    constexpr auto kMax = static_cast<std::uint32_t>(memif::kMaxRequestWords);
+    for (std::uint32_t w = 0; w < words; w += kMax) {
+      RgsAccess a;
+      a.offset = offset + w;
+      a.words = static_cast<std::uint8_t>(std::min(kMax, words - w));
+      a.wave = wave;
+      mem_.push_back(a);
+    }
+  }
+  // The finished primary packet's pixels, one word each, into the back frame-buffer bank
+  // (FrameRegisters::frame_bank): every ray of the packet, children included, has returned.
+  void write_pixels(const State& t) {
+    const auto bank = static_cast<std::uint8_t>(t.image.registers().frame_bank);
+    for (std::uint32_t px : pixels_) {
+      if (px == memif::kNone) continue;
+      RgsAccess a;
+      a.bank = bank;
+      a.offset = px;
+      a.data = pixel_word(t.sink.colour_sum[px]);
+      a.write = true;
+      mem_.push_back(a);
+    }
+  }
+
   std::uint32_t max_depth_ = 3;
   F epsilon_{};
+  std::vector<RgsAccess> mem_;             // the accesses of the request executing
+  std::vector<std::uint32_t> pixels_;      // the primary packet's pixels (kNone: empty lane)
+  std::uint32_t material_ = memif::kNone;  // the material read last in this shading pass
   std::vector<Surface> surf_;
   std::uint32_t light_ = 0;
   Rgb8 light_rgb_{};

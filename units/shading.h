@@ -97,15 +97,24 @@ inline Rgb8 sample_texture(const memif::ShadingRecord& rec, const memif::Materia
 }
 
 // Base colour of a hit: the material's diffuse colour, modulated by the texture when it has one.
+// `on_texel(address)` sees the shading-bank address of every texel read, in the order read.
+template <class OnTexel>
 inline Rgb8 base_colour(const memif::MemoryImage& image, const memif::ShadingRecord& rec,
-                        const memif::MaterialRecord& mat, std::uint32_t bu, std::uint32_t bv) {
+                        const memif::MaterialRecord& mat, std::uint32_t bu, std::uint32_t bv,
+                        OnTexel&& on_texel) {
   const Rgb8 diffuse = unpack_rgb(mat.diffuse_rgba);
   if (mat.texture == memif::kNone) return diffuse;
   const std::uint32_t w = 1u << mat.log2_width;
   const Rgb8 tex = sample_texture(rec, mat, bu, bv, [&](std::uint32_t x, std::uint32_t y) {
-    return image.word(memif::kShadingBank, mat.texture + y * w + x);
+    const std::uint32_t a = mat.texture + y * w + x;
+    on_texel(a);
+    return image.word(memif::kShadingBank, a);
   });
   return {mul8(diffuse[0], tex[0]), mul8(diffuse[1], tex[1]), mul8(diffuse[2], tex[2])};
+}
+inline Rgb8 base_colour(const memif::MemoryImage& image, const memif::ShadingRecord& rec,
+                        const memif::MaterialRecord& mat, std::uint32_t bu, std::uint32_t bv) {
+  return base_colour(image, rec, mat, bu, bv, [](std::uint32_t) {});
 }
 
 // p = 256, then `shininess` times p = (p*ws + 128) >> 8 (docs/shading.md section 6.6).

@@ -44,6 +44,8 @@ class ThreadProgram {
   Phase phase() const { return s_.phase; }
   RayKind kind() const { return s_.kind; }
   int packet_width() const { return s_.p; }
+  // The memory accesses of the RGS request executed last (RgsStep::memory()).
+  const std::vector<RgsAccess>& rgs_memory() const { return s_.rgs.memory(); }
 
   // What the thread asks of its next unit: the item to fetch and the pipeline slots it takes.
   Request request() const {
@@ -114,10 +116,13 @@ class ThreadProgram {
       case Phase::kIntersect:
         return s_.intersection.step(s_);
       case Phase::kShadeSurface:
+        s_.rgs.begin_request();
         return s_.rgs.shade_surface(s_);
       case Phase::kShadeLight:
+        s_.rgs.begin_request();
         return s_.rgs.shade_light(s_);
       case Phase::kShadeShadow:
+        s_.rgs.begin_request();
         return s_.rgs.shade_shadow(s_);
       case Phase::kDone:
         return;

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -105,6 +106,14 @@ class ScriptedThreads final : public ThreadTable {
     set_script(t, primary_);
   }
   int packets() const override { return packets_; }
+  const std::vector<RgsAccess>& rgs_memory(std::uint32_t t) const override {
+    const auto it = memory_.find(t);
+    return it == memory_.end() ? ThreadTable::rgs_memory(t) : it->second;
+  }
+  // Test hook: the memory accesses thread t's RGS requests make.
+  void set_memory(std::uint32_t t, std::vector<RgsAccess> access) {
+    memory_[t] = std::move(access);
+  }
   // Test hook: thread t continues with `script` (between runs only).
   void set_script(std::uint32_t t, std::vector<Request> script) {
     scripts_[t] = std::move(script);
@@ -128,6 +137,7 @@ class ScriptedThreads final : public ThreadTable {
   std::vector<std::size_t> pos_;
   std::vector<Request> primary_;
   int packets_;
+  std::map<std::uint32_t, std::vector<RgsAccess>> memory_;
 };
 
 // The neighbour upstream: pushes thread `second` onto the path at cycle `first` (or later while
@@ -554,6 +564,89 @@ TEST(UnitTimingRaySource, RoundRobinGrantAdmitsEveryPipelinesCycle) {
   EXPECT_EQ(threads.starts[1].thread, 3u);
   EXPECT_EQ(threads.starts[0].packet, 0);
   EXPECT_EQ(threads.starts[1].packet, 1);
+}
+
+// (5c) The RGS with its memory ports (memif::MemorySystem's shading and frame ports over the six
+// banks): a returning packet's shading reads go out in dependent waves (the shading record, then
+// the material it names, then the texel the material names), each wave once the one before it has
+// arrived; the shading is done rgs.depth cycles after the last word; the finished pixels go to
+// the frame port one word per cycle; the thread is freed as its last write goes out, and the
+// writes land in the frame-buffer bank.
+RgsAccess shading_read(std::uint32_t offset, int words, int wave) {
+  RgsAccess a;
+  a.offset = offset;
+  a.words = static_cast<std::uint8_t>(words);
+  a.wave = static_cast<std::uint8_t>(wave);
+  return a;
+}
+RgsAccess pixel_write(int bank, std::uint32_t pixel, std::uint32_t word) {
+  RgsAccess a;
+  a.bank = static_cast<std::uint8_t>(bank);
+  a.offset = pixel;
+  a.data = word;
+  a.write = true;
+  return a;
+}
+
+TEST(UnitTimingRgs, ReadsInDependentWavesThenShadingDepthThenOneWritePerCycle) {
+  hw::Kernel k;
+  memif::MemoryImage image(ff::kFp24, 1u << 12);
+  memif::MemorySystem mi(k, image);
+  const RgsPorts ports{&mi.shading_port(0), &mi.frame_port(0), mi.shading_client(0),
+                       mi.frame_client(0)};
+  const int rgs_depth = params().rgs_depth;
+  const int packets = 2;  // one thread: packet 1 is admitted when packet 0 frees it
+  ScriptedThreads threads(k, {{}}, {generate(kP + 1)}, packets);
+  RayGenerationController rgc(packets, 1);
+  auto& rgs = k.make<RaySource>("t.rgs", threads, rgs_depth, rgc, 0, 0, 1, ports);
+  ThreadPath& a = path(k, "t.path_a");
+  ThreadPath& g = path(k, "t.path_g");
+  rgs.add_input(&g);
+  rgs.set_output(UnitId::kTransformation, &a);
+  Source src(k, "t.source", g, {});
+  Sink sink(k, "t.sink", {&a});
+  k.run_to_completion([&] { return sink.got.size() == 1; }, 1000);
+
+  // The packet returns with its last RGS phase: record (4 words), material (4), texel (1), then
+  // its four pixels into frame-buffer bank 1.
+  threads.set_script(0, {shade(), kDone});
+  const std::uint32_t kPixels[kP] = {0, 1, 64, 65};
+  std::vector<RgsAccess> access = {shading_read(100, 4, 0), shading_read(200, 4, 1),
+                                   shading_read(300, 1, 2)};
+  for (int i = 0; i < kP; ++i)
+    access.push_back(pixel_write(memif::kFrameBank1, kPixels[i], 0x00102030u + i));
+  threads.set_memory(0, access);
+  const std::uint64_t returned = k.now() + 10;
+  src.script.push_back({returned, 0});
+  k.run_to_completion([&] { return sink.got.size() == 2 && mi.idle(); }, 1000);
+
+  // A lone read of w words pushed in c is poppable in c + 2 + (w - 1) + mem.latency + 1 (the
+  // port's request channel, the bank queue, w word slots, the SRAM latency, the response
+  // channel; memif/memory_controller_test.cpp), and the RGS pops it and issues the next wave's
+  // read in that same cycle.
+  const auto round_trip = [&](int words) {
+    return u64(2 + (words - 1) + params().mem_latency + 1);
+  };
+  const std::uint64_t issued = returned + kPathLatency + kReadyToIssue;
+  EXPECT_EQ(threads.issued_at(0, 0), issued);
+  const std::uint64_t record = issued;                    // wave 0 goes out at issue
+  const std::uint64_t material = record + round_trip(4);  // wave 1: after the record arrived
+  const std::uint64_t texel = material + round_trip(4);   // wave 2: after the material
+  const std::uint64_t shaded = texel + round_trip(1) + u64(rgs_depth);
+  // Pins: the four writes in shaded .. shaded + 3, the thread freed with the last one and given
+  // the next packet in that cycle (waves issued together, a missing depth, writes in one cycle
+  // or a free before the writes would each move it).
+  const std::uint64_t freed = shaded + u64(kP - 1);
+  ASSERT_EQ(threads.starts.size(), 2u);
+  EXPECT_EQ(threads.starts[1].cycle, freed);
+  EXPECT_EQ(sink.got[1].cycle, freed + kPathLatency);
+  EXPECT_EQ(rgs.packets_retired(), 1u);
+  EXPECT_EQ(k.stats().value("t.rgs.shading_reads"), 3.0);
+  EXPECT_EQ(k.stats().value("t.rgs.frame_writes"), 4.0);
+  EXPECT_EQ(mi.controller().client_bytes(ports.shading_client), 4u * (4 + 4 + 1));
+  EXPECT_EQ(mi.controller().client_bytes(ports.frame_client), 4u * kP);
+  for (int i = 0; i < kP; ++i)
+    EXPECT_EQ(image.word(memif::kFrameBank1, kPixels[i]), 0x00102030u + i) << "pixel " << i;
 }
 
 }  // namespace
