@@ -155,10 +155,17 @@ std::vector<PaperFigure> table4_figures(const nlohmann::json& cycle, const std::
       {"hit_list", h["list"].get<double>(), p.hit[1]},
       {"hit_transformation", h["transformation"].get<double>(), p.hit[2]},
       {"mb_s_dynrtc", b["dynrtc"].get<double>(), p.bw[0]},
-      {"mb_s_shading", b["shading"].get<double>(), p.bw[1]},
+      // The paper's shading bandwidth includes the frame buffer (DESIGN.md section 10).
+      {"mb_s_shading", b["shading"].get<double>() + b.value("frame_buffer", 0.0), p.bw[1]},
       {"mb_s_total", b["total"].get<double>(), p.bw[2]},
   };
   add_rate_figures(v, cycle, p.fps, width, height);
+  // Shading and frame-buffer bytes per pixel: the paper's from its shading MB/s over its frame
+  // rate at 1024x768 (Scene6: 19.0).
+  const double paper_bpp = p.fps > 0 ? p.bw[1] * 1048576.0 / (p.fps * 1024.0 * 768.0) : 0.0;
+  const double model_bpp =
+      cycle.contains("rgs") ? cycle["rgs"]["shading_bytes_per_pixel"].get<double>() : 0.0;
+  v.push_back({"shading_bytes_per_pixel", model_bpp, paper_bpp});
   return v;
 }
 
@@ -171,6 +178,17 @@ std::vector<PaperFigure> table3_figures(const nlohmann::json& cycle, const std::
   return v;
 }
 
+// The paper's setting: textures unfiltered (the paper rendered Scene6 and Office without bilinear
+// filtering, which "would slightly limit the performance (10 % at most)"), unless --set says.
+std::vector<std::string> paper_settings(const PaperOptions& opts) {
+  std::vector<std::string> set = opts.set;
+  const bool given = std::any_of(set.begin(), set.end(), [](const std::string& kv) {
+    return kv.rfind("image.bilinear=", 0) == 0;
+  });
+  if (!given) set.insert(set.begin(), "image.bilinear=0");
+  return set;
+}
+
 nlohmann::json run_paper_tables(const PaperOptions& opts) {
   check_options(opts);
   const std::vector<PaperScene> scenes = chosen_scenes(opts);
@@ -180,7 +198,7 @@ nlohmann::json run_paper_tables(const PaperOptions& opts) {
   nlohmann::json entries = nlohmann::json::array();
   for (const PaperScene& ps : scenes) {
     RenderSettings s = frame_settings("512x384", 0.0, false, 0, ps.bank_mb);
-    s.cycle.set = opts.set;
+    s.cycle.set = paper_settings(opts);
     s.res = tables.front() == 3 ? Resolution{512 / opts.scale, 384 / opts.scale}
                                 : Resolution{1024 / opts.scale, 768 / opts.scale};
     progress("loading " + ps.spec);
@@ -190,7 +208,7 @@ nlohmann::json run_paper_tables(const PaperOptions& opts) {
   }
   nlohmann::json j;
   j["scale"] = opts.scale;
-  j["configuration"] = opts.set;
+  j["configuration"] = paper_settings(opts);
   j["entries"] = entries;
   return j;
 }
@@ -222,6 +240,7 @@ const std::vector<TextColumn>& text_columns(int table) {
       {"mb_s_total", "total", 6, 0},
       {"cycles_per_packet", "cyc/pkt", 8, 1},
       {"mrays_per_s", "Mrays/s", 8, 2},
+      {"shading_bytes_per_pixel", "B/px", 6, 1},
   };
   return table == 3 ? t3 : t4;
 }
@@ -280,7 +299,8 @@ std::string paper_text(const nlohmann::json& result) {
     }
   }
   if (s.find("Table 4") != std::string::npos)
-    s += "shading bandwidth: the cycle model's RGS moves no memory yet (ratio 0)\n";
+    s += "shade: the RGS's shading-bank reads and frame-buffer writes (the paper's shading "
+         "bandwidth includes the frame buffer); B/px: both in bytes per pixel\n";
   return s;
 }
 
@@ -303,13 +323,13 @@ nlohmann::json run_thread_curve(const PaperOptions& opts) {
   check_options(opts);
   RenderSettings s = frame_settings("512x384", 0.0, false, 0, 4.0);
   s.res = {512 / opts.scale, 384 / opts.scale};
+  s.cycle.set = paper_settings(opts);
   progress("thread curve: loading builtin:room");
   const PreparedScene prep = prepare_scene("builtin:room", s);
   nlohmann::json rows = nlohmann::json::array();
   double first = 0.0, last = 0.0;
   for (int t = 1; t <= 64; t *= 2) {
     RenderSettings st = s;
-    st.cycle.set = opts.set;
     st.cycle.set.push_back("threads=" + std::to_string(t));
     progress("thread curve: " + std::to_string(t) + " threads");
     const FrameResult f = render_model(parse_model("cycle"), prep, st);

@@ -30,11 +30,19 @@ TEST(Paper, TablesHoldThePapersFigures) {
       {"fps", 30.6},
       {"usage", {{"traversal", 1}, {"list", 2}, {"transformation", 3}, {"intersection", 4}}},
       {"cache_hit", {{"traversal", 5}, {"list", 6}, {"transformation", 7}}},
-      {"bandwidth_mb_s", {{"dynrtc", 16}, {"shading", 0}, {"total", 16}}},
+      {"bandwidth_mb_s", {{"dynrtc", 16}, {"shading", 200}, {"frame_buffer", 40}, {"total", 256}}},
+      {"rgs", {{"shading_bytes_per_pixel", 33.5}}},
       {"cycles_per_packet", 30.0},
       {"rays_per_s", 12e6}};
   const std::vector<PaperFigure> f = table4_figures(cycle, "Scene6", 1024, 768);
-  ASSERT_EQ(f.size(), 13u);
+  ASSERT_EQ(f.size(), 14u);
+  EXPECT_STREQ(f[9].key, "mb_s_shading");
+  EXPECT_EQ(f[9].model, 240);  // shading reads + frame-buffer writes, as the paper's column
+  EXPECT_EQ(f[9].paper, 218);
+  // 218 MB/s at 15.3 fps of 1024x768 pixels: 19.0 bytes per pixel.
+  EXPECT_STREQ(f[13].key, "shading_bytes_per_pixel");
+  EXPECT_EQ(f[13].model, 33.5);
+  EXPECT_NEAR(f[13].paper, 218.0 * 1048576.0 / (15.3 * 1024 * 768), 1e-9);
   EXPECT_STREQ(f[0].key, "fps");
   EXPECT_EQ(f[0].model, 30.6);
   EXPECT_EQ(f[0].paper, 15.3);
@@ -97,7 +105,10 @@ TEST(Paper, RoomRowsBesideThePapers) {
   EXPECT_NE(text.find("  model builtin:room"), std::string::npos) << text;
   EXPECT_NE(text.find("  ratio model/paper"), std::string::npos) << text;
   const std::string csv = paper_csv(r);
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 + 13);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 + 14);
+  // The paper's setting: textures unfiltered, listed in the configuration.
+  EXPECT_EQ(r["configuration"][0], "image.bilinear=0");
+  EXPECT_GT(t4["figures"]["shading_bytes_per_pixel"]["model"].get<double>(), 16.0);
   EXPECT_NE(csv.find("4,Scene6,builtin:room,stand-in,64x48,usage_list,"), std::string::npos);
 }
 

@@ -62,28 +62,6 @@ int CycleUnit::deliver() {
   return moved;
 }
 
-bool CycleUnit::leave(ThreadToken t) {
-  const Request& next = threads_.request(t);
-  if (next.unit == UnitId::kNone) {
-    --inside_;
-    if (observer_ != nullptr) [[unlikely]]
-      observer_->left(now(), t);
-    retire(t);
-    return true;
-  }
-  ThreadPath* out = outputs_[unit_index(next.unit)];
-  if (out == nullptr)
-    throw std::logic_error(name() + ": no path to the " + unit_name(next.unit) + " unit");
-  if (!out->can_push()) return false;
-  out->push(t);
-  if (observer_ != nullptr) [[unlikely]] {
-    observer_->left(now(), t);
-    observer_->queued(now(), next.unit, t);
-  }
-  --inside_;
-  return true;
-}
-
 int CycleUnit::issue() {
   if (steps_left_ == 0) {
     ThreadToken t;

@@ -214,4 +214,27 @@ class CycleUnit : public hw::Module {
   hw::Counter* served_;
 };
 
+// (Inline: every unit's deliver() runs it for each thread it lets go.)
+inline bool CycleUnit::leave(ThreadToken t) {
+  const Request& next = threads_.request(t);
+  if (next.unit == UnitId::kNone) {
+    --inside_;
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->left(now(), t);
+    retire(t);
+    return true;
+  }
+  ThreadPath* out = outputs_[unit_index(next.unit)];
+  if (out == nullptr)
+    throw std::logic_error(name() + ": no path to the " + unit_name(next.unit) + " unit");
+  if (!out->can_push()) return false;
+  out->push(t);
+  if (observer_ != nullptr) [[unlikely]] {
+    observer_->left(now(), t);
+    observer_->queued(now(), next.unit, t);
+  }
+  --inside_;
+  return true;
+}
+
 }  // namespace saarcor::units

@@ -108,7 +108,8 @@ struct RgsPorts {
 // returning packets run their RGS phases and the finished packet frees its thread. An RGS request
 // that touches memory (the thread program lists its accesses: units/program_types.h RgsAccess)
 // keeps its thread: the shading-bank reads go out one per cycle on the shading port in dependent
-// waves (record and light, material, texels), the shading takes `depth` cycles after the last
+// waves (record and light, material, texels; a wave queues behind the reads already waiting and
+// goes out back to back), the shading takes `depth` cycles after the last
 // word arrived, then the finished pixels go to the frame port one word per cycle, and the thread
 // leaves (or is freed) as its last write goes out. A request without accesses takes `depth`
 // cycles after its issue cycle, as every unit's. The pipeline's threads are `count` consecutive
@@ -134,24 +135,25 @@ class RaySource : public CycleUnit {
   bool hold(ThreadToken thread) override;
 
  private:
-  // A thread the RGS keeps while its request's accesses are served.
+  // A thread the RGS keeps while its request's accesses are served. It waits in one of four
+  // FIFOs at a time: its wave's reads to issue (reading_), its shading (shading_, in order of
+  // `due`), its pixels to write (writing_), its path out (leaving_).
   struct Held {
-    enum class Stage : std::uint8_t { kReading, kShading, kWriting, kLeaving };
     std::vector<RgsAccess> access;  // the reads, then the writes (as the program lists them)
     std::size_t reads = 0;          // access[0, reads) are reads
     std::size_t next = 0;           // the next access to issue
     int outstanding = 0;            // reads issued and not answered
-    std::uint8_t wave = 0;          // the wave of the reads in flight
-    std::uint64_t due = 0;          // kShading: the cycle the shading is done
-    Stage stage = Stage::kReading;
+    std::uint64_t due = 0;          // the cycle its shading is done
   };
   Held& held(ThreadToken t) { return held_[t - first_]; }
   const Held& held(ThreadToken t) const { return held_[t - first_]; }
   int admit();
   int receive_shading();
-  int serve_held();
-  bool can_read(const Held& h) const {
-    return h.next < h.reads && (h.outstanding == 0 || h.access[h.next].wave == h.wave);
+  int issue_read();
+  int write_and_leave();
+  void shade(ThreadToken t, Held& h) {
+    h.due = now() + static_cast<std::uint64_t>(depth());
+    shading_.push_back(t);
   }
   void issue_access(memif::MemoryController::Port& port, std::uint16_t client, ThreadToken t,
                     Held& h);
@@ -163,8 +165,9 @@ class RaySource : public CycleUnit {
   Ring<ThreadToken> free_list_;
   int free_;
   RgsPorts ports_;
-  std::vector<Held> held_;           // by thread (minus first_)
-  std::vector<ThreadToken> active_;  // held threads, oldest first
+  std::vector<Held> held_;  // by thread (minus first_)
+  Ring<ThreadToken> reading_, shading_, writing_, leaving_;
+  int active_ = 0;  // held threads
   hw::Counter* retired_;
   hw::Counter* admitted_;
   hw::Counter* reads_;

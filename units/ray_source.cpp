@@ -19,7 +19,11 @@ RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
       free_list_(count),
       free_(count),
       ports_(ports),
-      held_(static_cast<std::size_t>(count)) {
+      held_(static_cast<std::size_t>(count)),
+      reading_(count),
+      shading_(count),
+      writing_(count),
+      leaving_(count) {
   has_extra_ = true;
   for (int i = 0; i < count; ++i)
     free_list_.push_back(first + static_cast<ThreadToken>(i));
@@ -65,18 +69,17 @@ bool RaySource::hold(ThreadToken thread) {
       h.access.begin());
   h.next = 0;
   h.outstanding = 0;
-  h.stage = Held::Stage::kReading;
-  if (h.reads == 0) {  // writes only: the colours are ready, shading done after the depth
-    h.stage = Held::Stage::kShading;
-    h.due = now() + static_cast<std::uint64_t>(depth());
-  }
-  active_.push_back(thread);
+  if (h.reads == 0)
+    shade(thread, h);  // writes only: the colours are ready, shading done after the depth
+  else
+    reading_.push_back(thread);
+  ++active_;
   return true;
 }
 
 int RaySource::extra() {
   int progress = 0;
-  if (!active_.empty()) progress += receive_shading() + serve_held();
+  if (active_ != 0) progress += receive_shading() + issue_read() + write_and_leave();
   return progress + admit();
 }
 
@@ -98,17 +101,19 @@ int RaySource::admit() {
   return 1;
 }
 
-// One shading-bank response per cycle (the port's width); the thread's last one starts its
-// shading, which is done `depth` cycles later.
+// One shading-bank response per cycle (the port's width). A thread's wave complete: its next
+// wave queues for the read port behind the reads already waiting; its last read starts its
+// shading, done `depth` cycles later.
 int RaySource::receive_shading() {
   auto& responses = ports_.shading->responses;
   if (!responses.can_pop()) return 0;
-  const memif::MemResponse r = responses.pop();
-  Held& h = held(r.tag);
-  --h.outstanding;
-  if (h.outstanding == 0 && h.next == h.reads) {
-    h.stage = Held::Stage::kShading;
-    h.due = now() + static_cast<std::uint64_t>(depth());
+  const auto t = static_cast<ThreadToken>(responses.pop().tag);
+  Held& h = held(t);
+  if (--h.outstanding == 0) {
+    if (h.next < h.reads)
+      reading_.push_back(t);
+    else
+      shade(t, h);
   }
   return 1;
 }
@@ -127,50 +132,51 @@ void RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t 
   port.requests.push(m);
 }
 
-// The held threads, oldest first: at most one read on the shading port and one write on the
-// frame port per cycle; a thread whose shading is done writes its pixels, then leaves.
-int RaySource::serve_held() {
+// One read per cycle on the shading port: the front thread's wave, back to back; a thread leaves
+// the queue at the end of its wave (the next one waits for this one's words).
+int RaySource::issue_read() {
+  if (reading_.empty() || !ports_.shading->requests.can_push()) return 0;
+  const ThreadToken t = reading_.front();
+  Held& h = held(t);
+  const std::uint8_t wave = h.access[h.next].wave;
+  ++h.outstanding;
+  issue_access(*ports_.shading, ports_.shading_client, t, h);
+  ++*reads_;
+  if (h.next == h.reads || h.access[h.next].wave != wave) reading_.pop_front();
+  return 1;
+}
+
+// Shading done: the thread's pixels go to the frame port, one word per cycle; a thread without
+// writes, or whose last write went out, leaves (or is freed) in that cycle, in order.
+int RaySource::write_and_leave() {
   int progress = 0;
-  bool read = !ports_.shading->requests.can_push(), wrote = !ports_.frame->requests.can_push();
-  for (std::size_t i = 0; i < active_.size();) {
-    const ThreadToken t = active_[i];
+  while (!shading_.empty() && held(shading_.front()).due <= now()) {
+    const ThreadToken t = shading_.front();
+    shading_.pop_front();
+    (held(t).next < held(t).access.size() ? writing_ : leaving_).push_back(t);
+  }
+  if (!writing_.empty() && ports_.frame->requests.can_push()) {
+    const ThreadToken t = writing_.front();
     Held& h = held(t);
-    if (h.stage == Held::Stage::kReading && !read && can_read(h)) {
-      h.wave = h.access[h.next].wave;
-      ++h.outstanding;
-      issue_access(*ports_.shading, ports_.shading_client, t, h);
-      ++*reads_;
-      read = true;
-      ++progress;
+    issue_access(*ports_.frame, ports_.frame_client, t, h);
+    ++*writes_;
+    ++progress;
+    if (h.next == h.access.size()) {
+      writing_.pop_front();
+      leaving_.push_back(t);
     }
-    if (h.stage == Held::Stage::kShading && h.due <= now())
-      h.stage = h.next < h.access.size() ? Held::Stage::kWriting : Held::Stage::kLeaving;
-    if (h.stage == Held::Stage::kWriting && !wrote) {
-      issue_access(*ports_.frame, ports_.frame_client, t, h);
-      ++*writes_;
-      wrote = true;
-      ++progress;
-      if (h.next == h.access.size()) h.stage = Held::Stage::kLeaving;
-    }
-    if (h.stage == Held::Stage::kLeaving && leave(t)) {
-      active_.erase(active_.begin() + static_cast<std::ptrdiff_t>(i));
-      ++progress;
-      continue;
-    }
-    ++i;
+  }
+  while (!leaving_.empty() && leave(leaving_.front())) {
+    leaving_.pop_front();
+    --active_;
+    ++progress;
   }
   return progress;
 }
 
 std::uint64_t RaySource::extra_wakeup(std::uint64_t now) const {
-  std::uint64_t t = hw::kNever;
-  for (const ThreadToken thread : active_) {
-    const Held& h = held(thread);
-    if (h.stage == Held::Stage::kShading)
-      t = std::min(t, std::max(now + 1, h.due));
-    else if (h.stage != Held::Stage::kReading || can_read(h))
-      return now + 1;
-  }
+  if (!reading_.empty() || !writing_.empty() || !leaving_.empty()) return now + 1;
+  std::uint64_t t = shading_.empty() ? hw::kNever : std::max(now + 1, held(shading_.front()).due);
   if (free_list_.empty() || !rgc_.packets_left(pipeline_, now)) return t;
   return std::min(t, rgc_.next_grant(pipeline_, now));
 }
