@@ -307,9 +307,10 @@ struct MaterialValues {
   double shine = 0.0;
   double transmittance = 0.0;
   double reflectivity = 0.0;
-  std::array<double, 9> key() const {
-    return {diffuse.x,  diffuse.y, diffuse.z,     specular.x,  specular.y,
-            specular.z, shine,     transmittance, reflectivity};
+  double ior = 0.0;  // as written; 0 where the file means none
+  std::array<double, 10> key() const {
+    return {diffuse.x,  diffuse.y, diffuse.z,     specular.x,   specular.y,
+            specular.z, shine,     transmittance, reflectivity, ior};
   }
 };
 struct MaterialSt {
@@ -591,7 +592,7 @@ class Parser {
     const double ks = number("fill Ks");
     m.values.shine = number("fill Shine");
     m.values.transmittance = number("fill T");
-    number("fill index of refraction");
+    m.values.ior = number("fill index of refraction");
     m.values.diffuse = rgb * kd;
     m.values.specular = glm::dvec3(ks);
     m.values.reflectivity = ks;
@@ -607,7 +608,7 @@ class Parser {
     m.values.specular = triple("fill material specular");
     m.values.shine = number("fill material Shine");
     m.values.transmittance = number("fill material T");
-    number("fill material index of refraction");
+    m.values.ior = number("fill material index of refraction");
     m.values.reflectivity = (m.values.specular.x + m.values.specular.y + m.values.specular.z) / 3.0;
     return m;
   }
@@ -1069,7 +1070,14 @@ class Loader {
     m.specular = glm::clamp(glm::vec3(v.specular), 0.0f, 1.0f);
     m.shininess = static_cast<float>(std::clamp(v.shine, 0.0, 255.0));
     m.reflectivity = static_cast<float>(std::clamp(v.reflectivity, 0.0, 1.0));
-    m.transparency = static_cast<float>(std::clamp(v.transmittance, 0.0, 1.0));
+    // NFF's T is the weight of the transmitted ray, bent by the index of refraction of the
+    // material's inside: a refraction ray (docs/shading.md section 7). BART writes an index of 0
+    // where none is meant (opaque materials, and the kitchen's 4 % transmittance); that, and an
+    // index outside 1/64..64, refracts with index 1: a straight ray.
+    m.transmission = static_cast<float>(std::clamp(v.transmittance, 0.0, 1.0));
+    m.refraction = m.transmission;
+    if (m.refraction > 0.0f)
+      m.ior = v.ior >= 1.0 / 64.0 && v.ior <= 64.0 ? static_cast<float>(v.ior) : 1.0f;
     m.metallic = 0.0f;
     m.roughness = 1.0f;
     const auto idx = static_cast<std::uint32_t>(scene_.materials.size());
@@ -1377,7 +1385,7 @@ class Loader {
   long detail_ = 0;
   int material_ = -1;  // index into materials_, -1 = none given yet
   std::vector<NamedMaterial> materials_;
-  std::map<std::array<double, 9>, int> material_index_;
+  std::map<std::array<double, 10>, int> material_index_;
   std::map<std::pair<int, int>, std::uint32_t> scene_material_;
   std::map<std::string, int> texture_index_;
   std::vector<ObjectBuild> builds_;

@@ -94,6 +94,11 @@ TEST(AffBart, KitchenHasTheManifestCounts) {
   EXPECT_DOUBLE_EQ(s.animation_seconds, 20.0);  // `a 0.0 20.0 800`
   EXPECT_EQ(s.skipped_primitives, 0u);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  // The glasses, the bowl and the dragon are glass (param_glass.aff: T 0.85, index 1.55).
+  int glass = 0;
+  for (const Material& m : s.materials)
+    glass += m.refraction == 0.85f && m.ior == 1.55f ? 1 : 0;
+  EXPECT_GT(glass, 0);
 }
 
 TEST(AffBart, KitchenStoolsAreOneSetOfObjectsInstancedFourTimes) {
@@ -360,14 +365,16 @@ TEST_F(AffFiles, StaticTransformIsTranslateRotateScale) {
   const Aabb b = world_bounds(s);
   EXPECT_FLOAT_EQ(b.lo.x, -1.0f);
   EXPECT_FLOAT_EQ(b.hi.y, 4.0f);
-  // fm: diffuse, specular, Shine, T; reflectivity = mean specular.
+  // fm: diffuse, specular, Shine, T, ior; reflectivity = mean specular; T refracts with ior.
   ASSERT_EQ(s.materials.size(), 1u);
   const Material& mat = s.materials[0];
   EXPECT_FLOAT_EQ(mat.base_color.r, 0.8f);
   EXPECT_FLOAT_EQ(mat.base_color.b, 0.1f);
   EXPECT_FLOAT_EQ(mat.specular.g, 0.5f);
   EXPECT_FLOAT_EQ(mat.shininess, 30.0f);
-  EXPECT_FLOAT_EQ(mat.transparency, 0.25f);
+  EXPECT_FLOAT_EQ(mat.transparency, 0.0f);
+  EXPECT_FLOAT_EQ(mat.refraction, 0.25f);
+  EXPECT_FLOAT_EQ(mat.ior, 1.5f);
   EXPECT_FLOAT_EQ(mat.reflectivity, 0.5f);
   EXPECT_TRUE(s.objects[0].normals.empty());
   EXPECT_TRUE(s.cameras.empty());
@@ -490,6 +497,29 @@ TEST_F(AffFiles, IncludesAreRelativeToTheIncludingFile) {
   for (const Instance& i : s.instances)
     if (s.nodes[i.id].name == "leaf.aff") leaf_y.push_back(i.object_to_world[3].y);
   EXPECT_EQ(leaf_y, (std::vector<double>{0.0, 5.0}));
+}
+
+// NFF's `f ... T index_of_refraction` (docs/aff.md, docs/scenes.md "Materials"): T is the weight
+// of the refraction ray, the index that of the material's inside; BART's 0 ("none") and indices
+// outside 1/64..64 refract with index 1 (a straight ray); materials differing only in the index
+// stay apart.
+TEST_F(AffFiles, TransmittanceRefractsWithTheIndexOfRefraction) {
+  const std::string root =
+      write("glass.aff", "f 1 1 1  0.1 0.2 40 0.7 1.33\n" + std::string(kTriangle) +
+                             "f 1 1 1  0.1 0.2 40 0.7 1.7\n" + kTriangle +
+                             "f 1 1 1  0.1 0.2 40 0.04 0\n" + kTriangle +
+                             "f 1 1 1  0.1 0.2 40 0 0\n" + kTriangle);
+  const Scene s = load_scene(root);
+  ASSERT_EQ(s.materials.size(), 4u);
+  EXPECT_FLOAT_EQ(s.materials[0].refraction, 0.7f);
+  EXPECT_FLOAT_EQ(s.materials[0].transmission, 0.7f);
+  EXPECT_FLOAT_EQ(s.materials[0].ior, 1.33f);
+  EXPECT_FLOAT_EQ(s.materials[0].transparency, 0.0f);
+  EXPECT_FLOAT_EQ(s.materials[0].reflectivity, 0.2f);  // Ks
+  EXPECT_FLOAT_EQ(s.materials[1].ior, 1.7f);
+  EXPECT_FLOAT_EQ(s.materials[2].refraction, 0.04f);
+  EXPECT_FLOAT_EQ(s.materials[2].ior, 1.0f);
+  EXPECT_FLOAT_EQ(s.materials[3].refraction, 0.0f);
 }
 
 TEST_F(AffFiles, MaterialStateDecidesWhetherAnIncludeIsShared) {

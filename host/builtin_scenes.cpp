@@ -727,10 +727,73 @@ Scene make_dynamic() {
   return s;
 }
 
+// ---- builtin:glass (refraction: a textured room, a glass sphere and a glass block) -------------
+
+// Glass as a glTF asset would give it (KHR_materials_transmission, KHR_materials_ior): a smooth
+// dielectric whose transmission factor becomes the refraction weight.
+std::uint32_t add_glass(Scene& s, const std::string& name, glm::vec3 tint, float transmission,
+                        float ior) {
+  Material m;
+  m.name = name;
+  m.base_color = glm::vec4(tint, 1.0f);
+  m.roughness = 0.05f;
+  m.transmission = transmission;
+  m.ior = ior;
+  derive_fixed_function_terms(m, false);
+  s.materials.push_back(m);
+  return static_cast<std::uint32_t>(s.materials.size() - 1);
+}
+
+Scene make_glass() {
+  Scene s;
+  const int checker = add_texture(s, "floor_checker", 32, [](int x, int y) {
+    return ((x / 4) + (y / 4)) % 2 ? glm::dvec3(0.20, 0.22, 0.30) : glm::dvec3(0.90, 0.88, 0.80);
+  });
+  const int stripes = add_texture(s, "wall_stripes", 32, [](int x, int) {
+    return (x / 4) % 2 ? glm::dvec3(0.85, 0.30, 0.20) : glm::dvec3(0.95, 0.90, 0.70);
+  });
+  const std::uint32_t floor_m = add_material(s, "floor", {1, 1, 1}, 0.0f, 0.6f, checker);
+  const std::uint32_t back_m = add_material(s, "back_wall", {1, 1, 1}, 0.0f, 1.0f, stripes);
+  const std::uint32_t wall_m = add_material(s, "wall", {0.75f, 0.80f, 0.85f}, 0.0f, 1.0f);
+  const std::uint32_t mirror_m = add_material(s, "mirror", {0.90f, 0.90f, 0.90f}, 1.0f, 0.05f);
+  const std::uint32_t post_m = add_material(s, "post", {0.20f, 0.65f, 0.25f}, 0.0f, 0.5f);
+  const std::uint32_t sphere_m = add_glass(s, "glass", {0.85f, 0.92f, 1.0f}, 0.9f, 1.5f);
+  const std::uint32_t block_m = add_glass(s, "crystal", {1.0f, 0.95f, 0.85f}, 0.85f, 1.7f);
+
+  MeshBuilder room("room");
+  const double w = 2.0, h = 2.5;  // the room spans [-2, 2] x [0, 2.5] x [-2, 2]
+  room.grid({-w, 0, w}, {2 * w, 0, 0}, {0, 0, -2 * w}, 4, 4, floor_m, {4, 4});  // 32
+  room.grid({-w, h, -w}, {2 * w, 0, 0}, {0, 0, 2 * w}, 1, 1, wall_m);           // ceiling, 2
+  room.grid({-w, 0, -w}, {2 * w, 0, 0}, {0, h, 0}, 1, 1, back_m, {3, 1});       // back, 2
+  room.grid({w, 0, w}, {-2 * w, 0, 0}, {0, h, 0}, 1, 1, wall_m);                // front, 2
+  room.grid({-w, 0, w}, {0, 0, -2 * w}, {0, h, 0}, 1, 1, wall_m);               // left, 2
+  room.grid({w, 0, -w}, {0, 0, 2 * w}, {0, h, 0}, 1, 1, wall_m);                // right, 2
+  // A mirror before the back wall, behind the block (2).
+  room.grid({0.4, 0.3, -w + 0.02}, {1.4, 0, 0}, {0, 1.5, 0}, 1, 1, mirror_m);
+  // A green post behind the sphere, seen through it; its foot below the floor, so no face lies
+  // in the floor's plane (40).
+  room.cylinder({-0.9, -0.05, -1.3}, {0, 1.65, 0}, 0.12, 10, post_m);
+  // The glass sphere (32 x 16: 960).
+  room.sphere({-0.5, 0.55, -0.2}, {0.55, 0.55, 0.55}, 32, 16, sphere_m);
+  add_instance(s, add_object(s, room), glm::dmat4(1.0), "room");
+  // A glass block: its own object, placed by a rotation and a non-uniform scale (12).
+  MeshBuilder block("block");
+  block.box({-0.5, 0.0, -0.5}, {0.5, 1.0, 0.5}, block_m);
+  // It stands a little above the floor: a face in the floor's plane would make the closest hit a
+  // tie that fp24 and binary32 break differently.
+  glm::dmat4 m = glm::translate(glm::dmat4(1.0), glm::dvec3(0.75, 0.02, 0.1));
+  m = glm::rotate(m, 0.6, glm::dvec3(0, 1, 0));
+  m = glm::scale(m, glm::dvec3(0.5, 0.9, 0.35));
+  add_instance(s, add_object(s, block), m, "block");
+  s.cameras.push_back(look_at({0.3, 1.4, 1.9}, {0.0, 0.5, -0.5}, "front"));
+  s.lights.push_back(light_at({0.0, 2.4, -0.6}, {0.95, 0.95, 0.9}));
+  return s;
+}
+
 }  // namespace
 
 std::vector<std::string> builtin_scene_names() {
-  return {"triangle", "cube", "room", "suncor", "terrain", "dynamic"};
+  return {"triangle", "cube", "room", "suncor", "terrain", "dynamic", "glass"};
 }
 
 Scene make_builtin_scene(const std::string& name) {
@@ -747,6 +810,8 @@ Scene make_builtin_scene(const std::string& name) {
     s = make_terrain();
   } else if (name == "dynamic") {
     s = make_dynamic();
+  } else if (name == "glass") {
+    s = make_glass();
   } else {
     std::string known;
     for (const std::string& n : builtin_scene_names())

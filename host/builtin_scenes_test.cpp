@@ -30,6 +30,7 @@ const Expected kBuiltins[] = {
     {"suncor", 33288, 187145136, 1, 5622, 0, 1},                           // SunCOR
     {"terrain", 1000000 + 36006 + 36008 + 36010, 10469866, 4, 264, 0, 1},  // Terrain
     {"dynamic", 39414 + 832 + 840, 52790, 3, 17, 16, 3},                   // Quake3-p
+    {"glass", 32 + 10 + 2 + 40 + 960 + 12, 1056, 2, 2, 0, 1},              // refraction
 };
 
 const Scene& cached(const std::string& name) {
@@ -75,7 +76,7 @@ TEST(BuiltinScenes, CountsMatchThePapersScenes) {
 }
 
 TEST(BuiltinScenes, SameNameSameScene) {
-  for (const char* name : {"room", "suncor", "dynamic"}) {
+  for (const char* name : {"room", "suncor", "dynamic", "glass"}) {
     SCOPED_TRACE(name);
     const Scene a = make_builtin_scene(name);
     const Scene& b = cached(name);
@@ -117,6 +118,26 @@ TEST(BuiltinScenes, DynamicMoversFollowTheirAnimation) {
         EXPECT_NEAR(s.instances[i].object_to_world[c][r], at0[i][c][r], 1e-9);
 }
 
+// builtin:glass: a glass sphere (ior 1.5) and a crystal block (ior 1.7) whose refraction weights
+// come from their transmission as a glTF asset's would (docs/scenes.md "Materials").
+TEST(BuiltinScenes, GlassHasTwoRefractiveMaterials) {
+  const Scene& s = cached("glass");
+  std::map<std::string, const Material*> by_name;
+  for (const Material& m : s.materials)
+    by_name[m.name] = &m;
+  ASSERT_TRUE(by_name.count("glass") && by_name.count("crystal"));
+  EXPECT_FLOAT_EQ(by_name["glass"]->refraction, 0.9f);
+  EXPECT_FLOAT_EQ(by_name["glass"]->ior, 1.5f);
+  EXPECT_FLOAT_EQ(by_name["crystal"]->refraction, 0.85f);
+  EXPECT_FLOAT_EQ(by_name["crystal"]->ior, 1.7f);
+  int refractive = 0;
+  for (const Material& m : s.materials)
+    refractive += m.refraction > 0.0f ? 1 : 0;
+  EXPECT_EQ(refractive, 2);
+  EXPECT_FLOAT_EQ(by_name["mirror"]->reflectivity, 0.95f);
+  EXPECT_EQ(s.textures.size(), 2u);
+}
+
 class BuiltinExport : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(BuiltinExport, ExportThenReloadGivesTheSameScene) {
@@ -138,6 +159,14 @@ TEST_P(BuiltinExport, ExportThenReloadGivesTheSameScene) {
   EXPECT_EQ(b.textures.size(), a.textures.size());
   EXPECT_DOUBLE_EQ(b.animation_seconds, a.animation_seconds);
   EXPECT_TRUE(b.warnings.empty());
+  // Materials, glass included (KHR_materials_transmission, KHR_materials_ior).
+  ASSERT_EQ(b.materials.size(), a.materials.size());
+  for (std::size_t m = 0; m < a.materials.size(); ++m) {
+    EXPECT_EQ(b.materials[m].transmission, a.materials[m].transmission) << a.materials[m].name;
+    EXPECT_EQ(b.materials[m].ior, a.materials[m].ior) << a.materials[m].name;
+    EXPECT_EQ(b.materials[m].refraction, a.materials[m].refraction) << a.materials[m].name;
+    EXPECT_EQ(b.materials[m].reflectivity, a.materials[m].reflectivity) << a.materials[m].name;
+  }
   for (std::size_t o = 0; o < a.objects.size(); ++o) {
     EXPECT_EQ(b.objects[o].positions, a.objects[o].positions);
     EXPECT_EQ(b.objects[o].triangles, a.objects[o].triangles);
@@ -175,7 +204,8 @@ TEST_P(BuiltinExport, ExportThenReloadGivesTheSameScene) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BuiltinExport,
-                         ::testing::Values("triangle", "cube", "room", "suncor", "dynamic"));
+                         ::testing::Values("triangle", "cube", "room", "suncor", "dynamic",
+                                           "glass"));
 
 TEST(BuiltinScenes, SuncorExportStaysSmall) {
   const auto path = std::filesystem::temp_directory_path() /

@@ -408,6 +408,15 @@ inline std::uint32_t fix8(float x) {
   return v >= 256.0 ? 256u : static_cast<std::uint32_t>(v);
 }
 
+// One child ray's origin: T_R = [D, n, D; O] on R'_o = (a, 0, b): (D*a + n*0) + (D*b + O).
+inline glm::vec3 child_origin(const glm::vec3& d, const glm::vec3& n, const glm::vec3& o, float a,
+                              float b) {
+  glm::vec3 r;
+  for (int i = 0; i < 3; ++i)
+    r[i] = (d[i] * a + n[i] * 0.0f) + (d[i] * b + o[i]);
+  return r;
+}
+
 struct ShadeLight {
   glm::vec3 position;
   std::uint32_t rgb;
@@ -427,9 +436,9 @@ class Shader {
       : scene_(scene),
         bank_(image.image.bank(memif::kShadingBank)),
         regs_(image.image.registers()),
+        format_(image.image.format()),
         params_(params) {
-    const auto& f = image.image.format();
-    epsilon_ = static_cast<float>(ff::decode(regs_.epsilon, f, ff::Subnormals::kFlush));
+    epsilon_ = to_float(regs_.epsilon);
     max_depth_ =
         params.max_depth >= 0 ? static_cast<std::uint32_t>(params.max_depth) : regs_.max_depth;
     if (host_scene.lights.size() != regs_.light_count)
@@ -499,8 +508,9 @@ class Shader {
                                         word(record + 3)};
     const memif::ShadingRecord sr = memif::decode_shading(rec_words);
     const std::uint32_t maddr = regs_.material_base + memif::kMaterialWords * sr.material;
-    const std::uint32_t mat_words[4] = {word(maddr), word(maddr + 1), word(maddr + 2),
-                                        word(maddr + 3)};
+    std::uint32_t mat_words[memif::kMaterialWords];
+    for (std::uint32_t i = 0; i < memif::kMaterialWords; ++i)
+      mat_words[i] = word(maddr + i);
     const MaterialRecord mat = memif::decode_material(mat_words);
     std::uint32_t base[3];
     for (int c = 0; c < 3; ++c)
@@ -560,30 +570,40 @@ class Shader {
     // Section 7: weights and children.
     const std::uint32_t kr = mat.reflectivity;
     const std::uint32_t kt = mat.transparency;
+    const std::uint32_t kf = mat.refraction;
     const std::uint32_t wl =
-        params_.secondary ? mul8(p.weight, 255u - std::min(255u, kr + kt)) : p.weight;
+        params_.secondary ? mul8(p.weight, 255u - std::min(255u, kr + kt + kf)) : p.weight;
     for (int c = 0; c < 3; ++c)
       sum[c] += wl * std::min(255u, acc[c]);
     if (!params_.secondary || p.depth >= max_depth_) return;
-    const std::uint32_t wr = mul8(p.weight, kr);
+    std::uint32_t wr = mul8(p.weight, kr);
     const std::uint32_t wt = mul8(p.weight, kt);
+    const std::uint32_t wf = mul8(p.weight, kf);
     const float e = epsilon_;
-    if (wr > 0) {
+    if (wf > 0) {
+      // The material's eta for the side the ray comes from: the back of a triangle is inside.
+      const float eta = to_float(hit.cos > 0.0f ? mat.eta_leave : mat.eta_enter);
       FloatRay child;
-      for (int r = 0; r < 3; ++r) {
-        child.origin[r] = (D[r] * (-e) + n[r] * 0.0f) + (D[r] * t + O[r]);
-        child.direction[r] = refl[r];
+      if (refract_float(D, n, eta, child.direction)) {
+        child.origin = child_origin(D, n, O, t, e);  // R'_o = (t, 0, e)
+        pending_.push_back(PendingRay{child, wf, p.depth + 1});
+      } else {
+        wr = std::min(255u, wr + wf);  // total internal reflection: the reflection ray takes it
       }
-      pending_.push_back(PendingRay{child, wr, p.depth + 1});
     }
+    if (wr > 0)
+      pending_.push_back(PendingRay{FloatRay{child_origin(D, n, O, -e, t), refl}, wr, p.depth + 1});
     if (wt > 0) {
       FloatRay child;
-      for (int r = 0; r < 3; ++r) {
-        child.origin[r] = (D[r] * e + n[r] * 0.0f) + (D[r] * t + O[r]);
+      child.origin = child_origin(D, n, O, e, t);
+      for (int r = 0; r < 3; ++r)
         child.direction[r] = (D[r] * 1.0f + n[r] * 0.0f) + (D[r] * 0.0f + 0.0f);
-      }
       pending_.push_back(PendingRay{child, wt, p.depth + 1});
     }
+  }
+
+  float to_float(std::uint32_t bits) const {
+    return static_cast<float>(ff::decode(bits, format_, ff::Subnormals::kFlush));
   }
 
   // Section 5: the texel colour (RGB8) at barycentrics (u, v), nearest or bilinear.
@@ -626,6 +646,7 @@ class Shader {
   const FloatScene& scene_;
   const std::vector<std::uint32_t>& bank_;
   const memif::FrameRegisters& regs_;
+  ff::Format format_;
   FloatParams params_;
   float epsilon_ = 0.0f;
   std::uint32_t max_depth_ = 0;
@@ -634,6 +655,20 @@ class Shader {
 };
 
 }  // namespace
+
+bool refract_float(const glm::vec3& d, const glm::vec3& n, float eta, glm::vec3& direction) {
+  const float nd = dot_t(n, d);
+  const float dd = dot_t(d, d);
+  const float nn = dot_t(n, n);
+  const float ec = eta * (-nd);
+  const float g = 1.0f - eta * eta;
+  const float radicand = g * (dd * nn) + ec * ec;
+  if (radicand < 0.0f) return false;
+  const float mu = (ec - std::sqrt(radicand)) / nn;
+  for (int r = 0; r < 3; ++r)
+    direction[r] = (d[r] * eta + n[r] * mu) + (d[r] * 0.0f + 0.0f);
+  return true;
+}
 
 FloatFrame render_float(const FloatScene& float_scene, const BuiltImage& image, const Scene& scene,
                         const FloatParams& params) {

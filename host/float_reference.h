@@ -152,6 +152,14 @@ FloatHit trace_float(const FloatScene& scene, const FloatRay& ray, float t_min =
 bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float t_min,
                              float t_best, float& t, float& u, float& v, float& cos);
 
+// The refracted direction (docs/shading.md section 7; DESIGN.md section 7 with the sign of D12) of
+// a ray with direction D at a surface whose normal n faces the ray, eta = n1 / n2, in binary32 in
+// the RGS's op order: c = -dot(n, D), mu = (eta*c - sqrt((1 - eta*eta)*(dot(D, D)*dot(n, n)) +
+// (eta*c)*(eta*c))) / dot(n, n), direction_r = (D_r*eta + n_r*mu) + (D_r*0 + 0), which has the
+// length of D. Neither vector needs unit length. Returns false (direction untouched) under total
+// internal reflection: a negative radicand.
+bool refract_float(const glm::vec3& d, const glm::vec3& n, float eta, glm::vec3& direction);
+
 // The primary ray of pixel (x, y) from T_init = [Cr, Cu, Cd; Cp] (host/primary_rays.h, DIGEST D8:
 // the host has folded scale and pixel-centre offset into the basis): origin Cp, direction
 // (Cr*x + Cu*y) + (Cd*1 + 0), in binary32.
@@ -166,7 +174,7 @@ std::vector<FloatRay> primary_rays(const PrimaryBasis32& camera, int width, int 
 struct FloatParams {
   bool shade = true;       // false: hit records only, the image stays black
   bool shadows = false;    // shadow rays towards every light
-  bool secondary = false;  // reflection and transparency rays up to the depth bound
+  bool secondary = false;  // reflection, transparency and refraction rays up to the depth bound
   int max_depth = -1;      // secondary-ray depth bound, -1 = FrameRegisters::max_depth
   InstanceStep instance_step = InstanceStep::kBinary64;  // render_float(image, ...) only
 };

@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -485,6 +487,149 @@ TEST(FloatShading, ReflectionWeightsAndDepthBound) {
     EXPECT_EQ(depth0.rgb[centre + static_cast<std::size_t>(c)],
               std::min(255u, (wl * local + 127u) / 255u));
   }
+}
+
+// A glass quad in the plane z = 0 seen at 60 degrees from the -y side (the centre pixel's ray
+// hits the origin), and a green wall at y = 2 that the quad's mirror image of the ray reaches.
+// `back`: the quad's winding is reversed, so the ray hits its back: it leaves glass (eta = ior).
+Scene glass_quad(bool back, float refraction, float reflectivity) {
+  Scene scene;
+  Object quad;
+  quad.name = "glass";
+  quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  quad.triangles = back ? std::vector<glm::uvec3>{{0, 2, 1}, {0, 3, 2}}
+                        : std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 3}};
+  quad.material = {0, 0};
+  mark_degenerate_triangles(quad);
+  Object wall;
+  wall.name = "wall";
+  wall.positions = {{-1, 2, 0.5f}, {1, 2, 0.5f}, {1, 2, 2}, {-1, 2, 2}};
+  wall.triangles = {{0, 1, 2}, {0, 2, 3}};
+  wall.material = {1, 1};
+  mark_degenerate_triangles(wall);
+  scene.objects = {quad, wall};
+  Instance a, b;
+  b.object = 1;
+  b.id = 1;
+  scene.instances = {a, b};
+  Material m;
+  m.name = "glass";
+  m.base_color = {0.8f, 0.8f, 0.9f, 1.0f};
+  m.refraction = refraction;
+  m.reflectivity = reflectivity;
+  m.ior = 1.5f;
+  Material g;
+  g.name = "green";
+  g.base_color = {0.1f, 0.9f, 0.2f, 1.0f};
+  scene.materials = {m, g};
+  Light l;
+  l.position = {0, 0, 4};
+  scene.lights.push_back(l);
+  Camera c;
+  c.position = {0.0f, -2.0f * std::sqrt(3.0f), 2.0f};  // 60 degrees from the quad's normal
+  c.forward = -glm::normalize(c.position);
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::vec3(0, 0, 1)), c.forward));
+  scene.cameras.push_back(c);
+  return scene;
+}
+
+std::array<std::uint8_t, 3> glass_quad_centre(bool back, float refraction, float reflectivity) {
+  const Scene s = glass_quad(back, refraction, reflectivity);
+  ImageParams ip;
+  ip.width = 9;
+  ip.height = 9;
+  ip.background_rgb = 0x808080u;
+  const BuiltImage image = build_image(s, ip);
+  FloatParams p;
+  p.secondary = true;
+  const FloatFrame f = render_float(image, s, p);
+  EXPECT_TRUE(f.at(4, 4).hit.hit());
+  EXPECT_EQ(f.at(4, 4).hit.instance, 0u);
+  const std::size_t c = 3 * (4 * 9 + 4);
+  return {f.rgb[c], f.rgb[c + 1], f.rgb[c + 2]};
+}
+
+// docs/shading.md section 7: a refraction ray takes the refraction weight; under total internal
+// reflection (leaving glass at 60 degrees, beyond the critical angle of 41.8 degrees) the
+// reflection ray takes it. Entering, the ray bends into the quad and misses everything (the
+// background, as a straight transparency ray would); leaving, the centre pixel shows the green
+// wall exactly as a mirror of the same weight does.
+TEST(FloatShading, RefractionAndTotalInternalReflection) {
+  const auto entering = glass_quad_centre(false, 0.6f, 0.0f);
+  const auto leaving = glass_quad_centre(true, 0.6f, 0.0f);
+  const auto mirror_front = glass_quad_centre(false, 0.0f, 0.6f);
+  const auto mirror_back = glass_quad_centre(true, 0.0f, 0.6f);
+  EXPECT_EQ(leaving, mirror_back);
+  EXPECT_NE(entering, mirror_front);  // the mirror sees the green wall, the refracted ray not
+  EXPECT_GT(mirror_back[1], mirror_back[0]);
+  // Entering: local colour plus the background with the refraction weight.
+  Scene s = glass_quad(false, 0.0f, 0.0f);
+  s.materials[0].transparency = 0.6f;  // a straight ray misses too: the same weights, colours
+  ImageParams ip;
+  ip.width = 9;
+  ip.height = 9;
+  ip.background_rgb = 0x808080u;
+  FloatParams p;
+  p.secondary = true;
+  const FloatFrame straight = render_float(build_image(s, ip), s, p);
+  const std::size_t c = 3 * (4 * 9 + 4);
+  EXPECT_EQ(entering, (std::array<std::uint8_t, 3>{straight.rgb[c], straight.rgb[c + 1],
+                                                   straight.rgb[c + 2]}));
+}
+
+// Snell's law in binary32 (refract_float, the float reference's refraction): for random
+// unnormalised D and n (n facing the ray) and eta in [0.4, 2.5], sin(theta_t) = eta sin(theta_i),
+// the refracted direction lies in the plane of incidence, crosses the surface and has the length
+// of D; total internal reflection is reported exactly when eta sin(theta_i) > 1 (away from it).
+TEST(FloatRefraction, SnellsLawInBinary32) {
+  std::mt19937_64 rng(0x5E11u);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(-3.0f, 3.0f), eta_d(0.4f, 2.5f);
+  const auto d3 = [](const glm::vec3& v) { return glm::dvec3(v); };
+  int refracted = 0, total = 0;
+  double worst_snell = 0.0, worst_plane = 0.0, worst_length = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    const float sd = std::exp2(len(rng)), sn = std::exp2(len(rng));
+    const glm::vec3 d(u(rng) * sd, u(rng) * sd, u(rng) * sd);
+    glm::vec3 n(u(rng) * sn, u(rng) * sn, u(rng) * sn);
+    const float eta = eta_d(rng);
+    if (!((n.x * d.x + n.y * d.y) + (n.z * d.z + 0.0f) < 0.0f)) n = -n;  // facing the ray
+    const glm::dvec3 D = d3(d), N = d3(n);
+    const double cos_i = -glm::dot(N, D) / std::sqrt(glm::dot(D, D) * glm::dot(N, N));
+    if (!(cos_i > 1e-3)) continue;
+    const double sin_i = std::sqrt(std::max(0.0, 1.0 - cos_i * cos_i));
+    const double want = eta * sin_i;
+    if (std::abs(want - 1.0) < 1e-5) continue;  // at the critical angle either answer is right
+    glm::vec3 t(7.0f);
+    const bool ok = refract_float(d, n, eta, t);
+    ASSERT_EQ(!ok, want > 1.0) << "eta " << eta << " sin_i " << sin_i;
+    if (!ok) {
+      EXPECT_EQ(t, glm::vec3(7.0f));  // untouched
+      ++total;
+      continue;
+    }
+    ++refracted;
+    const glm::dvec3 T = d3(t);
+    const double sin_t = glm::length(glm::cross(T, N)) / (glm::length(T) * glm::length(N));
+    const double cos_t = std::sqrt(std::max(0.0, 1.0 - want * want));
+    // binary32 rounds at 2^-24; near the critical angle the square root amplifies it.
+    const double snell = std::abs(sin_t - want) * std::min(1.0, cos_t / 1e-3);
+    EXPECT_LT(snell, 2e-6) << "eta " << eta << " sin_i " << sin_i;
+    worst_snell = std::max(worst_snell, snell);
+    const glm::dvec3 pn = glm::cross(D, N);
+    const double plane = std::abs(glm::dot(T, pn)) / (glm::length(T) * glm::length(pn));
+    EXPECT_LT(plane, 1e-6);
+    worst_plane = std::max(worst_plane, plane);
+    EXPECT_LT(glm::dot(T, N), 0.0) << "the refracted ray crosses the surface";
+    const double length = std::abs(glm::length(T) / glm::length(D) - 1.0);
+    EXPECT_LT(length * std::min(1.0, cos_t / 1e-3), 2e-6);
+    worst_length = std::max(worst_length, length);
+  }
+  EXPECT_GT(refracted, 5000);
+  EXPECT_GT(total, 1000);
+  std::printf(
+      "[ snell    ] binary32: %d refracted, %d totally reflected; worst |sin_t - eta "
+      "sin_i| %.2g, out of plane %.2g, |T|/|D| - 1 %.2g\n",
+      refracted, total, worst_snell, worst_plane, worst_length);
 }
 
 TEST(FloatShading, RefusesASceneWithOtherLights) {

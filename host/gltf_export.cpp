@@ -155,6 +155,7 @@ void export_gltf(const Scene& scene, const std::string& path) {
     tex.source = static_cast<int>(t);
     model.textures.push_back(tex);
   }
+  bool transmission_used = false, ior_used = false;
   for (const Material& m : scene.materials) {
     tinygltf::Material gm;
     gm.name = m.name;
@@ -165,8 +166,23 @@ void export_gltf(const Scene& scene, const std::string& path) {
     gm.pbrMetallicRoughness.baseColorTexture.index = m.texture;
     if (m.transparency > 0.0f) gm.alphaMode = "BLEND";
     gm.doubleSided = true;  // the hardware has no backface culling (DIGEST D13)
+    // Glass (docs/scenes.md "Materials"): the inputs the loader derives the refraction weight from.
+    if (m.transmission > 0.0f) {
+      tinygltf::Value::Object t;
+      t["transmissionFactor"] = tinygltf::Value(static_cast<double>(m.transmission));
+      gm.extensions["KHR_materials_transmission"] = tinygltf::Value(t);
+      transmission_used = true;
+    }
+    if (m.ior != 1.5f) {
+      tinygltf::Value::Object i;
+      i["ior"] = tinygltf::Value(static_cast<double>(m.ior));
+      gm.extensions["KHR_materials_ior"] = tinygltf::Value(i);
+      ior_used = true;
+    }
     model.materials.push_back(gm);
   }
+  if (transmission_used) model.extensionsUsed.push_back("KHR_materials_transmission");
+  if (ior_used) model.extensionsUsed.push_back("KHR_materials_ior");
 
   for (const Object& o : scene.objects) {
     tinygltf::Mesh mesh;

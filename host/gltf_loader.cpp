@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 
@@ -293,6 +294,36 @@ void compute_missing_normals(Object& obj, const std::vector<std::uint8_t>& missi
   }
 }
 
+// A number property of one of a material's extensions; nullopt when the extension, the property
+// or a number there is missing.
+std::optional<double> extension_number(const tinygltf::Material& gm, const char* extension,
+                                       const char* property) {
+  const auto e = gm.extensions.find(extension);
+  if (e == gm.extensions.end() || !e->second.Has(property)) return std::nullopt;
+  const tinygltf::Value& v = e->second.Get(property);
+  if (!v.IsNumber()) return std::nullopt;
+  return v.GetNumberAsDouble();
+}
+
+// Glass (docs/shading.md section 7, docs/scenes.md "Materials"): KHR_materials_transmission's
+// transmissionFactor and KHR_materials_ior's ior (glTF's 1.5 when absent). The transmission
+// texture is not read: the factor alone sets the refraction weight.
+void read_glass(const tinygltf::Material& gm, Material& mat, Scene& scene) {
+  if (const auto t = extension_number(gm, "KHR_materials_transmission", "transmissionFactor"))
+    mat.transmission = static_cast<float>(std::clamp(*t, 0.0, 1.0));
+  if (const auto e = gm.extensions.find("KHR_materials_transmission");
+      e != gm.extensions.end() && e->second.Has("transmissionTexture"))
+    scene.warn("material '" + mat.name +
+               "': transmissionTexture is not supported: transmissionFactor alone is used");
+  if (const auto ior = extension_number(gm, "KHR_materials_ior", "ior")) {
+    if (*ior >= 1.0 && *ior <= 64.0)
+      mat.ior = static_cast<float>(*ior);
+    else
+      scene.warn("material '" + mat.name + "': ior " + std::to_string(*ior) +
+                 " is outside 1..64: 1.5 is used");
+  }
+}
+
 Object convert_mesh(const tinygltf::Model& model, const Reader& reader, std::size_t mesh_index,
                     std::uint32_t default_material, bool& default_used, Scene& scene) {
   const tinygltf::Mesh& mesh = model.meshes[mesh_index];
@@ -502,7 +533,8 @@ Scene load_gltf(const std::string& path) {
   // unsupported *required* extension is refused; material and texture extensions only change
   // appearance, so they are ignored with a warning.
   const auto supported = [](const std::string& ext) {
-    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization";
+    return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" ||
+           ext == "KHR_materials_transmission" || ext == "KHR_materials_ior";
   };
   const auto cosmetic = [](const std::string& ext) {
     return ext.rfind("KHR_materials_", 0) == 0 || ext == "KHR_texture_transform";
@@ -569,6 +601,7 @@ Scene load_gltf(const std::string& path) {
                      ": TEXCOORD_0 is used instead");
       }
     }
+    read_glass(gm, mat, scene);
     derive_fixed_function_terms(mat, gm.alphaMode == "BLEND");
     scene.materials.push_back(std::move(mat));
   }

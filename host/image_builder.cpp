@@ -37,6 +37,17 @@ std::uint32_t rgb8(const glm::vec3& c) {
   return to8(c.r) | (to8(c.g) << 8) | (to8(c.b) << 16);
 }
 
+// A refracting material's index of refraction: finite, within [1/64, 64] (both ratios stay far
+// inside every format's range; real media lie in 1..2.5).
+double ior_of(const Material& mat, std::size_t m) {
+  const double ior = mat.ior;
+  if (!(ior >= 1.0 / 64.0 && ior <= 64.0))
+    throw std::runtime_error("material " + std::to_string(m) + " (" + mat.name +
+                             ") has index of refraction " + std::to_string(ior) +
+                             "; expected 1/64..64");
+  return ior;
+}
+
 // Rounds v into f so that the result is <= v (outward rounding of a box's lower corner).
 std::uint32_t round_down(double v, const ff::Format& f) {
   const std::uint32_t e = ff::from_double(v, f, ff::Mode{});
@@ -567,6 +578,13 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
       }
       rec.reflectivity = to8(mat.reflectivity);
       rec.transparency = to8(mat.transparency);
+      rec.refraction = to8(mat.refraction);
+      if (rec.refraction > 0) {
+        // Both ratios rounded once from binary64, so the RGS selects one instead of dividing.
+        const double ior = ior_of(mat, m);
+        rec.eta_enter = ff::from_double(1.0 / ior, b.params.format, ff::Mode{});
+        rec.eta_leave = ff::from_double(ior, b.params.format, ff::Mode{});
+      }
     }
     rec.bilinear = b.params.bilinear;
     const auto w = memif::encode_material(rec);

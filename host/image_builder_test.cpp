@@ -332,8 +332,8 @@ TEST(ImageBuilder, BytesPerBankAccounting) {
     for (std::uint32_t w = end; w < b.image.bank_words(); ++w)
       ASSERT_EQ(b.image.word(3 + j, w), 0u) << "bank " << 3 + j << " word " << w;
   }
-  // Shading bank: 1 material, 1 light, 512 records, no texture.
-  EXPECT_EQ(b.stats.bytes_per_bank[2], 16u + 16u + 512u * 16u);
+  // Shading bank: 1 material (8 words), 1 light, 512 records, no texture.
+  EXPECT_EQ(b.stats.bytes_per_bank[2], 32u + 16u + 512u * 16u);
   EXPECT_EQ(b.stats.bytes_per_bank[0], 64u * 48u * 4u);
   EXPECT_EQ(full_upload_bytes(b), b.stats.scene_bytes() + b.stats.bytes_per_bank[2]);
 }
@@ -472,8 +472,8 @@ TEST(ImageBuilder, SceneThatDoesNotFitNamesBankAndOverflow) {
   EXPECT_NE(e2.find("scene does not fit: shading bank 2 needs 16.1 KB of 8.0 KB"),
             std::string::npos)
       << e2;
-  EXPECT_NE(e2.find("textures overflow by 8.1 KB = 8272 bytes"), std::string::npos) << e2;
-  // ... and by default halved until they fit: 2048 words hold 8 material, 4 light and 8 record
+  EXPECT_NE(e2.find("textures overflow by 8.1 KB = 8304 bytes"), std::string::npos) << e2;
+  // ... and by default halved until they fit: 2048 words hold 16 material, 4 light and 8 record
   // words, so 64x64 -> 32x64 (2048 texels, too many) -> 32x32.
   q.fit_textures = true;
   const BuiltImage fitted = build_image(t, q);
@@ -484,13 +484,42 @@ TEST(ImageBuilder, SceneThatDoesNotFitNamesBankAndOverflow) {
   EXPECT_EQ(dt.textures[0].width, 32u);
   EXPECT_EQ(dt.textures[0].height, 32u);
   EXPECT_EQ(dt.textures[0].texels[31 * 32 + 31], 0xFF336699u);
-  EXPECT_EQ(fitted.stats.bytes_per_bank[2], 4u * (20u + 1024u));
+  EXPECT_EQ(fitted.stats.bytes_per_bank[2], 4u * (28u + 1024u));
 
   // Frame buffer.
   ImageParams fb = small_params();
   fb.bank_words = 1000;
   const std::string e3 = error_of(few_triangles(), fb);
   EXPECT_NE(e3.find("frame buffer bank 0 needs"), std::string::npos) << e3;
+}
+
+// The material record's refraction words (memif/image_format.h): the weight, and both ratios of
+// the indices rounded once from binary64: 1 / ior on entering, ior on leaving. A material that
+// does not refract keeps them 0. An index outside 1/64..64 is refused.
+TEST(ImageBuilder, RefractionWeightAndEtas) {
+  Scene s = few_triangles();
+  s.materials[1].refraction = 0.8f;
+  s.materials[1].ior = 1.33f;
+  for (const ff::Format f : {ff::kFp24, ff::Format{7, 23}}) {
+    ImageParams p = small_params();
+    p.format = f;
+    const DecodedImage d = decode_image(build_image(s, p).image);
+    ASSERT_EQ(d.materials.size(), 2u);
+    const memif::MaterialRecord& m = d.materials[1];
+    EXPECT_EQ(m.refraction, 204u);  // 0.8 * 255
+    EXPECT_EQ(m.eta_enter, ff::from_double(1.0 / static_cast<double>(1.33f), f, ff::Mode{}));
+    EXPECT_EQ(m.eta_leave, ff::from_double(static_cast<double>(1.33f), f, ff::Mode{}));
+    EXPECT_NEAR(dec(m.eta_enter, f) * dec(m.eta_leave, f), 1.0, 2e-5);
+    EXPECT_EQ(d.materials[0].refraction, 0u);
+    EXPECT_EQ(d.materials[0].eta_enter, 0u);
+    EXPECT_EQ(d.materials[0].eta_leave, 0u);
+  }
+  for (const float bad : {0.0f, 100.0f, std::nanf("")}) {
+    s.materials[1].ior = bad;
+    EXPECT_NE(error_of(s, small_params()).find("material 1 (half) has index of refraction"),
+              std::string::npos)
+        << bad;
+  }
 }
 
 TEST(ImageBuilder, BadInputsGiveOneLineErrors) {
@@ -695,7 +724,7 @@ TEST(ImageBuilder, DuckRoundTrip) {
       EXPECT_EQ(d.shading[t].tex_u[k], std::lround((double(uv[k].x) - fu) * 4096.0)) << t;
   }
   EXPECT_EQ(b.stats.bytes_per_bank[2],
-            4u * (4u * d.materials.size() + 4u * d.lights.size() + 4u * 4212u + 512u * 512u));
+            4u * (8u * d.materials.size() + 4u * d.lights.size() + 4u * 4212u + 512u * 512u));
 }
 
 TEST(DecodeImage, CorruptImagesAreRefused) {

@@ -257,6 +257,9 @@ void derive_fixed_function_terms(Material& m, bool alpha_blend) {
   m.shininess = static_cast<float>(std::clamp(2.0 / (alpha * alpha) - 2.0, 1.0, 256.0));
   m.reflectivity = metal * (1.0f - rough);
   m.transparency = alpha_blend ? std::clamp(1.0f - m.base_color.a, 0.0f, 1.0f) : 0.0f;
+  // Transmission is the dielectric's share (KHR_materials_transmission: metals do not transmit),
+  // so reflectivity + refraction <= 1.
+  m.refraction = std::clamp(m.transmission, 0.0f, 1.0f) * (1.0f - metal);
 }
 
 Scene load_scene(const std::string& spec) {

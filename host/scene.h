@@ -36,6 +36,12 @@ struct Material {
   float shininess = 1.0f;
   float reflectivity = 0.0f;
   float transparency = 0.0f;
+  // Glass: glTF KHR_materials_transmission's transmissionFactor (an input, like metallic) and
+  // KHR_materials_ior's index of refraction of the material's inside (outside: 1, vacuum). The
+  // shader's refraction weight is derived from them (docs/shading.md section 7).
+  float transmission = 0.0f;
+  float ior = 1.5f;
+  float refraction = 0.0f;
 };
 
 // One object: a triangle mesh in its own coordinate space with its own bottom-level kd-tree.

@@ -260,6 +260,11 @@ TEST(GltfMaterials, MetallicRoughnessMapsToTheFixedFunctionTerms) {
   m.base_color.a = 0.25f;
   derive_fixed_function_terms(m, true);
   EXPECT_FLOAT_EQ(m.transparency, 0.75f);
+  EXPECT_FLOAT_EQ(m.refraction, 0.0f);
+  m.transmission = 0.9f;  // glass: the dielectric share transmits
+  m.metallic = 0.5f;
+  derive_fixed_function_terms(m, false);
+  EXPECT_FLOAT_EQ(m.refraction, 0.45f);
 }
 
 TEST(GltfAnimation, AnimatedTriangleRotatesAboutZ) {
@@ -714,6 +719,42 @@ TEST_F(BadGltf, UnsupportedRequiredExtensionIsRefused) {
           kTri, 4, "",
           R"(,"extensionsUsed":["KHR_materials_unlit"],"extensionsRequired":["KHR_materials_unlit"])")));
   EXPECT_TRUE(has_warning(s, "extension KHR_materials_unlit is not supported: ignored"));
+}
+
+// KHR_materials_transmission and KHR_materials_ior (docs/scenes.md "Materials"): the transmission
+// factor times (1 - metallic) is the refraction weight, ior the index of the material's inside
+// (1.5 when absent); both extensions are supported (no warning, may be required); a transmission
+// texture and an ior below 1 are reduced with a warning.
+TEST_F(BadGltf, TransmissionAndIorMapToRefraction) {
+  const std::string extra =
+      R"(,"materials":[)"
+      R"({"name":"water","pbrMetallicRoughness":{"metallicFactor":0.25},"extensions":{)"
+      R"("KHR_materials_transmission":{"transmissionFactor":0.8},"KHR_materials_ior":{"ior":1.33}}},)"
+      R"({"name":"glass","extensions":{"KHR_materials_transmission":{"transmissionFactor":1.0}}},)"
+      R"({"name":"odd","extensions":{"KHR_materials_transmission":{"transmissionFactor":2.0,)"
+      R"("transmissionTexture":{"index":0}},"KHR_materials_ior":{"ior":0.5}}},)"
+      R"({"name":"opaque"}],)"
+      R"("extensionsUsed":["KHR_materials_transmission","KHR_materials_ior"],)"
+      R"("extensionsRequired":["KHR_materials_transmission"])";
+  const Scene s = load_scene(write("glass.gltf", gltf(kTri, 4, "", extra)));
+  ASSERT_GE(s.materials.size(), 4u);
+  const Material& water = s.materials[0];
+  EXPECT_FLOAT_EQ(water.transmission, 0.8f);
+  EXPECT_FLOAT_EQ(water.refraction, 0.6f);  // 0.8 * (1 - 0.25): metals do not transmit
+  EXPECT_FLOAT_EQ(water.ior, 1.33f);
+  EXPECT_FLOAT_EQ(water.transparency, 0.0f);
+  EXPECT_FLOAT_EQ(s.materials[1].refraction, 0.0f);  // glTF's default metallic is 1
+  EXPECT_FLOAT_EQ(s.materials[1].transmission, 1.0f);
+  EXPECT_FLOAT_EQ(s.materials[1].ior, 1.5f);           // glTF's default
+  EXPECT_FLOAT_EQ(s.materials[2].transmission, 1.0f);  // clamped
+  EXPECT_FLOAT_EQ(s.materials[2].ior, 1.5f);
+  EXPECT_FLOAT_EQ(s.materials[3].transmission, 0.0f);
+  EXPECT_FLOAT_EQ(s.materials[3].refraction, 0.0f);
+  EXPECT_TRUE(has_warning(s, "material 'odd': ior 0.500000 is outside 1..64: 1.5 is used"));
+  EXPECT_TRUE(has_warning(
+      s, "material 'odd': transmissionTexture is not supported: transmissionFactor alone is used"));
+  for (const std::string& w : s.warnings)
+    EXPECT_EQ(w.find("is not supported: ignored"), std::string::npos) << w;
 }
 
 TEST_F(BadGltf, UnknownBuiltinListsTheKnownOnes) {

@@ -115,12 +115,20 @@ inline constexpr int kInstanceRows = 6;
 inline constexpr int kTriangleRows = 3;
 
 // ---- shading bank ---------------------------------------------------------------------------
-// Material record (4 words at material_base + 4*material):
+// Material record (kMaterialWords = 8 words at material_base + 8*material; a power of two, so
+// the RGS forms the address with a shift as for the 4-word records):
 //   w0 diffuse RGB8 (bits 0..23) | opacity A8 (24..31)
 //   w1 specular RGB8 | shininess exponent (24..31)
 //   w2 texture: word address of texel (0,0) in the shading bank, kNone = untextured
 //   w3 log2 texture width (0..3) | log2 height (4..7) | reflectivity 0..255 (8..15)
 //      | transparency 0..255 (16..23) | bit 24: bilinear filtering
+//   w4 refraction weight 0..255 (bits 0..7) | reserved, 0 (8..31)
+//   w5 eta on entering: 1 / ior (outside over inside; a float encoding of the image format)
+//   w6 eta on leaving: ior (inside over outside; a float encoding of the image format)
+//   w7 reserved, 0
+// A hit on the front of a triangle (D'z <= 0) enters the material, a hit on its back leaves it;
+// the host stores both ratios (rounded once from binary64), so the RGS selects one by the sign of
+// D'z instead of dividing. Both are 0 in a material that does not refract.
 // Texels: RGBA8, one word each, row-major, power-of-two sizes, wrap = repeat.
 struct MaterialRecord {
   std::uint32_t diffuse_rgba = 0xFFFFFFFFu;
@@ -131,13 +139,22 @@ struct MaterialRecord {
   std::uint32_t reflectivity = 0;
   std::uint32_t transparency = 0;
   bool bilinear = true;
+  std::uint32_t refraction = 0;  // weight of the refraction ray, 0..255
+  std::uint32_t eta_enter = 0;   // float encoding of 1 / ior
+  std::uint32_t eta_leave = 0;   // float encoding of ior
   friend bool operator==(const MaterialRecord&, const MaterialRecord&) = default;
 };
-inline constexpr int kMaterialWords = 4;
-inline std::array<std::uint32_t, 4> encode_material(const MaterialRecord& m) {
-  return {m.diffuse_rgba, m.specular_rgb_shininess, m.texture,
+inline constexpr int kMaterialWords = 8;
+inline std::array<std::uint32_t, kMaterialWords> encode_material(const MaterialRecord& m) {
+  return {m.diffuse_rgba,
+          m.specular_rgb_shininess,
+          m.texture,
           (m.log2_width & 15u) | ((m.log2_height & 15u) << 4) | ((m.reflectivity & 255u) << 8) |
-              ((m.transparency & 255u) << 16) | (m.bilinear ? (1u << 24) : 0u)};
+              ((m.transparency & 255u) << 16) | (m.bilinear ? (1u << 24) : 0u),
+          m.refraction & 255u,
+          m.eta_enter,
+          m.eta_leave,
+          0u};
 }
 inline MaterialRecord decode_material(const std::uint32_t* w) {
   MaterialRecord m;
@@ -149,6 +166,9 @@ inline MaterialRecord decode_material(const std::uint32_t* w) {
   m.reflectivity = (w[3] >> 8) & 255u;
   m.transparency = (w[3] >> 16) & 255u;
   m.bilinear = ((w[3] >> 24) & 1u) != 0;
+  m.refraction = w[4] & 255u;
+  m.eta_enter = w[5];
+  m.eta_leave = w[6];
   return m;
 }
 

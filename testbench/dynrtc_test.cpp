@@ -56,10 +56,30 @@ TEST_P(BitExact, CycleModelEqualsFunctionalModel) {
   expect_bit_exact(nearest, shaded, sc.spec + " nearest [" + shaded.name + "]");
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, BitExact, ::testing::Range(0, 27));
+INSTANTIATE_TEST_SUITE_P(Scenes, BitExact, ::testing::Range(0, 28));
 
 TEST(DynRtc, SceneCasesCoverEveryBuiltinAndModel) {
-  EXPECT_EQ(scene_cases().size(), 27u);  // 6 built-ins + 21 glTF files (MANIFEST glTF table)
+  EXPECT_EQ(scene_cases().size(), 28u);  // 7 built-ins + 21 glTF files (MANIFEST glTF table)
+}
+
+// Refraction (docs/shading.md section 7) with shadow, reflection and total internal reflection
+// rays on builtin:glass: bit-identical to the functional model with one DynRTP and with four, for
+// thread counts from 1 to 64 and packets of 1, 4 and 16 (refraction packets do not share an
+// origin, so they take 2P transformation steps), and every kind of ray is traced.
+TEST(DynRtc, RefractionOnGlassIsBitExact) {
+  const host::BuiltImage b = build("builtin:glass", kSanitized ? 16 : 32, kSanitized ? 12 : 24);
+  const std::vector<testing::Config> cases = {
+      {"p1-t1", {"threads=1"}, true},
+      {"p1-t4-packet1", {"threads=4", "packet=1"}, true},
+      {"p1-t64", {}, true},
+      {"p4-t2-packet16", {"pipelines=4", "threads=2", "packet=16"}, true},
+      {"p4-t16-random-lat", {"pipelines=4", "threads=16"}, true, 29},
+  };
+  for (const testing::Config& c : cases)
+    expect_bit_exact(b, c, std::string("glass [") + c.name + "]");
+  const FunctionalFrame fn = run_functional(b.image, testing::shading_of(cases[0]));
+  for (const RayKind k : {RayKind::kShadow, RayKind::kReflection, RayKind::kRefraction})
+    EXPECT_GT(fn.rays_issued[static_cast<std::size_t>(k)], 10u) << ray_kind_name(k);
 }
 
 // The evaluation order of modules changes no figure; with several DynRTPs too (the RGC's packet

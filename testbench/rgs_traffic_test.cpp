@@ -37,7 +37,7 @@ TEST(RgsTraffic, EveryPixelIsOneWordInTheBackBankAndTheImageIsReadFromIt) {
     const CycleFrame c = run_cycle(b.image, prototype_params());
     EXPECT_EQ(c.frame_bank, bank);
     EXPECT_EQ(stat(c, "dynrtp0.rgs.frame_writes"), pixels);
-    EXPECT_EQ(c.frame_bytes, 4u * pixels);
+    EXPECT_EQ(c.frame_bytes, 3u * pixels);  // RGB8: 3 bytes of each word counted (D36)
     EXPECT_EQ(c.frame.rgb, fn.rgb) << "bank " << bank;
     // The run wrote a copy: the caller's frame-buffer banks are still the builder's zeros.
     for (std::uint32_t i = 0; i < pixels; ++i)
@@ -57,7 +57,7 @@ TEST(RgsTraffic, HitSinkFrameReadsNoShadingDataAndWritesEveryPixel) {
   const CycleFrame c = run_cycle(b.image, prototype_params(), o);
   EXPECT_EQ(c.shading_bytes, 0u);
   EXPECT_EQ(c.figures.bw_shading, 0.0);
-  EXPECT_EQ(c.frame_bytes, 4u * 32 * 24);
+  EXPECT_EQ(c.frame_bytes, 3u * 32 * 24);
   EXPECT_GT(c.figures.bw_frame, 0.0);
   EXPECT_DOUBLE_EQ(c.figures.bw_total, c.figures.bw_dynrtc + c.figures.bw_frame);
 }

@@ -69,7 +69,7 @@ TEST_P(UnitVectorsOnScenes, EveryVectorIsTheDatapathsAnswer) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, UnitVectorsOnScenes, ::testing::Range(0, 27));
+INSTANTIATE_TEST_SUITE_P(Scenes, UnitVectorsOnScenes, ::testing::Range(0, 28));
 
 // With shadow and secondary rays the transformation unit also generates shadow, reflection and
 // transparency rays (the RGS's T, DESIGN.md section 7): those steps are vectors too.

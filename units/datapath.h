@@ -1,13 +1,13 @@
 // The DynRTC datapaths as pure functions (paper sections 2.1-2.3 and 3.1; DESIGN.md sections 5
 // and 7): the transformation step, the traversal step of one kd-node for a packet, the
 // unit-triangle intersection and its acceptance rules (DIGEST D13 plus the tie rule of
-// docs/shading.md section 3), and the slab clip of D29. Each takes the float unit (UnitFp) of the
-// hardware unit that owns the operators, so ops are counted per unit. The functional model and the
-// cycle model call these same functions; nothing here keeps state, so results cannot depend on
-// timing. `fp` is a UnitFp (counts every op) or a RawFp (the thread program, which counts each
-// step's ops in bulk). These are the paper's op order on encodings (the reference datapath); the
-// same steps on binary64 values, which the thread program takes where they decide, are in
-// units/fast_paths.h.
+// docs/shading.md section 3), the slab clip of D29, and the RGS FP helper's refraction factor. Each
+// takes the float unit (UnitFp) of the hardware unit that owns the operators, so ops are counted
+// per unit. The functional model and the cycle model call these same functions; nothing here keeps
+// state, so results cannot depend on timing. `fp` is a UnitFp (counts every op) or a RawFp (the
+// thread program, which counts each step's ops in bulk). These are the paper's op order on
+// encodings (the reference datapath); the same steps on binary64 values, which the thread program
+// takes where they decide, are in units/fast_paths.h.
 #pragma once
 
 #include <algorithm>
@@ -92,6 +92,34 @@ template <class F, class Fp>
 [[gnu::flatten]] inline F dot_step(const Fp& fp, const Vec3<F>& a, const Vec3<F>& b) {
   return fp.add(fp.add(fp.mul(a[0], b[0]), fp.mul(a[1], b[1])),
                 fp.add(fp.mul(a[2], b[2]), F::zero()));
+}
+
+// ---- RGS FP helper: the refraction factor (paper 2.2.2, DESIGN.md 7, D10, D12) ----------------
+// The paper generates a refracted ray from T_R = [D, N, D; O] and R' = ((t, 0, e), (-eta, mu, 0))
+// with mu = eta*c - sqrt(1 - eta^2 + (eta*c)^2), c = N.D: the textbook formula for a D that points
+// back to the viewer. With D the ray's direction, as in every other row of the table, and N the
+// normal facing the ray (as for reflection), c = -N.D (the cosine of incidence, >= 0) and the
+// refracted direction is eta*D + mu*N: R' = ((t, 0, e), (eta, mu, 0)), with eta = n1 / n2 (the
+// side the ray comes from over the side it enters). Neither D nor N is a unit vector (D9), so the
+// helper scales mu by |D| / |N|, which gives the refracted direction the length of D:
+//   mu = (eta*c - sqrt((1 - eta*eta)*(D.D * N.N) + (eta*c)^2)) / N.N,   c = -N.D
+// (for unit D and N exactly the paper's mu). A negative radicand is total internal reflection: no
+// refracted ray exists (a sign test). Inputs: N.D, D.D and N.N from the transformation unit's dot
+// products. 5 mul, 3 add, 1 sqrt, 1 div.
+template <class F>
+struct RefractionFactor {
+  F mu{};              // the refracted direction is eta*D + mu*N (NaN under total reflection)
+  bool total = false;  // total internal reflection: the radicand is < 0
+};
+template <class F, class Fp>
+inline RefractionFactor<F> refraction_factor(const Fp& fp, F eta, F nd, F dd, F nn) {
+  const F ec = fp.mul(eta, nd.neg());
+  const F g = fp.sub(F::one(), fp.mul(eta, eta));
+  const F radicand = fp.add(fp.mul(g, fp.mul(dd, nn)), fp.mul(ec, ec));
+  RefractionFactor<F> r;
+  r.total = is_neg_nonzero(radicand);
+  r.mu = fp.div(fp.sub(ec, fp.sqrt(radicand)), nn);
+  return r;
 }
 
 // ---- traversal unit (paper 3.1, DESIGN.md 5, DIGEST D27/D33) ---------------------------------

@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <initializer_list>
 #include <random>
 #include <vector>
@@ -82,6 +83,122 @@ TEST(RayGeneration, ShadowReflectionTransparency) {
   // Transparency: R' = ((e, 0, t), (1, 0, 0)) -> (O + t*D + e*D, D).
   expect_vec(transform_step(fp, tr, v3(0.25, 0, 5), true), 0, -0.25, 0, "transparency origin");
   expect_vec(transform_step(fp, tr, v3(1, 0, 0), false), 0, -1, 0, "transparency direction");
+}
+
+// Refraction (DESIGN.md 7 with the sign decided in D12): T_R = [D, N, D; O] on
+// R' = ((t, 0, e), (eta, mu, 0)) gives (O + t*D + e*D, eta*D + mu*N), N facing the ray.
+TEST(RayGeneration, Refraction) {
+  ff::OpCounts ops;
+  UnitFp<F> fp({}, &ops);
+  // A ray (1, -1, 0) at 45 degrees onto the floor y = 0 from (-5, 5, 0): t = 5, N = (0, 1, 0),
+  // e = 0.25, eta = 0.5. N.D = -1, D.D = 2, N.N = 1: eta*c = 0.5, the radicand
+  // (1 - 0.25)*2 + 0.25 = 1.75, mu = 0.5 - sqrt(1.75).
+  const Vec3<F> d = v3(1, -1, 0), n = v3(0, 1, 0), origin = v3(-5, 5, 0);
+  const Mat34<F> tr = columns(d, n, d, origin);
+  expect_vec(transform_step(fp, tr, v3(5, 0, 0.25), true), 0.25, -0.25, 0, "refraction origin");
+  ops = {};
+  const RefractionFactor<F> r =
+      refraction_factor(fp, f(0.5), dot_step(fp, n, d), dot_step(fp, d, d), dot_step(fp, n, n));
+  EXPECT_FALSE(r.total);
+  const F root = f(std::sqrt(1.75));  // sqrt(1.75) rounded once; 0.5 - root is exact
+  EXPECT_EQ(r.mu.bits, f(0.5 - root.to_double()).bits);
+  EXPECT_EQ(ops.mul, 9u + 5u);  // three dot products, then the helper's 5 mul, 3 add, sqrt, div
+  EXPECT_EQ(ops.add, 9u + 3u);
+  EXPECT_EQ(ops.sqrt, 1u);
+  EXPECT_EQ(ops.div, 1u);
+  // eta*D + mu*N = (0.5, -0.5 + mu, 0) = (0.5, -root, 0): |(0.5, -1.3229)| = sqrt(2) = |D|, and
+  // sin(theta_t) = 0.5 / sqrt(2) = eta * sin(45 degrees) (Snell).
+  const Vec3<F> dir = transform_step(fp, tr, Vec3<F>{f(0.5), r.mu, f(0)}, false);
+  expect_vec(dir, 0.5, -root.to_double(), 0, "refraction direction");
+  // Leaving glass (eta = 1.5) at 45 degrees is beyond the critical angle (41.8 degrees): the
+  // radicand (1 - 2.25)*2 + 2.25 = -0.25 is negative, total internal reflection.
+  EXPECT_TRUE(refraction_factor(fp, f(1.5), f(-1), f(2), f(1)).total);
+  // eta = 1 (no change of medium) leaves the direction alone: mu = (c - sqrt(c^2)) / N.N = 0.
+  const RefractionFactor<F> same = refraction_factor(fp, f(1), f(-1), f(2), f(1));
+  EXPECT_FALSE(same.total);
+  expect_vec(transform_step(fp, tr, Vec3<F>{f(1), same.mu, f(0)}, false), 1, -1, 0, "eta = 1");
+}
+
+using V64 = std::array<double, 3>;
+V64 cross64(const V64& a, const V64& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double dot64(const V64& a, const V64& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+V64 values(const Vec3<F>& v) {
+  return {v[0].to_double(), v[1].to_double(), v[2].to_double()};
+}
+
+// Worst deviations of the refracted directions from Snell's law, the plane of incidence and |D|.
+struct SnellWorst {
+  int refracted = 0, total = 0;
+  double snell = 0.0, plane = 0.0, length = 0.0;
+};
+
+// One refraction: total internal reflection exactly when eta sin(theta_i) > 1; otherwise the
+// direction's deviations, weighted near the critical angle (where the square root amplifies the
+// radicand's rounding) by cos(theta_t) / 0.01. fp24 rounds at 2^-17 = 7.6e-6.
+void check_refraction(const UnitFp<F>& fp, const Vec3<F>& d, const Vec3<F>& n, F eta,
+                      SnellWorst& w) {
+  const V64 D = values(d), N = values(n);
+  const double dd = dot64(D, D), nn = dot64(N, N);
+  const double cos_i = -dot64(N, D) / std::sqrt(dd * nn);
+  if (!(cos_i > 1e-3)) return;  // (nearly) grazing or degenerate: no meaningful angle
+  const double sin_i = std::sqrt(std::max(0.0, 1.0 - cos_i * cos_i));
+  const RefractionFactor<F> r =
+      refraction_factor(fp, eta, dot_step(fp, n, d), dot_step(fp, d, d), dot_step(fp, n, n));
+  const double want = eta.to_double() * sin_i;  // sin(theta_t)
+  if (std::abs(want - 1.0) < 1e-3) return;      // at the critical angle either answer is right
+  ASSERT_EQ(r.total, want > 1.0) << "eta " << eta.to_double() << " sin_i " << sin_i;
+  ++(r.total ? w.total : w.refracted);
+  if (r.total) return;
+  Mat34<F> tr{};
+  for (int i = 0; i < 3; ++i)
+    tr[i] = {d[i], n[i], d[i], F::zero()};
+  const V64 T = values(transform_step(fp, tr, Vec3<F>{eta, r.mu, f(0)}, false));
+  const double tt = dot64(T, T);
+  const V64 tn = cross64(T, N), pn = cross64(D, N);
+  const double weight = std::min(1.0, std::sqrt(std::max(0.0, 1.0 - want * want)) / 1e-2);
+  const double snell = std::abs(std::sqrt(dot64(tn, tn) / (tt * nn)) - want) * weight;
+  const double plane = std::abs(dot64(T, pn)) / std::sqrt(tt * dot64(pn, pn));  // T . (D x N)
+  const double length = std::abs(std::sqrt(tt / dd) - 1.0) * weight;
+  EXPECT_LT(snell, 2e-4) << "eta " << eta.to_double() << " sin_i " << sin_i;
+  EXPECT_LT(plane, 1e-4);
+  EXPECT_LT(length, 2e-4);
+  EXPECT_LT(dot64(T, N), 0.0) << "the refracted ray crosses the surface";
+  w.snell = std::max(w.snell, snell);
+  w.plane = std::max(w.plane, plane);
+  w.length = std::max(w.length, length);
+}
+
+// Snell's law in fp24: for random unnormalised D and N (N facing the ray) and eta in [0.4, 2.5],
+// the refracted direction T = eta*D + mu*N satisfies sin(theta_t) = eta * sin(theta_i), lies in the
+// plane of D and N, goes through the surface (T.N < 0) and has the length of D; total internal
+// reflection is reported exactly when eta * sin(theta_i) > 1 (checked away from the boundary).
+TEST(Refraction, SnellsLawInFp24) {
+  UnitFp<F> fp;
+  std::mt19937_64 rng(0x5E11u);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), len(-3.0, 3.0), eta_d(0.4, 2.5);
+  SnellWorst w;
+  for (int k = 0; k < 20000; ++k) {
+    const double sd = std::exp2(len(rng)), sn = std::exp2(len(rng));
+    const Vec3<F> d{f(u(rng) * sd), f(u(rng) * sd), f(u(rng) * sd)};
+    Vec3<F> n{f(u(rng) * sn), f(u(rng) * sn), f(u(rng) * sn)};
+    const F eta = f(eta_d(rng));
+    if (!is_neg_nonzero(dot_step(fp, n, d))) {  // the RGS turns the normal to face the ray
+      for (F& x : n)
+        x = x.neg();
+    }
+    check_refraction(fp, d, n, eta, w);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+  EXPECT_GT(w.refracted, 5000);
+  EXPECT_GT(w.total, 1000);
+  std::printf(
+      "[ snell    ] fp24: %d refracted, %d totally reflected; worst |sin_t - eta sin_i| %.2g, "
+      "out of plane %.2g, |T|/|D| - 1 %.2g\n",
+      w.refracted, w.total, w.snell, w.plane, w.length);
 }
 
 TEST(TraversalLane, BothChildrenSplitTheSegmentAtD) {

@@ -43,7 +43,7 @@ struct FunctionalParams {
   bool reference_datapath = false;
   bool shade = true;       // run the RGS; false leaves the image black (hit records only)
   bool shadows = false;    // shadow rays (docs/shading.md 6.4); Table 3 setting: off
-  bool secondary = false;  // reflection and transparency rays; Table 3 setting: off
+  bool secondary = false;  // reflection, transparency and refraction rays; Table 3 setting: off
   int max_depth = -1;      // secondary-ray depth bound, -1 = FrameRegisters::max_depth
   ff::Mode mode{};         // rounding of every FP unit
 };
@@ -66,10 +66,17 @@ struct RayCounters {
   friend bool operator==(const RayCounters&, const RayCounters&) = default;
 };
 
-enum class RayKind : std::uint8_t { kPrimary = 0, kShadow = 1, kReflection = 2, kTransparency = 3 };
-inline constexpr int kRayKinds = 4;
+enum class RayKind : std::uint8_t {
+  kPrimary = 0,
+  kShadow = 1,
+  kReflection = 2,
+  kTransparency = 3,
+  kRefraction = 4,
+};
+inline constexpr int kRayKinds = 5;
 inline const char* ray_kind_name(RayKind k) {
-  constexpr const char* kNames[] = {"primary", "shadow", "reflection", "transparency"};
+  constexpr const char* kNames[] = {"primary", "shadow", "reflection", "transparency",
+                                    "refraction"};
   return kNames[static_cast<int>(k)];
 }
 
@@ -192,7 +199,7 @@ class UnitTap {
 };
 
 // The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is
-// DIGEST D10's optional shading helper (cosines: mul, sqrt, div).
+// DIGEST D10's optional shading helper (cosines: mul, sqrt, div; the refraction factor mu).
 template <class F>
 class PipelineUnits {
  public:

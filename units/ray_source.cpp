@@ -129,6 +129,7 @@ void RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t 
   m.write = a.write;
   m.offset = a.offset;
   m.data[0] = a.data;
+  if (a.write) m.counted_bytes = 3;  // a pixel's RGB8: 3 bytes of the word count (D36)
   port.requests.push(m);
 }
 

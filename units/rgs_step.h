@@ -4,10 +4,10 @@
 // packet returns (path g) it records primary hits, shades: the world normal through M^T, the
 // material and texture, ambient, per light a packet of shadow-ray directions through the
 // transformation unit and the cosines on the RGS FP helper (mul, sqrt, div), specular highlights,
-// then reflection and transparency children, traced last in, first out. Dot products and normals
-// run on the transformation unit and are counted there. Timing: units/ray_source.cpp (the RGC's
-// admission and the final hits); exact-cycle test: units/unit_timing_test.cpp
-// (UnitTimingRaySource.*).
+// then reflection, transparency and refraction children (the refraction factor mu on the RGS FP
+// helper too), traced last in, first out. Dot products and normals run on the transformation unit
+// and are counted there. Timing: units/ray_source.cpp (the RGC's admission and the final hits);
+// exact-cycle test: units/unit_timing_test.cpp (UnitTimingRaySource.*).
 #pragma once
 
 #include <algorithm>
@@ -360,62 +360,106 @@ class RgsStep {
     next_light(t);
   }
 
-  // Local colour into the pixel, then reflection and transparency children (D37).
+  // The child packets of one shaded packet: reflection, transparency, refraction.
+  struct Children {
+    std::array<GenPacket<F>*, 3> packet;
+    std::array<bool, 3> any{};
+  };
+
+  // Local colour into the pixel, then reflection, transparency and refraction children (D37).
   void finish_surface(State& t) {
-    // The children are built in the next two pending slots, whose lane vectors are kept from
+    // The children are built in the next three pending slots, whose lane vectors are kept from
     // earlier packets (no allocation per packet); the reflection packet is traced first.
-    if (pending_.size() < pending_size_ + 2) pending_.resize(pending_size_ + 2);
-    GenPacket<F>& transp = pending_[pending_size_];
-    GenPacket<F>& refl = pending_[pending_size_ + 1];
-    refl.kind = RayKind::kReflection;
-    transp.kind = RayKind::kTransparency;
-    refl.depth = transp.depth = t.depth + 1;
-    refl.shared_origin = transp.shared_origin = false;
-    refl.lanes.assign(t.lanes.size(), GenLane<F>{});
-    transp.lanes.assign(t.lanes.size(), GenLane<F>{});
-    bool any_refl = false, any_transp = false;
+    if (pending_.size() < pending_size_ + 3) pending_.resize(pending_size_ + 3);
+    Children ch{&pending_[pending_size_ + 2], &pending_[pending_size_ + 1],
+                &pending_[pending_size_]};
+    const RayKind kinds[3] = {RayKind::kReflection, RayKind::kTransparency, RayKind::kRefraction};
+    for (int k = 0; k < 3; ++k) {
+      GenPacket<F>& pk = *ch.packet[k];
+      pk.kind = kinds[k];
+      pk.depth = t.depth + 1;
+      pk.shared_origin = false;
+      pk.lanes.assign(t.lanes.size(), GenLane<F>{});
+    }
     for (int i = 0; i < t.p; ++i) {
       const Surface& s = surf_[static_cast<std::size_t>(i)];
-      if (s.hit)
-        finish_lane(t, s, refl.lanes[static_cast<std::size_t>(i)],
-                    transp.lanes[static_cast<std::size_t>(i)], any_refl, any_transp);
+      if (s.hit) finish_lane(t, s, static_cast<std::size_t>(i), ch);
     }
-    if (any_transp) ++pending_size_;
-    if (any_refl) {
-      if (!any_transp) std::swap(transp, refl);
+    // Keep the packets that have rays, bottom to top: refraction, transparency, reflection.
+    const std::size_t first = pending_size_;
+    for (int k = 2; k >= 0; --k) {
+      if (!ch.any[k]) continue;
+      const std::size_t slot = first + static_cast<std::size_t>(2 - k);
+      if (slot != pending_size_) std::swap(pending_[slot], pending_[pending_size_]);
       ++pending_size_;
     }
     next_packet(t);
   }
 
-  // One hit's local colour, weighted by what its children leave, and its children's lanes.
-  void finish_lane(State& t, const Surface& s, GenLane<F>& refl, GenLane<F>& transp, bool& any_refl,
-                   bool& any_transp) {
+  // One hit's local colour, weighted by what its children take, and its children's lanes. At the
+  // depth bound the children's weights are lost (docs/shading.md section 7).
+  void finish_lane(State& t, const Surface& s, std::size_t i, Children& ch) {
     Rgb8 local{};
     for (int k = 0; k < 3; ++k)
       local[k] = std::min<std::uint32_t>(255u, s.acc[k]);
-    const bool spawn = t.params.secondary && t.depth < max_depth_;
-    const std::uint32_t kr = spawn ? s.mat.reflectivity : 0u;
-    const std::uint32_t kt = spawn ? s.mat.transparency : 0u;
+    const std::uint32_t kr = s.mat.reflectivity, kt = s.mat.transparency;
+    const std::uint32_t kf = s.mat.refraction;
     const std::uint32_t wl =
-        t.params.secondary ? mul8(s.weight, 255u - std::min(255u, kr + kt)) : s.weight;
+        t.params.secondary ? mul8(s.weight, 255u - std::min(255u, kr + kt + kf)) : s.weight;
     add_colour(t, s.pixel, wl, local);
-    const std::uint32_t wr = mul8(s.weight, kr), wt = mul8(s.weight, kt);
+    if (!t.params.secondary || t.depth >= max_depth_) return;
+    std::uint32_t wr = mul8(s.weight, kr);
+    const std::uint32_t wt = mul8(s.weight, kt), wf = mul8(s.weight, kf);
     const Mat34<F> tr = reflect_matrix(s.ray, s.n);
+    F kk = s.kk;
+    if (wf > 0) {
+      const Refracted r = refract(t, s);
+      if (r.total) {
+        // Total internal reflection: the refracted share is reflected, on the reflection ray.
+        wr = std::min(255u, wr + wf);
+        if (kr == 0 && !s.spec) kk = twice_quotient(t, r.nd, s.nn);  // not made by surface()
+      } else {
+        ch.packet[2]->lanes[i] = {
+            true, s.pixel, wf, tr, {s.rec.t, F::zero(), epsilon_}, {r.eta, r.mu, F::zero()}};
+        ch.any[2] = true;
+      }
+    }
     if (wr > 0) {
-      refl = {true,
-              s.pixel,
-              wr,
-              tr,
-              {epsilon_.neg(), F::zero(), s.rec.t},
-              {F::one(), s.kk.neg(), F::zero()}};
-      any_refl = true;
+      ch.packet[0]->lanes[i] = {true,
+                                s.pixel,
+                                wr,
+                                tr,
+                                {epsilon_.neg(), F::zero(), s.rec.t},
+                                {F::one(), kk.neg(), F::zero()}};
+      ch.any[0] = true;
     }
     if (wt > 0) {
-      transp = {
+      ch.packet[1]->lanes[i] = {
           true, s.pixel, wt, tr, {epsilon_, F::zero(), s.rec.t}, {F::one(), F::zero(), F::zero()}};
-      any_transp = true;
+      ch.any[1] = true;
     }
+  }
+
+  // The refraction factor of one hit (DESIGN.md section 7, the sign of D12): N.D and D.D on the
+  // transformation unit (one step: rows N and D on D), mu on the RGS FP helper. eta is the
+  // material's ratio for the side the ray comes from: the back of a triangle (D'z > 0, the
+  // normal was turned to face the ray) is inside the material.
+  struct Refracted {
+    F eta{}, nd{}, mu{};
+    bool total = false;
+  };
+  static Refracted refract(State& t, const Surface& s) {
+    Refracted r;
+    r.eta = F::from_bits(is_pos_nonzero(s.rec.c) ? s.mat.eta_leave : s.mat.eta_enter);
+    r.nd = shade_dot(t, s.n, s.ray.d);
+    const F dd = shade_dot(t, s.ray.d, s.ray.d);
+    t.u.shading_transformation_steps += 1;
+    PipelineUnits<F>::count(t.u.rgs_ops, 3, 5, 1, 0);
+    ++t.u.rgs_ops.sqrt;
+    const RefractionFactor<F> f = refraction_factor(t.u.raw, r.eta, r.nd, dd, s.nn);
+    r.mu = f.mu;
+    r.total = f.total;
+    return r;
   }
 
   // The next child packet (last in, first out), or the thread is done.

@@ -54,8 +54,8 @@ inline memif::ShadingRecord read_shading_record(const memif::MemoryImage& image,
 inline memif::MaterialRecord read_material(const memif::MemoryImage& image,
                                            std::uint32_t material) {
   const std::uint32_t a = image.registers().material_base + memif::kMaterialWords * material;
-  std::array<std::uint32_t, 4> w{};
-  for (std::uint32_t i = 0; i < 4; ++i)
+  std::array<std::uint32_t, memif::kMaterialWords> w{};
+  for (std::uint32_t i = 0; i < memif::kMaterialWords; ++i)
     w[i] = image.word(memif::kShadingBank, a + i);
   return memif::decode_material(w.data());
 }
