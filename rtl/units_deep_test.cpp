@@ -1,5 +1,5 @@
 // Deep runs of the SystemVerilog unit datapaths (label "deep"; ctest --preset deep): every scene
-// of the covering design (testbench/dynrtc_testing.h: the six built-ins and 21 glTF models of
+// of the covering design (testbench/dynrtc_testing.h: the seven built-ins and 21 glTF models of
 // ../shared/scenes), 20,000 vectors per unit from a frame with shadow rays and secondary rays to
 // depth 2, each through the RTL against units/datapath.h and the file, bit for bit.
 #include <gtest/gtest.h>
@@ -24,6 +24,7 @@ constexpr Scene kScenes[] = {
     {"builtin:suncor", "4"},
     {"builtin:terrain", "32"},
     {"builtin:dynamic", "4"},
+    {"builtin:glass", "4"},
     {"Triangle/Triangle.gltf", "4"},
     {"TriangleWithoutIndices/TriangleWithoutIndices.gltf", "4"},
     {"Box/Box.gltf", "4"},
