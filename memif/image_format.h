@@ -121,7 +121,8 @@ inline constexpr int kTriangleRows = 3;
 //   w1 specular RGB8 | shininess exponent (24..31)
 //   w2 texture: word address of texel (0,0) in the shading bank, kNone = untextured
 //   w3 log2 texture width (0..3) | log2 height (4..7) | reflectivity 0..255 (8..15)
-//      | transparency 0..255 (16..23) | bit 24: bilinear filtering
+//      | transparency 0..255 (16..23) | bit 24: bilinear filtering | bit 25: refracts (w4..w6
+//      hold its refraction: the RGS reads w4..w7 only then)
 //   w4 refraction weight 0..255 (bits 0..7) | reserved, 0 (8..31)
 //   w5 eta on entering: 1 / ior (outside over inside; a float encoding of the image format)
 //   w6 eta on leaving: ior (inside over outside; a float encoding of the image format)
@@ -145,12 +146,15 @@ struct MaterialRecord {
   friend bool operator==(const MaterialRecord&, const MaterialRecord&) = default;
 };
 inline constexpr int kMaterialWords = 8;
+inline constexpr int kMaterialBaseWords = 4;                  // w0..w3, what every shaded hit needs
+inline constexpr std::uint32_t kMaterialRefracts = 1u << 25;  // w3: w4..w7 are needed
 inline std::array<std::uint32_t, kMaterialWords> encode_material(const MaterialRecord& m) {
   return {m.diffuse_rgba,
           m.specular_rgb_shininess,
           m.texture,
           (m.log2_width & 15u) | ((m.log2_height & 15u) << 4) | ((m.reflectivity & 255u) << 8) |
-              ((m.transparency & 255u) << 16) | (m.bilinear ? (1u << 24) : 0u),
+              ((m.transparency & 255u) << 16) | (m.bilinear ? (1u << 24) : 0u) |
+              ((m.refraction & 255u) != 0 ? kMaterialRefracts : 0u),
           m.refraction & 255u,
           m.eta_enter,
           m.eta_leave,

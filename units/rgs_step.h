@@ -256,8 +256,12 @@ class RgsStep {
     s.mat = read_material(t.image, rec.material);
     if (rec.material != material_) {  // the packet's hits mostly share a material: read once
       material_ = rec.material;
-      read(t.image.registers().material_base + memif::kMaterialWords * rec.material,
-           memif::kMaterialWords, 1);
+      // w0..w3; the refraction words only for a material w3 flags as refracting.
+      const std::uint32_t a =
+          t.image.registers().material_base + memif::kMaterialWords * rec.material;
+      read(a, memif::kMaterialBaseWords, 1);
+      if (s.mat.refraction != 0)
+        read(a + memif::kMaterialBaseWords, memif::kMaterialWords - memif::kMaterialBaseWords, 2);
     }
     s.base = base_colour(t.image, rec, s.mat, fix16(s.rec.u), fix16(s.rec.v),
                          [this](std::uint32_t a) { read(a, 1, 2); });
@@ -307,8 +311,9 @@ class RgsStep {
   void next_light(State& t) {
     const auto& regs = t.image.registers();
     if (light_ >= regs.light_count || surface_hit_mask(t) == 0) return finish_surface(t);
+    // The light's record: the RGS's on-chip light table, loaded with the frame (no shading-bank
+    // read per packet; docs/shading.md section 9).
     const std::uint32_t a = regs.light_base + memif::kLightWords * light_;
-    read(a, memif::kLightWords, 0);
     Vec3<F> pos;
     for (std::uint32_t k = 0; k < 3; ++k)
       pos[k] = F::from_bits(t.image.word(memif::kShadingBank, a + k));
