@@ -62,6 +62,21 @@ std::vector<memif::BankRange> frame_reads(const BuiltImage& b, int frame_bank) {
   return reads;
 }
 
+std::vector<memif::BankRange> data_words(const BuiltImage& b) {
+  std::vector<memif::BankRange> out;
+  const auto shading = static_cast<std::uint32_t>(b.stats.bytes_per_bank[memif::kShadingBank] / 4);
+  if (shading > 0) out.push_back({memif::kShadingBank, 0, shading, "shading data"});
+  const char* names[memif::kItemTypes] = {"kd-nodes", "list entries", "matrix rows"};
+  for (int j = 0; j < memif::kSceneBanks; ++j)
+    for (int t = 0; t < memif::kItemTypes; ++t) {
+      const memif::BankRange r =
+          item_words(b.image, static_cast<ItemType>(t), 0,
+                     b.image.regions().count[static_cast<std::size_t>(t)], j, names[t]);
+      if (r.end > r.begin) out.push_back(r);
+    }
+  return out;
+}
+
 std::vector<memif::UploadRun> changed_words(const memif::MemoryImage& before,
                                             const memif::MemoryImage& after) {
   if (before.bank_words() != after.bank_words())

@@ -21,6 +21,10 @@ namespace saarcor::host {
 // that is every data word.
 std::vector<memif::BankRange> frame_reads(const BuiltImage& built, int frame_bank);
 
+// Every data word of the shading and scene banks (what full_upload_bytes counts): the shading
+// bank's data and, in each scene bank, the words of its kd-nodes, list entries and matrix rows.
+std::vector<memif::BankRange> data_words(const BuiltImage& built);
+
 // The words of banks 2-5 (shading and scene data; the frame-buffer banks are the hardware's) in
 // which `after` differs from `before`, as runs of consecutive changed words, in bank and word
 // order. Throws std::runtime_error when the images' bank sizes differ.

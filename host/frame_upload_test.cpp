@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -206,6 +207,17 @@ TEST(FrameUpload, FrameReadsCoverTheImageButTheOtherCopy) {
   EXPECT_TRUE(in_reads(memif::kFrameBank1, 32 * 24 - 1, reads));
   EXPECT_FALSE(in_reads(memif::kFrameBank1, 32 * 24, reads));
   EXPECT_FALSE(in_reads(memif::kFrameBank0, 0, reads));
+  // The data words are what a full upload writes, and outside them every word is zero.
+  std::uint64_t words = 0;
+  memif::MemoryImage masked = im;
+  for (const memif::BankRange& r : data_words(b)) {
+    words += r.end - r.begin;
+    std::fill(masked.bank(r.bank).begin() + r.begin, masked.bank(r.bank).begin() + r.end, 0u);
+  }
+  EXPECT_EQ(4 * words, full_upload_bytes(b));
+  for (int bank = memif::kShadingBank; bank < memif::kNumBanks; ++bank)
+    EXPECT_TRUE(std::ranges::all_of(masked.bank(bank), [](std::uint32_t w) { return w == 0; }))
+        << "bank " << bank;
   memif::MemoryImage other(ff::kFp24, 1024);
   EXPECT_THROW(changed_words(im, other), std::runtime_error);
 }
