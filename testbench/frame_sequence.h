@@ -80,6 +80,9 @@ struct SequenceResult {
   std::uint64_t instances = 0, dynamic_instances = 0, objects = 0;
   std::uint64_t initial_load_bytes = 0;   // every data word of banks 2-5 and the registers
   std::uint64_t initial_load_cycles = 0;  // cycle model: over the bus, nothing rendering
+  // Scene-bank bytes of one top-level copy (its node and list slots and the instance records):
+  // what double buffering costs (the second copy).
+  std::uint64_t top_copy_bytes = 0;
   std::vector<SequenceFrame> frames;
   // The whole sequence on its clock: from frame 0's start to the last frame's end.
   std::uint64_t total_cycles() const;

@@ -136,6 +136,23 @@ TEST(FrameSequence, AnimatedGltfModelsThirtyFrames) {
   }
 }
 
+// Frame k after k incremental uploads into alternating top-level copies is the frame a fresh
+// image built at t_k gives (primary rays: the epsilon a sequence keeps from frame 0 plays no part).
+TEST(FrameSequence, EachFrameEqualsAFreshRenderAtItsTime) {
+  std::vector<Rgb8Image> images;
+  const SequenceResult r =
+      run_sequence("builtin:dynamic", parse_model("fp24"), small(32, 24), frames(4),
+                   [&](const SequenceFrame&, const Rgb8Image& image) { images.push_back(image); });
+  ASSERT_EQ(images.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    RenderSettings s = small(32, 24);
+    s.time = r.frames[k].time;
+    const FrameResult fresh =
+        render_model(parse_model("fp24"), prepare_scene("builtin:dynamic", s), s);
+    EXPECT_EQ(fresh.image.rgb, images[k].rgb) << "frame " << k;
+  }
+}
+
 TEST(FrameSequence, StaticSceneUploadsOnlyTheRegisters) {
   const SequenceResult r =
       run_sequence("builtin:room", parse_model("cycle"), small(16, 12), frames(3));
