@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "host/frame_upload.h"
 #include "host/tree_settings.h"
@@ -319,6 +320,7 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
   cur.top_rebuilt = true;  // frame 0: both levels built with the image
   cur.top_level_builds = host.stats.top_level_builds;
   cur.bottom_level_builds = host.stats.bottom_level_builds;
+  cur.host_rebuild_seconds = host.stats.top_build_seconds;
   for (int k = 0; k < opts.frames; ++k) {
     const auto t0 = Clock::now();
     // The swap: the registers the host sent latch, the frame buffers alternate.
@@ -358,6 +360,7 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
     cur.digest = digest(frame);
     cur.host_seconds = seconds_since(t0);
     if (sink) sink(cur, image_of(frame));
+    beat.beat("frame " + std::to_string(k + 1) + " / " + std::to_string(opts.frames) + " done");
     if (more && cycle) place(next.row, cur, gap_cycles);
     r.frames.push_back(cur);
     if (more) cur = next.row;
@@ -368,7 +371,7 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
 
 // ---- report ---------------------------------------------------------------------------------
 
-nlohmann::json sequence_json(const SequenceResult& r) {
+nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
   nlohmann::json j;
   j["scene"] = r.scene;
   j["model"] = r.model;
@@ -403,6 +406,7 @@ nlohmann::json sequence_json(const SequenceResult& r) {
                         {"upload_in_gap", f.gap},
                         {"rays", f.rays},
                         {"digest", f.digest}};
+    if (host_times) e["host_rebuild_ms"] = f.host_rebuild_seconds * 1e3;
     if (r.cycle) {
       e["upload_cycles"] = f.upload_cycles;
       e["upload_hidden"] = f.hidden;
@@ -473,9 +477,9 @@ std::string sequence_table(const SequenceResult& r) {
   s += "\n";
   if (r.cycle) {
     s += "frame  time s bank copy moved top bot  upload B  upload cyc hidden    stall  "
-         "render cyc    fps trav list xfrm  int  hit t  l  x\n";
+         "render cyc    fps trav list xfrm  int  hit t  l  x  rebuild ms\n";
   } else {
-    s += "frame  time s bank copy moved top bot  upload B  gap\n";
+    s += "frame  time s bank copy moved top bot  upload B  gap  rebuild ms\n";
   }
   for (const SequenceFrame& f : r.frames) {
     std::snprintf(buf, sizeof buf, "%5d %7.3f %4d %4d %5u %3" PRIu64 " %3" PRIu64 " ", f.index,
@@ -493,7 +497,7 @@ std::string sequence_table(const SequenceResult& r) {
                     f.stall_cycles);
       s += buf;
     } else {
-      std::snprintf(buf, sizeof buf, "%9" PRIu64 "  %s", f.upload_bytes, f.gap ? "yes" : "no");
+      std::snprintf(buf, sizeof buf, "%9" PRIu64 "  %-3s", f.upload_bytes, f.gap ? "yes" : "no");
       s += buf;
     }
     if (r.cycle) {
@@ -503,7 +507,9 @@ std::string sequence_table(const SequenceResult& r) {
                     f.hit[2]);
       s += buf;
     }
-    s += "\n";
+    // The host's top-level (re)build on this machine: not on the model's clock (D46).
+    std::snprintf(buf, sizeof buf, " %11.2f\n", f.host_rebuild_seconds * 1e3);
+    s += buf;
   }
   const nlohmann::json j = sequence_json(r);
   const nlohmann::json& sum = j["summary"];
@@ -685,6 +691,16 @@ SequenceOptions sequence_options(const RenderOptions& o) {
   return s;
 }
 
+// The shortest frame at the modelled clock (0 without a clock): what the host's rebuild, done
+// while the frame before renders, has to fit in.
+double shortest_frame_ms(const SequenceResult& r) {
+  if (!r.cycle || r.frames.empty()) return 0.0;
+  std::uint64_t c = r.frames.front().cycles;
+  for (const SequenceFrame& f : r.frames)
+    c = std::min(c, f.cycles);
+  return static_cast<double>(c) / (r.clock_mhz * 1e3);
+}
+
 std::string numbered(const std::string& prefix, int index) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "%04d", index);
@@ -774,7 +790,7 @@ int run_frame_sequence(const RenderOptions& opts) {
       ++written;
     };
     const SequenceResult r = run_sequence(opts.scene, model, settings, so, sink);
-    report = sequence_json(r);
+    report = sequence_json(r, !in_dir);  // a run folder keeps host times in host.json
     printout = sequence_table(r);
     csv = sequence_csv(r);
     nlohmann::json frames = nlohmann::json::array();
@@ -783,14 +799,15 @@ int run_frame_sequence(const RenderOptions& opts) {
       frames.push_back({{"frame", f.index},
                         {"rebuild_seconds", f.host_rebuild_seconds},
                         {"seconds", f.host_seconds}});
-      rebuild_max = std::max(rebuild_max, f.host_rebuild_seconds);
+      if (f.index > 0) rebuild_max = std::max(rebuild_max, f.host_rebuild_seconds);
     }
     host["per_frame"] = frames;
     host["top_level_rebuild_seconds_max"] = rebuild_max;
-    char buf[200];
+    char buf[300];
     std::snprintf(buf, sizeof buf,
-                  "  host: top-level rebuild at most %.2f ms per frame (this host)\n",
-                  rebuild_max * 1e3);
+                  "  host: top-level rebuild at most %.2f ms per frame after the first (this "
+                  "host; the shortest frame at the clock: %.2f ms)\n",
+                  rebuild_max * 1e3, shortest_frame_ms(r));
     printout += buf;
     outputs.push_back({"images", numbered(prefix, 0) + " .. " + numbered(prefix, written - 1)});
   }

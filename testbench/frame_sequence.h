@@ -108,9 +108,10 @@ SequenceResult run_sequence(const std::string& scene, const ModelSpec& model,
                             const RenderSettings& settings, const SequenceOptions& opts,
                             const FrameSink& sink = {});
 
-// The report (no host timing), the per-frame table and summary as printed, and the CSV of the
-// frames.
-nlohmann::json sequence_json(const SequenceResult& r);
+// The report (host timing only with host_times: each frame's top-level rebuild on this host, which
+// a run folder keeps in host.json), the per-frame table and summary as printed (with the host's
+// rebuild times), and the CSV of the frames (no host timing).
+nlohmann::json sequence_json(const SequenceResult& r, bool host_times = false);
 std::string sequence_table(const SequenceResult& r);
 std::string sequence_csv(const SequenceResult& r);
 
