@@ -805,10 +805,15 @@ int run_frame_sequence(const RenderOptions& opts) {
     host["top_level_rebuild_seconds_max"] = rebuild_max;
     char buf[300];
     std::snprintf(buf, sizeof buf,
-                  "  host: top-level rebuild at most %.2f ms per frame after the first (this "
-                  "host; the shortest frame at the clock: %.2f ms)\n",
-                  rebuild_max * 1e3, shortest_frame_ms(r));
+                  "  host: top-level rebuild at most %.2f ms per frame after the first (this host",
+                  rebuild_max * 1e3);
     printout += buf;
+    if (r.cycle) {
+      std::snprintf(buf, sizeof buf, "; the shortest frame at the clock: %.2f ms",
+                    shortest_frame_ms(r));
+      printout += buf;
+    }
+    printout += ")\n";
     outputs.push_back({"images", numbered(prefix, 0) + " .. " + numbered(prefix, written - 1)});
   }
   report["configuration"] = configuration(opts, settings, model.kind == ModelKind::kCycle);
