@@ -153,6 +153,20 @@ TEST(FrameSequence, EachFrameEqualsAFreshRenderAtItsTime) {
   }
 }
 
+// Every one of SunCOR's 5,622 instances moves every frame: the whole top level and every matrix
+// change, and the frames stay bit for bit the functional model's (this is where suncor-wind's
+// cycle-model frames are checked in CI; DynRtc's scene cases leave it to this test).
+TEST(FrameSequence, SuncorWindEveryInstanceMovesEveryFrame) {
+  const SequenceResult r =
+      run_sequence("builtin:suncor-wind", parse_model("cycle"), small(16, 12), frames(3));
+  expect_sequence_invariants(r);
+  for (std::size_t k = 1; k < 3; ++k) {
+    EXPECT_EQ(r.frames[k].moved_instances, 5622u);
+    EXPECT_GT(r.frames[k].upload_words * 4, 5622u * 36u);  // every matrix and the tree
+  }
+  EXPECT_GT(r.top_copy_bytes, 1u << 20);
+}
+
 TEST(FrameSequence, StaticSceneUploadsOnlyTheRegisters) {
   const SequenceResult r =
       run_sequence("builtin:room", parse_model("cycle"), small(16, 12), frames(3));
