@@ -430,6 +430,28 @@ Object make_sunflower(std::uint32_t seed_m, std::uint32_t petal_m, std::uint32_t
   return b.finish();
 }
 
+// SunCOR's field: 75 x 75 grid positions minus the last three, 5,622 sunflowers, each jittered,
+// turned and scaled.
+struct SunflowerPlace {
+  double x, z, yaw, scale;
+};
+std::vector<SunflowerPlace> sunflower_places() {
+  Rng rng(0x5C0Au);
+  const int side = 75;
+  const double spacing = 0.9;
+  std::vector<SunflowerPlace> out;
+  for (int i = 0; i < 5622; ++i) {
+    const int gx = i % side, gz = i / side;
+    SunflowerPlace f{};
+    f.x = (gx - side / 2) * spacing + rng.range(-0.3, 0.3);
+    f.z = -(gz * spacing) + rng.range(-0.3, 0.3);
+    f.yaw = rng.range(-0.5, 0.5);
+    f.scale = rng.range(0.8, 1.2);
+    out.push_back(f);
+  }
+  return out;
+}
+
 Scene make_suncor() {
   Scene s;
   const std::uint32_t seed_m = add_material(s, "seeds", {0.25f, 0.15f, 0.06f}, 0.0f, 0.9f);
@@ -437,23 +459,64 @@ Scene make_suncor() {
   const std::uint32_t stem_m = add_material(s, "stem", {0.20f, 0.45f, 0.12f}, 0.0f, 0.8f);
   const std::uint32_t leaf_m = add_material(s, "leaves", {0.15f, 0.55f, 0.10f}, 0.0f, 0.7f);
   s.objects.push_back(make_sunflower(seed_m, petal_m, stem_m, leaf_m));
-  // 75 x 75 grid positions minus the last three: 5,622 instances.
-  Rng rng(0x5C0Au);
-  const int side = 75;
-  const double spacing = 0.9;
-  for (int i = 0; i < 5622; ++i) {
-    const int gx = i % side, gz = i / side;
-    const double x = (gx - side / 2) * spacing + rng.range(-0.3, 0.3);
-    const double z = -(gz * spacing) + rng.range(-0.3, 0.3);
-    const double yaw = rng.range(-0.5, 0.5);
-    const double scale = rng.range(0.8, 1.2);
-    glm::dmat4 m = glm::translate(glm::dmat4(1.0), {x, 0.0, z});
-    m = glm::rotate(m, yaw, {0.0, 1.0, 0.0});
-    m = glm::scale(m, glm::dvec3(scale));
-    add_instance(s, 0, m, "sunflower" + std::to_string(i));
+  for (const SunflowerPlace& f : sunflower_places()) {
+    glm::dmat4 m = glm::translate(glm::dmat4(1.0), {f.x, 0.0, f.z});
+    m = glm::rotate(m, f.yaw, {0.0, 1.0, 0.0});
+    m = glm::scale(m, glm::dvec3(f.scale));
+    add_instance(s, 0, m, "sunflower" + std::to_string(s.instances.size()));
   }
   s.cameras.push_back(look_at({0.0, 3.5, 6.0}, {0.0, 0.5, -20.0}, "field"));
   s.lights.push_back(light_at({-30.0, 80.0, 40.0}, {1.0, 0.97, 0.9}));
+  return s;
+}
+
+// ---- builtin:suncor-wind (SunCOR's field with every instance moving) -------------------------
+
+// The same field in the wind: a gust runs through it along +x, each sunflower sways about its
+// base (a tilt of up to 0.12 rad about z, applied after its own yaw), one cycle every 4 s. Every
+// one of the 5,622 instances moves every frame: the top level's worst case (paper section 2: the
+// top-level index "must be rebuilt whenever any object moves").
+Scene make_suncor_wind() {
+  Scene s = make_suncor();
+  const std::vector<SunflowerPlace> places = sunflower_places();
+  const double period = 4.0;
+  const int keys = 17;
+  s.nodes.clear();
+  s.roots.clear();
+  s.instances.clear();
+  s.animations.reserve(places.size());
+  for (const SunflowerPlace& f : places) {
+    Node node;
+    node.name = "sunflower" + std::to_string(s.nodes.size());
+    node.object = 0;
+    node.use_trs = true;
+    node.animated = true;
+    node.translation = {f.x, 0.0, f.z};
+    node.scale = glm::dvec3(f.scale);
+    const int index = static_cast<int>(s.nodes.size());
+    const glm::dquat yaw = glm::angleAxis(f.yaw, glm::dvec3(0.0, 1.0, 0.0));
+    AnimChannel rot;
+    rot.node = index;
+    rot.path = AnimPath::kRotation;
+    for (int k = 0; k < keys; ++k) {
+      const double t = period * k / (keys - 1);
+      const double tilt = 0.12 * std::sin(2.0 * kPi * t / period - 0.15 * f.x);
+      const glm::dquat q = glm::angleAxis(tilt, glm::dvec3(0.0, 0.0, 1.0)) * yaw;
+      rot.times.push_back(t);
+      // binary32 keys, as a glTF file stores them: export and re-load are exact
+      rot.values.emplace_back(glm::dvec4(glm::vec4(glm::dvec4(q.x, q.y, q.z, q.w))));
+    }
+    node.rotation = glm::dquat(rot.values[0].w, rot.values[0].x, rot.values[0].y, rot.values[0].z);
+    s.nodes.push_back(node);
+    s.roots.push_back(index);
+    s.animations.push_back(std::move(rot));
+    Instance inst;
+    inst.object = 0;
+    inst.id = static_cast<std::uint32_t>(index);
+    inst.dynamic = true;
+    s.instances.push_back(inst);
+  }
+  s.animation_seconds = period;
   return s;
 }
 
@@ -793,7 +856,7 @@ Scene make_glass() {
 }  // namespace
 
 std::vector<std::string> builtin_scene_names() {
-  return {"triangle", "cube", "room", "suncor", "terrain", "dynamic", "glass"};
+  return {"triangle", "cube", "room", "suncor", "terrain", "dynamic", "glass", "suncor-wind"};
 }
 
 Scene make_builtin_scene(const std::string& name) {
@@ -812,6 +875,8 @@ Scene make_builtin_scene(const std::string& name) {
     s = make_dynamic();
   } else if (name == "glass") {
     s = make_glass();
+  } else if (name == "suncor-wind") {
+    s = make_suncor_wind();
   } else {
     std::string known;
     for (const std::string& n : builtin_scene_names())

@@ -31,6 +31,7 @@ const Expected kBuiltins[] = {
     {"terrain", 1000000 + 36006 + 36008 + 36010, 10469866, 4, 264, 0, 1},  // Terrain
     {"dynamic", 39414 + 832 + 840, 52790, 3, 17, 16, 3},                   // Quake3-p
     {"glass", 32 + 10 + 2 + 40 + 960 + 12, 1056, 2, 2, 0, 1},              // refraction
+    {"suncor-wind", 33288, 187145136, 1, 5622, 5622, 1},                   // SunCOR, all moving
 };
 
 const Scene& cached(const std::string& name) {
@@ -136,6 +137,31 @@ TEST(BuiltinScenes, GlassHasTwoRefractiveMaterials) {
   EXPECT_EQ(refractive, 2);
   EXPECT_FLOAT_EQ(by_name["mirror"]->reflectivity, 0.95f);
   EXPECT_EQ(s.textures.size(), 2u);
+}
+
+// Every sunflower sways about its own base, where SunCOR has it, by at most 0.12 rad.
+TEST(BuiltinScenes, SuncorWindMovesEveryInstanceAboutItsBase) {
+  const Scene& still = cached("suncor");
+  Scene s = cached("suncor-wind");
+  EXPECT_DOUBLE_EQ(s.animation_seconds, 4.0);
+  const auto up = [](const glm::dmat4& m) { return glm::normalize(glm::dvec3(m[1])); };
+  std::vector<glm::dmat4> at0;
+  for (const Instance& i : s.instances)
+    at0.push_back(i.object_to_world);
+  s.set_time(1.0);
+  double largest = 0.0;
+  for (std::size_t i = 0; i < s.instances.size(); ++i) {
+    const glm::dmat4& m = s.instances[i].object_to_world;
+    EXPECT_NE(m, at0[i]) << "sunflower " << i;
+    for (int r = 0; r < 3; ++r)
+      EXPECT_NEAR(m[3][r], still.instances[i].object_to_world[3][r], 1e-12);
+    const double tilt = std::acos(std::clamp(glm::dot(up(m), glm::dvec3(0, 1, 0)), -1.0, 1.0));
+    EXPECT_LE(tilt, 0.12 + 1e-6);
+    largest = std::max(largest, tilt);
+    EXPECT_NEAR(glm::length(glm::dvec3(m[1])),
+                glm::length(glm::dvec3(still.instances[i].object_to_world[1])), 1e-6);
+  }
+  EXPECT_GT(largest, 0.11);
 }
 
 class BuiltinExport : public ::testing::TestWithParam<const char*> {};

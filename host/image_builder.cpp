@@ -176,12 +176,26 @@ std::uint64_t stripe_words(std::uint64_t count, int item_words) {
 
 // ---- scene banks ---------------------------------------------------------------------------
 
+std::uint32_t top_copies(const BuiltImage& b) {
+  return b.params.top_level_buffers == 2 ? 2u : 1u;
+}
+
+// The registers name top-level copy b.top_buffer: its tree's root and its instance records.
+void name_top_copy(BuiltImage& b) {
+  memif::FrameRegisters& regs = b.image.registers();
+  regs.top_root = b.top_buffer * b.top_node_capacity;
+  regs.instance_row_base = b.top_buffer * static_cast<std::uint32_t>(memif::kInstanceRows) *
+                           static_cast<std::uint32_t>(b.instances.size());
+}
+
 // Assigns every node, list and row index and the region bases; throws when the banks overflow.
 void assign_scene_layout(BuiltImage& b) {
-  const std::uint64_t top_nodes = b.top_node_capacity;
-  const std::uint64_t top_lists = b.top_list_capacity;
+  const std::uint64_t copies = top_copies(b);
+  const std::uint64_t top_nodes = b.top_node_capacity * copies;
+  const std::uint64_t top_lists = b.top_list_capacity * copies;
   std::uint64_t nodes = top_nodes, lists = top_lists;
-  std::uint64_t rows = static_cast<std::uint64_t>(memif::kInstanceRows) * b.instances.size();
+  std::uint64_t rows =
+      static_cast<std::uint64_t>(memif::kInstanceRows) * b.instances.size() * copies;
   b.triangle_row_start = static_cast<std::uint32_t>(rows);
   std::uint64_t shading = 0;
   for (ObjectInfo& o : b.objects) {
@@ -224,13 +238,13 @@ void assign_scene_layout(BuiltImage& b) {
             static_cast<std::uint32_t>(node_words + list_words)};
   r.count = {static_cast<std::uint32_t>(nodes), static_cast<std::uint32_t>(lists),
              static_cast<std::uint32_t>(rows)};
-  b.image.registers().top_root = 0;
-  b.image.registers().instance_row_base = 0;
   b.image.registers().instance_count = static_cast<std::uint32_t>(b.instances.size());
+  name_top_copy(b);
 }
 
 void write_top_level(BuiltImage& b) {
-  put_tree(b.image, b.top, 0, 0, b.top.items);
+  put_tree(b.image, b.top, b.top_buffer * b.top_node_capacity, b.top_buffer * b.top_list_capacity,
+           b.top.items);
 }
 
 void write_instance_matrix(BuiltImage& b, std::size_t i) {
@@ -238,6 +252,15 @@ void write_instance_matrix(BuiltImage& b, std::size_t i) {
       b.image.registers().instance_row_base + static_cast<std::uint32_t>(memif::kInstanceRows * i);
   for (int r = 0; r < 3; ++r)
     put_row(b.image, r0 + r, b.instances[i].world_to_object_encoded[r]);
+}
+
+// The image's rows 0-2 of instance i (in the copy the registers name) hold its matrix already.
+bool instance_matrix_stored(const BuiltImage& b, std::size_t i) {
+  const std::uint32_t r0 =
+      b.image.registers().instance_row_base + static_cast<std::uint32_t>(memif::kInstanceRows * i);
+  for (std::uint32_t r = 0; r < 3; ++r)
+    if (b.image.row(r0 + r) != b.instances[i].world_to_object_encoded[r]) return false;
+  return true;
 }
 
 void write_instance(BuiltImage& b, std::size_t i) {
@@ -269,11 +292,19 @@ void write_scene_banks(BuiltImage& b) {
   // Reserved top-level slots hold empty leaves, so every node slot decodes to a valid node.
   memif::KdNode empty;
   empty.leaf = true;
-  for (std::uint32_t k = 0; k < b.top_node_capacity; ++k)
+  for (std::uint32_t k = 0; k < b.top_node_capacity * top_copies(b); ++k)
     put_node(b.image, k, empty);
-  write_top_level(b);
-  for (std::size_t i = 0; i < b.instances.size(); ++i)
-    write_instance(b, i);
+  // Every copy holds the whole top level, so either can serve a frame.
+  const std::uint32_t current = b.top_buffer;
+  for (std::uint32_t c = 0; c < top_copies(b); ++c) {
+    b.top_buffer = c;
+    name_top_copy(b);
+    write_top_level(b);
+    for (std::size_t i = 0; i < b.instances.size(); ++i)
+      write_instance(b, i);
+  }
+  b.top_buffer = current;
+  name_top_copy(b);
   const ff::Format& f = b.params.format;
   for (const ObjectInfo& o : b.objects) {
     if (!o.stored) continue;
@@ -299,11 +330,12 @@ void fill_scene_stats(BuiltImage& b) {
   }
   s.top_node_bytes = 8 * b.top.nodes.size();
   s.top_list_bytes = 4 * b.top.items.size();
-  s.reserved_bytes = 8 * (b.top_node_capacity - b.top.nodes.size()) +
-                     4 * (b.top_list_capacity - b.top.items.size());
-  s.bottom_node_bytes = 8 * (r.count[0] - std::uint64_t{b.top_node_capacity});
-  s.bottom_list_bytes = 4 * (r.count[1] - std::uint64_t{b.top_list_capacity});
-  s.instance_row_bytes = 4ull * rw * memif::kInstanceRows * b.instances.size();
+  const std::uint64_t copies = top_copies(b);
+  s.reserved_bytes = 8 * (b.top_node_capacity * copies - b.top.nodes.size()) +
+                     4 * (b.top_list_capacity * copies - b.top.items.size());
+  s.bottom_node_bytes = 8 * (r.count[0] - b.top_node_capacity * copies);
+  s.bottom_list_bytes = 4 * (r.count[1] - b.top_list_capacity * copies);
+  s.instance_row_bytes = 4ull * rw * memif::kInstanceRows * b.instances.size() * copies;
   s.triangle_row_bytes = 4ull * rw * (r.count[2] - std::uint64_t{b.triangle_row_start});
 }
 
@@ -329,6 +361,7 @@ void build_top_level(BuiltImage& b) {
       item = which.at(item);
   }
   b.stats.top_build_seconds = seconds_since(t0);
+  ++b.stats.top_level_builds;
 }
 
 void update_instance(BuiltImage& b, std::size_t i, const Instance& inst) {
@@ -477,6 +510,24 @@ std::uint16_t texcoord_4_12(double x, std::uint64_t& clamped) {
   return static_cast<std::uint16_t>(q);
 }
 
+// The light records (at light_base); returns how many of them changed.
+std::uint32_t write_lights(BuiltImage& b, const Scene& scene) {
+  auto& bank = b.image.bank(memif::kShadingBank);
+  std::uint32_t changed = 0;
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    const Light& L = scene.lights[l];
+    const std::size_t a = b.image.registers().light_base + memif::kLightWords * l;
+    std::array<std::uint32_t, memif::kLightWords> w{};
+    for (int k = 0; k < 3; ++k)
+      w[static_cast<std::size_t>(k)] =
+          ff::from_double(static_cast<double>(L.position[k]), b.params.format, ff::Mode{});
+    w[3] = rgb8(L.color);
+    if (!std::equal(w.begin(), w.end(), bank.begin() + static_cast<std::ptrdiff_t>(a))) ++changed;
+    std::copy(w.begin(), w.end(), bank.begin() + static_cast<std::ptrdiff_t>(a));
+  }
+  return changed;
+}
+
 void write_shading_bank(BuiltImage& b, const Scene& scene) {
   MemoryImage& im = b.image;
   memif::FrameRegisters& regs = im.registers();
@@ -591,15 +642,7 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
     std::copy(w.begin(), w.end(),
               bank.begin() + static_cast<std::ptrdiff_t>(memif::kMaterialWords * m));
   }
-  // Lights.
-  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
-    const Light& L = scene.lights[l];
-    const std::size_t a = regs.light_base + memif::kLightWords * l;
-    for (int k = 0; k < 3; ++k)
-      bank[a + static_cast<std::size_t>(k)] =
-          ff::from_double(static_cast<double>(L.position[k]), b.params.format, ff::Mode{});
-    bank[a + 3] = rgb8(L.color);
-  }
+  write_lights(b, scene);
   // Shading records: one per triangle slot of every stored object.
   for (std::size_t oi = 0; oi < b.objects.size(); ++oi) {
     const ObjectInfo& info = b.objects[oi];
@@ -677,6 +720,9 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
     throw std::runtime_error("top-level item cost factor " +
                              std::to_string(params.top_item_cost_factor) +
                              " must be positive and finite");
+  if (params.top_level_buffers != 1 && params.top_level_buffers != 2)
+    throw std::runtime_error("top-level copies " + std::to_string(params.top_level_buffers) +
+                             " must be 1 or 2 (double-buffered)");
   if (params.stack_entries < 2 || params.stack_entries > 4096)
     throw std::runtime_error("traversal stack of " + std::to_string(params.stack_entries) +
                              " entries is outside 2..4096");
@@ -751,6 +797,7 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
     }
     const double secs = seconds_since(t0);
     b.stats.bottom_build_seconds += secs;
+    ++b.stats.bottom_level_builds;
     ++b.stats.stored_objects;
     b.stats.triangle_slots += n;
     b.stats.dropped_triangles += info.dropped;
@@ -818,6 +865,10 @@ UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
                                std::to_string(scene.instances[i].id) +
                                ") has a singular, non-affine or out-of-range transform");
   }
+  if (scene.lights.size() != b.image.registers().light_count)
+    throw std::runtime_error(
+        "rebuild_top_level: the scene has " + std::to_string(scene.lights.size()) +
+        " lights, the image was built for " + std::to_string(b.image.registers().light_count));
   primary_basis(choose_camera(scene, b.params), b.params.width, b.params.height);
   UploadDelta d;
   std::vector<std::uint8_t> moved(b.instances.size(), 0);
@@ -828,6 +879,19 @@ UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
       moved[i] = 1;
       ++d.moved_instances;
     }
+  }
+  d.light_bytes = 4ull * memif::kLightWords * write_lights(b, scene);
+  d.register_bytes = sizeof(memif::FrameRegisters);
+  const bool two = top_copies(b) == 2;
+  if (two && d.moved_instances == 0) {
+    // Nothing the hardware reads of the top level changed: the copy in flight serves on.
+    d.top_rebuilt = false;
+    set_view_registers(b, scene);
+    return d;
+  }
+  if (two) {  // the frame in flight reads the other copy
+    b.top_buffer ^= 1u;
+    name_top_copy(b);
   }
   build_top_level(b);
   const int rw = ff::row_words(b.params.format);
@@ -844,15 +908,20 @@ UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
     d.relayout_bytes = b.stats.scene_bytes();
   } else {
     write_top_level(b);
-    for (std::size_t i = 0; i < b.instances.size(); ++i)
-      if (moved[i]) write_instance_matrix(b, i);
+    std::uint64_t rewritten = 0;
+    for (std::size_t i = 0; i < b.instances.size(); ++i) {
+      // The other copy holds the matrices of two frames ago: it needs every row that differs.
+      if (two ? !instance_matrix_stored(b, i) : moved[i] != 0) {
+        write_instance_matrix(b, i);
+        ++rewritten;
+      }
+    }
     fill_scene_stats(b);
     d.top_node_bytes = 8 * b.top.nodes.size();
     d.top_list_bytes = 4 * b.top.items.size();
-    d.instance_row_bytes = 4ull * rw * 3 * d.moved_instances;
+    d.instance_row_bytes = 4ull * rw * 3 * rewritten;
   }
   set_view_registers(b, scene);
-  d.register_bytes = sizeof(memif::FrameRegisters);
   return d;
 }
 

@@ -49,6 +49,10 @@ struct ImageParams {
   // Node and list slots reserved for the top-level tree, as a multiple of its first build, when
   // the scene has dynamic instances: a per-frame rebuild that fits needs no relayout.
   double top_level_headroom = 2.0;
+  // Copies of the top level (its tree, its lists, the instance records) in the scene banks: 1, or
+  // 2 for frame sequences, where the host writes the next frame's copy while the frame in flight
+  // reads the other (docs/frames.md, decisions D46). The registers name the current copy.
+  int top_level_buffers = 1;
   // Textures are resampled to power-of-two sizes of at most this many texels per side.
   std::uint32_t max_texture_size = 1024;
   // When the shading bank overflows, halve the largest texture until it fits (counted in
@@ -107,6 +111,10 @@ struct ImageStats {
   std::uint64_t texture_halvings = 0;    // halvings made to fit the shading bank
   double top_build_seconds = 0.0;
   double bottom_build_seconds = 0.0;  // all bottom-level trees
+  // Trees built since build_image began (the frame sequence counts rebuilds by their change):
+  // the top level once per build or rebuild, a bottom level once per stored object.
+  std::uint64_t top_level_builds = 0;
+  std::uint64_t bottom_level_builds = 0;
   std::uint64_t scene_bytes() const;  // words of the three scene banks holding data, x4
 };
 
@@ -119,8 +127,11 @@ struct BuiltImage {
   std::vector<InstanceInfo> instances;  // Scene::instances order = hit record instance index
   std::vector<ObjectInfo> objects;      // Scene::objects order
   ImageStats stats;
-  std::uint32_t top_node_capacity = 0;   // node slots 0 .. capacity-1 belong to the top level
-  std::uint32_t top_list_capacity = 0;   // list slots likewise
+  // Node slots 0 .. capacity-1 belong to the top level (copy c of top_level_buffers at c x
+  // capacity); list slots likewise; copy c's instance records start at row c x 6 x instances.
+  std::uint32_t top_node_capacity = 0;
+  std::uint32_t top_list_capacity = 0;
+  std::uint32_t top_buffer = 0;          // the copy the registers name (always 0 with one copy)
   std::uint32_t triangle_row_start = 0;  // first T_delta row (after the instance records)
 };
 
@@ -146,21 +157,30 @@ struct UploadDelta {
   std::uint64_t instance_row_bytes = 0;  // world -> object rows of moved instances (3 rows each)
   std::uint64_t register_bytes = 0;      // the frame registers (camera, bounds, ...)
   std::uint64_t relayout_bytes = 0;      // a full upload when the top level outgrew its capacity
+  std::uint64_t light_bytes = 0;         // light records of lights that moved (16 B each)
   std::uint32_t moved_instances = 0;
   bool relayout = false;
+  // False only with two top-level copies when no instance moved: the copy in flight serves the
+  // next frame too, and only the registers change.
+  bool top_rebuilt = true;
   std::uint64_t total() const {
-    return top_node_bytes + top_list_bytes + instance_row_bytes + register_bytes + relayout_bytes;
+    return top_node_bytes + top_list_bytes + instance_row_bytes + register_bytes + relayout_bytes +
+           light_bytes;
   }
 };
 
 // Re-evaluates the instances of `scene` (the same scene, its transforms at a new time): new
 // world -> object matrices, world bounds, a new top-level tree written into its reserved slots,
-// new scene bounds and camera registers. Bottom-level trees, triangle matrices and shading data
-// stay. When the new top-level tree outgrows the reserved slots the scene banks are laid out
-// again (relayout = true) and everything in them counts as uploaded. Throws, leaving `built`
-// unchanged, when `scene` does not have the same objects and instances as the one the image was
-// built from, or has a bad instance transform or camera; throws when a relayout does not fit the
-// banks (then `built` must be built again).
+// new scene bounds and camera registers, and the light records of lights that moved. Bottom-level
+// trees, triangle matrices and the rest of the shading data stay. With two top-level copies the
+// new tree and every instance's matrix go into the copy the registers do not name, and the
+// registers then name it (instance_row_bytes counts the instances whose rows that copy did not
+// hold yet); when no instance moved nothing is rebuilt (top_rebuilt = false). When the new
+// top-level tree outgrows the reserved slots the scene banks are laid out again (relayout = true)
+// and everything in them counts as uploaded. Throws, leaving `built` unchanged, when `scene` does
+// not have the same objects and instances as the one the image was built from, or has a bad
+// instance transform or camera; throws when a relayout does not fit the banks (then `built` must be
+// built again).
 UploadDelta rebuild_top_level(BuiltImage& built, const Scene& scene);
 
 // ---- reading an image back (tests, the functional model's tests) ------------------------------

@@ -36,13 +36,59 @@ HostBus::HostBus(hw::Kernel& kernel, std::string name, MemoryController& control
       &stats().counter(this->name() + ".bytes_uploaded", "bytes", "bytes sent over the host bus");
 }
 
-void HostBus::upload(int bank, std::uint32_t offset, const std::vector<std::uint32_t>& words) {
+void HostBus::check_protected(int bank, std::uint32_t offset, std::size_t words) const {
   if (bank < 0 || bank >= kNumBanks ||
-      static_cast<std::uint64_t>(offset) + words.size() > controller_.image().bank(bank).size()) {
-    throw std::runtime_error("host bus: upload of " + std::to_string(words.size()) +
-                             " words at bank " + std::to_string(bank) + " offset " +
-                             std::to_string(offset) + " lies outside the bank");
+      static_cast<std::uint64_t>(offset) + words > controller_.image().bank(bank).size()) {
+    throw std::runtime_error("host bus: upload of " + std::to_string(words) + " words at bank " +
+                             std::to_string(bank) + " offset " + std::to_string(offset) +
+                             " lies outside the bank");
   }
+  const std::uint64_t end = static_cast<std::uint64_t>(offset) + words;
+  for (const BankRange& r : protected_) {
+    if (r.bank != bank || words == 0 || end <= r.begin || offset >= r.end) continue;
+    throw std::runtime_error("host bus: upload of " + std::to_string(words) + " words at bank " +
+                             std::to_string(bank) + " words " + std::to_string(offset) + ".." +
+                             std::to_string(end - 1) + " overlaps " + r.what + " (bank " +
+                             std::to_string(r.bank) + " words " + std::to_string(r.begin) + ".." +
+                             std::to_string(r.end - 1) + "), which the frame in flight reads");
+  }
+}
+
+void HostBus::protect(std::vector<BankRange> ranges) {
+  protected_ = std::move(ranges);
+}
+
+void HostBus::upload(const HostUpload& u) {
+  protect(u.frame_reads);
+  for (const UploadRun& r : u.runs)  // all checked before anything is queued
+    check_protected(r.bank, r.offset, r.words.size());
+  for (const UploadRun& r : u.runs)
+    upload(r.bank, r.offset, r.words);
+  upload_registers(u.register_words);
+}
+
+void HostBus::upload_registers(std::uint32_t words) {
+  if (words == 0) return;
+  if (queue_.empty()) {
+    start_ = now();
+    spent_ = 0;
+  }
+  for (std::uint32_t i = 0; i < words;) {
+    Burst b{kRegisters, 0, 0, {}};
+    while (b.words < config_.burst_words && i < words) {
+      ++b.words;
+      ++i;
+    }
+    queue_.push_back(b);
+  }
+}
+
+bool HostBus::stored() const {
+  return queue_.empty() && controller_.client_bytes(client_) == sent_->value - register_sent_;
+}
+
+void HostBus::upload(int bank, std::uint32_t offset, const std::vector<std::uint32_t>& words) {
+  check_protected(bank, offset, words.size());
   if (queue_.empty()) {
     start_ = now();
     spent_ = 0;
@@ -66,6 +112,14 @@ std::uint64_t HostBus::earliest_send() const {
 
 int HostBus::evaluate() {
   if (queue_.empty() || now() < earliest_send()) return 0;
+  if (queue_.front().bank == kRegisters) {  // into the chip's shadow registers, not a bank
+    const std::uint64_t bytes = 4u * static_cast<std::uint64_t>(queue_.front().words);
+    spent_ += bytes;
+    *sent_ += bytes;
+    register_sent_ += bytes;
+    queue_.pop_front();
+    return 1;
+  }
   if (!port_.requests.can_push()) {
     stall();
     return 0;

@@ -315,4 +315,24 @@ class MemoryImage {
   FrameRegisters regs_;
 };
 
+// ---- words of a frame sequence (docs/frames.md) ------------------------------------------
+// What the host writes between frames and what a frame in flight reads, as words of the banks:
+// the host computes both (host/frame_upload.h), the host bus refuses a write into a range the
+// frame in flight reads (memif/host_bus.h).
+
+// Words [begin, end) of one bank, named for messages.
+struct BankRange {
+  int bank = 0;
+  std::uint32_t begin = 0;
+  std::uint32_t end = 0;
+  std::string what;
+};
+
+// One run of consecutive words for one bank.
+struct UploadRun {
+  int bank = 0;
+  std::uint32_t offset = 0;
+  std::vector<std::uint32_t> words;
+};
+
 }  // namespace saarcor::memif

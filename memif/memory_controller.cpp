@@ -119,6 +119,20 @@ bool MemoryController::idle() const {
   return true;
 }
 
+bool MemoryController::port_idle(const Port& port) const {
+  if (!port.requests.empty() || !port.responses.empty()) return false;
+  int index = -1;
+  for (std::size_t p = 0; p < ports_.size(); ++p)
+    if (ports_[p].get() == &port) index = static_cast<int>(p);
+  for (const Bank& b : banks_) {
+    for (const Queued& q : b.queue)
+      if (q.port == index) return false;
+    for (const InFlight& f : b.inflight)
+      if (f.port == index) return false;
+  }
+  return true;
+}
+
 int MemoryController::evaluate() {
   // Back to front, like pipeline stages: each stage reads what the later one left last cycle.
   int progress = retire_responses();

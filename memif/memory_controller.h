@@ -86,6 +86,9 @@ class MemoryController : public hw::Module {
   int clients() const { return static_cast<int>(clients_.size()); }
   std::uint64_t bank_switches() const;
   bool idle() const;  // nothing queued, in flight, or in a port channel
+  // Nothing of `port`'s is in its channels, queued or in flight (a client's requests all served:
+  // the RGS's last frame-buffer write stored while a host upload still runs).
+  bool port_idle(const Port& port) const;
   const MemoryControllerConfig& config() const { return config_; }
   const MemoryImage& image() const { return image_; }
 

@@ -83,6 +83,12 @@ bool MemorySystem::idle() const {
   return true;
 }
 
+bool MemorySystem::frame_writes_stored() const {
+  for (const Pipeline& p : pipes_)
+    if (!controller_->port_idle(*p.frame)) return false;
+  return true;
+}
+
 void MemorySystem::invalidate_caches() {
   for (Pipeline& p : pipes_) {
     for (auto& c : p.caches)

@@ -54,6 +54,8 @@ class MemorySystem {
   // No miss outstanding, nothing queued in the controller or in any memif channel (responses
   // included: a response the unit has not popped yet counts as work), nothing left to upload.
   bool idle() const;
+  // Every DynRTP's frame-buffer writes stored (the end of a frame; a host upload may go on).
+  bool frame_writes_stored() const;
   // Invalidates every cache (frame start, after an upload; D20).
   void invalidate_caches();
   // Bandwidth report: one line per client, "name bytes MB/s", at the modelled clock over

@@ -296,6 +296,56 @@ TEST(HostBus, UploadsAtTheConfiguredBandwidth) {
   EXPECT_THROW(MemorySystem(k2, img, bad), std::runtime_error);
 }
 
+// Frame sequences (docs/frames.md): the next frame's registers share the bus's bandwidth but go
+// to no bank; stored() holds once every SRAM word is in its bank; an upload into words the frame
+// in flight reads is refused with one line naming the range, and nothing of it is queued.
+TEST(HostBus, RegistersShareTheBandwidthAndProtectedWordsAreRefused) {
+  MemoryImage img(ff::kFp24, 4096);
+  hw::Kernel k;
+  MemorySystem mi(k, img);  // 132 MB/s, 4-word bursts
+  HostUpload u;
+  u.runs.push_back({kFirstSceneBank, 100, std::vector<std::uint32_t>(64, 0xA5u)});
+  u.register_words = 32;
+  u.frame_reads = {{kFirstSceneBank, 0, 100, "the top-level tree"},
+                   {kFirstSceneBank, 164, 4096, "the bottom-level trees"}};
+  EXPECT_EQ(u.sram_bytes(), 256u);
+  EXPECT_EQ(u.bytes(), 384u);
+  mi.host().upload(u);
+  EXPECT_FALSE(mi.host().stored());
+  const std::uint64_t cycles = k.run_to_completion([&] { return mi.host().stored(); }, 1000000);
+  EXPECT_EQ(mi.host().bytes_sent(), 384u);
+  EXPECT_EQ(mi.host().register_bytes_sent(), 128u);
+  EXPECT_EQ(mi.controller().client_bytes(mi.host().client()), 256u);
+  EXPECT_EQ(img.word(kFirstSceneBank, 163), 0xA5u);
+  EXPECT_EQ(img.word(kFirstSceneBank, 164), 0u);
+  // The registers come last: the whole 384 bytes' credit, ceil(384 * 90e6 / (132 * 2^20)) =
+  // 250 cycles, then the SRAM words' last write was already stored.
+  const auto credit =
+      static_cast<std::uint64_t>(std::ceil(384.0 * 90e6 / std::round(132.0 * 1048576.0)));
+  EXPECT_EQ(cycles, credit);
+  // One word into the protected range: refused, nothing queued.
+  HostUpload bad;
+  bad.runs.push_back({kFirstSceneBank, 0, {1, 2}});
+  bad.runs.push_back({kFirstSceneBank, 99, {7}});
+  bad.frame_reads = u.frame_reads;
+  try {
+    mi.host().upload(bad);
+    FAIL() << "an upload into the top-level tree in flight was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    EXPECT_NE(m.find("bank 3 words 0..1 overlaps the top-level tree (bank 3 words 0..99), which "
+                     "the frame in flight reads"),
+              std::string::npos)
+        << m;
+  }
+  EXPECT_TRUE(mi.host().idle());
+  EXPECT_THROW(mi.host().upload(kFirstSceneBank, 4000, {1}), std::runtime_error);
+  EXPECT_NO_THROW(mi.host().upload(kFirstSceneBank, 100, {1}));  // between the ranges
+  mi.host().protect({});
+  EXPECT_NO_THROW(mi.host().upload(kFirstSceneBank, 0, {1}));
+}
+
 TEST(MemorySystem, BandwidthReportNamesEveryClient) {
   MemoryImage img = testing::random_scene_image(ff::kFp24, 9);
   hw::Kernel k;

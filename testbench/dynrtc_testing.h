@@ -149,8 +149,12 @@ struct SceneCase {
 };
 inline std::vector<SceneCase> scene_cases() {
   std::vector<SceneCase> s;
-  for (const std::string& n : host::builtin_scene_names())
+  for (const std::string& n : host::builtin_scene_names()) {
+    // SunCOR's object under swaying transforms: builtin:suncor covers its geometry here, and the
+    // frame-sequence tests check its frames bit for bit (FrameSequence.SuncorWindEveryInstance...).
+    if (n == "suncor-wind") continue;
     s.push_back({"builtin:" + n, 32, 24, n == "terrain" ? 32u : 4u});
+  }
   for (const char* m : {"Triangle/Triangle.gltf",
                         "TriangleWithoutIndices/TriangleWithoutIndices.gltf",
                         "Box/Box.gltf",

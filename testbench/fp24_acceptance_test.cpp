@@ -45,6 +45,9 @@ constexpr KnownDeviation kKnown[] = {
     // where the fp24 ulp is 1/16, so u = O'x + t*D'x cancels to an absolute error ~0.1.
     {"builtin:suncor", 98.6, 33.7,
      "cancellation in u = O'x + t*D'x: tiny triangles far away, |O'| ~ 5e3, fp24 ulp 1/16"},
+    // The same field, every sunflower tilted by the wind at t = 0 (98.60 %, 34.03 dB measured).
+    {"builtin:suncor-wind", 98.5, 33.7,
+     "as builtin:suncor: the same tiny triangles far away, tilted"},
 };
 
 const KnownDeviation* known(const std::string& spec) {

@@ -16,6 +16,7 @@
 #include "host/float_reference.h"
 #include "host/primary_rays.h"
 #include "host/tree_settings.h"
+#include "testbench/frame_sequence.h"
 #include "testbench/heartbeat.h"
 #include "testbench/hit_exr.h"
 #include "testbench/image_io.h"
@@ -419,6 +420,7 @@ void build_prepared_image(PreparedScene& p, const RenderSettings& settings, ff::
   ip.height = settings.res.height;
   ip.max_depth = static_cast<std::uint32_t>(settings.depth);
   ip.bank_words = static_cast<std::uint32_t>(std::llround(settings.bank_mb * 262144.0));
+  ip.top_level_buffers = settings.top_level_buffers;
   for (const std::string& kv : settings.cycle.set)
     if (host::is_tree_setting(kv)) host::apply_tree_setting(ip, kv);
   const auto t0 = Clock::now();
@@ -693,6 +695,9 @@ void write_run_files(const RenderOptions& opts, nlohmann::json report, const Fra
 }  // namespace
 
 int run_render(const RenderOptions& opts) {
+  if (opts.frames_given) return run_frame_sequence(opts);
+  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty())
+    throw std::runtime_error("--fps, --dt, --frame-gap and --bus-sweep need --frames N");
   const ModelSpec model = parse_model(opts.model);
   RenderSettings settings =
       frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);

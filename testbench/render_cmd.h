@@ -65,6 +65,9 @@ struct RenderSettings {
   // The request trace (the functional and the cycle models) and the Kanata log (the cycle model)
   // to write; the streams belong to the caller (docs/traces.md).
   units::RunTraceOptions trace;
+  // Copies of the top level in the image (host::ImageParams::top_level_buffers): 2 for frame
+  // sequences (testbench/frame_sequence.h).
+  int top_level_buffers = 1;
 };
 
 // The scene loaded, set to the time, with its memory image built in `format`.
@@ -157,9 +160,18 @@ struct RenderOptions {
   bool out_given = false;         // --out was on the command line (not its default)
   bool hits_asked = false;        // --hits was on the command line, with or without a file name
   std::vector<std::string> argv;  // the command line, for command.txt
+  // --frames N [--fps F | --dt S] [--frame-gap] [--bus-sweep MB/S,...]: a frame sequence
+  // (testbench/frame_sequence.h, docs/frames.md).
+  int frames = 0;
+  double fps = 0.0;
+  double dt = 0.0;
+  bool frame_gap = false;
+  std::string bus_sweep;
+  bool frames_given = false, fps_given = false, dt_given = false;
 };
 
-// Returns 0; throws std::runtime_error with one line on bad input.
+// Returns 0; throws std::runtime_error with one line on bad input. With --frames: the sequence
+// (run_frame_sequence).
 int run_render(const RenderOptions& opts);
 
 // Writes one line of progress to stderr when the heartbeat would show (a terminal, CI unset:

@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
   saarcor::RenderOptions render_opts;
   {
     auto* sub = app.add_subcommand(
-        "render", "render one frame with a model; write PNG, EXR, hit EXR, report");
+        "render", "render one frame (or --frames N) with a model; write PNG, EXR, hit EXR, report");
     sub->add_option("scene", render_opts.scene, "glTF file or builtin:NAME")->required();
     sub->add_option("--model", render_opts.model,
                     "float | fp24 | e7m10..e7m23 | cycle | cycle-e7m23")
@@ -128,10 +128,27 @@ int main(int argc, char** argv) {
                     "cycle model: write a Kanata pipeline log (opens in Konata)");
     sub->add_option("--konata-threads", render_opts.trace.konata_threads,
                     "cycle model: the threads of --konata, e.g. 0,3,8-11 (default: all)");
-    sub->callback([&, out, hits, trace_from, trace_to] {
+    // Frame sequences (testbench/frame_sequence.h, docs/frames.md)
+    auto* frames = sub->add_option("--frames", render_opts.frames,
+                                   "render N frames of the animation: per-frame top-level "
+                                   "rebuild, upload over the host bus, frame-buffer swap");
+    auto* fps = sub->add_option("--fps", render_opts.fps,
+                                "frames: frames per animation second (default: the animation's "
+                                "length spread over the frames)");
+    auto* dt = sub->add_option("--dt", render_opts.dt, "frames: animation seconds between frames");
+    sub->add_flag("--frame-gap", render_opts.frame_gap,
+                  "frames: one top-level copy, every upload after the frame in flight (instead "
+                  "of two copies and uploads during it)");
+    sub->add_option("--bus-sweep", render_opts.bus_sweep,
+                    "frames, cycle model: run the sequence once per host-bus bandwidth "
+                    "MB/S,MB/S,... and tabulate which uploads stay hidden");
+    sub->callback([&, out, hits, trace_from, trace_to, frames, fps, dt] {
       render_opts.out_given = out->count() > 0;
       render_opts.hits_asked = hits->count() > 0;
       render_opts.trace.window_given = trace_from->count() > 0 || trace_to->count() > 0;
+      render_opts.frames_given = frames->count() > 0;
+      render_opts.fps_given = fps->count() > 0;
+      render_opts.dt_given = dt->count() > 0;
       render_opts.argv = command;
       status = saarcor::run_render(render_opts);
     });

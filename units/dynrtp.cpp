@@ -11,6 +11,7 @@
 #include <memory>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -93,8 +94,7 @@ void check_frame_buffer(const memif::MemoryImage& image) {
 }
 
 // The frame's image as the hardware left it: the words the RGS wrote into the back bank.
-void read_frame_buffer(const memif::MemoryImage& image, CycleFrame& out) {
-  const int bank = static_cast<int>(image.registers().frame_bank);
+void read_frame_buffer(const memif::MemoryImage& image, int bank, CycleFrame& out) {
   const std::vector<std::uint32_t>& fb = image.bank(bank);
   auto& rgb = out.frame.rgb;
   rgb.resize(out.frame.pixels.size() * 3u);
@@ -178,7 +178,7 @@ class Chip {
     if (!rgc_.all_handed_out()) return false;
     for (const auto& d : pipes_)
       if (!d->rgs().idle()) return false;
-    return mi_.idle();
+    return mi_.frame_writes_stored();
   }
   std::uint64_t packets_retired() const {
     std::uint64_t n = 0;
@@ -267,12 +267,12 @@ std::string thread_report(RecordedThreads<F, kLanes>& threads, const CycleParams
   return s.str();
 }
 
-// Runs the kernel until the chip has retired every packet, sampling the figures every
-// opt.interval cycles into out.series and reporting progress.
+// Runs the kernel until `done` (by default: the chip has retired every packet), sampling the
+// figures every opt.interval cycles into out.series and reporting progress.
 template <class F, int kLanes>
 void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, const CycleParams& p,
-              const CycleRunOptions& opt, CycleFrame& out) {
-  const auto done = [&] { return chip.finished(); };
+              const CycleRunOptions& opt, CycleFrame& out, std::function<bool()> done = {}) {
+  if (!done) done = [&] { return chip.finished(); };
   const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
   Snapshot last = snapshot(k, chip);
   while (!done()) {
@@ -296,6 +296,37 @@ void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, co
     if (opt.progress)
       opt.progress(k.now(), static_cast<int>(chip.packets_retired()), threads.packets());
   }
+}
+
+// Queues the host's upload (refused here when it writes what the frame reads) and runs the frame
+// until it or the upload is done, whichever comes first. Returns true when the upload is not.
+template <class F, int kLanes>
+bool start_upload(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads,
+                  const CycleParams& p, const CycleRunOptions& opt, const memif::HostUpload& upload,
+                  CycleFrame& out) {
+  memif::HostBus& host = chip.memory().host();
+  host.upload(upload);
+  out.upload_bytes = upload.bytes();
+  simulate(k, chip, threads, p, opt, out, [&] { return chip.finished() || host.stored(); });
+  if (!host.stored()) return true;
+  out.upload_cycles = k.now();
+  return false;
+}
+
+// The frame is done and its upload is not: the bus goes on alone until its last word is stored
+// (the next frame cannot start before). A slow bus may wait longer than the watchdog's span for
+// its next burst's credit, so the watchdog allows that wait.
+void finish_upload(hw::Kernel& k, Chip& chip, const CycleParams& p, CycleFrame& out) {
+  const memif::HostBus& host = chip.memory().host();
+  const double burst_cycles =
+      4.0 * p.hostbus_burst_words * p.clock_mhz * 1e6 / (p.hostbus_mb_s * 1048576.0);
+  k.config().watchdog_cycles =
+      std::max<std::uint64_t>(p.watchdog, static_cast<std::uint64_t>(2.0 * burst_cycles) + 16);
+  const hw::RunResult r = k.run([&] { return host.stored(); });
+  if (r.status != hw::RunResult::Status::kDone)
+    throw std::runtime_error("cycle model: the host upload stopped at cycle " +
+                             std::to_string(r.cycles) + "\n" + r.report);
+  out.upload_cycles = k.now();
 }
 
 // Per pipeline and in total: packets, unit issue and stall cycles, requests, cache counts.
@@ -347,18 +378,39 @@ void frame_rates(const CycleParams& p, CycleFrame& out) {
                                          static_cast<double>(steps) / p.packet;
 }
 
-template <class F, int kLanes>
-CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
-                            const CycleRunOptions& opt) {
-  const auto t0 = std::chrono::steady_clock::now();
+// The parameters, the options and the image's frame buffer, before anything is built.
+void check_run(const memif::MemoryImage& image, const CycleParams& p, const CycleRunOptions& opt) {
   check_cycle_params(p);
-  check_frame_buffer(image_in);
-  // The chip's memory: the RGS writes the frame-buffer bank, the caller's image stays unchanged
-  // (several runs may share it, as a sweep's points do).
-  memif::MemoryImage image = image_in;
+  check_frame_buffer(image);
   if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
     throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
                              std::to_string(opt.ahead_packets) + ")");
+}
+
+// The frame as the RGS left it: the image read back from the bank it wrote, and its traffic.
+void collect_rgs(const memif::MemoryImage& image, int bank, const Snapshot& end, CycleFrame& out) {
+  read_frame_buffer(image, bank, out);
+  out.shading_bytes = end.shading_bytes;
+  out.frame_bytes = end.frame_bytes;
+  const double pixels = static_cast<double>(out.frame.width) * out.frame.height;
+  out.shading_bytes_per_pixel =
+      pixels > 0 ? static_cast<double>(end.shading_bytes + end.frame_bytes) / pixels : 0.0;
+}
+
+template <class F, int kLanes>
+CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
+                            const CycleRunOptions& opt, const memif::HostUpload* upload) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_run(image_in, p, opt);
+  // The chip's memory. Without an upload, a copy: the RGS writes its frame-buffer bank and the
+  // caller's image stays unchanged (several runs may share it, as a sweep's points do). With one,
+  // the caller's image (run_cycle's mutable overload): the upload's words and the frame's pixels
+  // stay in it for the next frame.
+  std::optional<memif::MemoryImage> copy;
+  if (upload == nullptr) copy.emplace(image_in);
+  memif::MemoryImage& image = copy ? *copy : const_cast<memif::MemoryImage&>(image_in);
+  // The bank this frame is written into (an upload brings the next frame's registers).
+  const int frame_bank = static_cast<int>(image.registers().frame_bank);
   RecordedThreads<F, kLanes> threads(image, functional_params(p, opt.shading),
                                      p.pipelines * p.threads, opt.programs, opt.ahead_packets,
                                      opt.trace);
@@ -379,20 +431,17 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   out.params = p;
   out.packets = static_cast<std::uint64_t>(threads.packets());
   const Snapshot start = snapshot(k, chip);
+  const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
   simulate(k, chip, threads, p, opt, out);
   if (opt.vcd != nullptr) k.finish_trace();
   if (tracer) tracer->finish();
   const Snapshot end = snapshot(k, chip);
+  out.cycles = k.now();
+  if (uploading) finish_upload(k, chip, p, out);
 
   threads.finish();
   collect(out.frame, threads);
-  read_frame_buffer(image, out);
-  out.shading_bytes = end.shading_bytes;
-  out.frame_bytes = end.frame_bytes;
-  const double pixels = static_cast<double>(out.frame.width) * out.frame.height;
-  out.shading_bytes_per_pixel =
-      pixels > 0 ? static_cast<double>(end.shading_bytes + end.frame_bytes) / pixels : 0.0;
-  out.cycles = k.now();
+  collect_rgs(image, frame_bank, end, out);
   out.figures = figures(start, end, p.clock_mhz);
   collect_units(k, chip, end, out);
   frame_rates(p, out);
@@ -465,22 +514,38 @@ const char* program_mode_name(ProgramMode m) {
   return "?";
 }
 
-CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
-                     const CycleRunOptions& options) {
+namespace {
+
+CycleFrame run_cycle_image(const memif::MemoryImage& image, const CycleParams& params,
+                           const CycleRunOptions& options, const memif::HostUpload* upload) {
   // The prototype's P = 4 gets thread programs with 4-lane packet arrays (ThreadProgram's
   // kLanes); wider packets the full 64.
   if (image.format() == ff::kFp24) {
-    if (params.packet <= 4) return run_cycle_format<ff::Float<7, 16>, 4>(image, params, options);
-    return run_cycle_format<ff::Float<7, 16>, kMaxPacket>(image, params, options);
+    if (params.packet <= 4)
+      return run_cycle_format<ff::Float<7, 16>, 4>(image, params, options, upload);
+    return run_cycle_format<ff::Float<7, 16>, kMaxPacket>(image, params, options, upload);
   }
   // The widest format with fp24's exponent, for the width study (docs/cycle-model.md, "Datapath
   // width"): 31-bit values, a matrix row in four words instead of three.
   if (image.format() == ff::Format{7, 23}) {
-    if (params.packet <= 4) return run_cycle_format<ff::Float<7, 23>, 4>(image, params, options);
-    return run_cycle_format<ff::Float<7, 23>, kMaxPacket>(image, params, options);
+    if (params.packet <= 4)
+      return run_cycle_format<ff::Float<7, 23>, 4>(image, params, options, upload);
+    return run_cycle_format<ff::Float<7, 23>, kMaxPacket>(image, params, options, upload);
   }
   throw std::runtime_error("cycle model: the image is in " + ff::format_name(image.format()) +
                            "; the cycle model is built for fp24 (e7m16) and e7m23");
+}
+
+}  // namespace
+
+CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
+                     const CycleRunOptions& options) {
+  return run_cycle_image(image, params, options, nullptr);
+}
+
+CycleFrame run_cycle(memif::MemoryImage& image, const CycleParams& params,
+                     const CycleRunOptions& options, const memif::HostUpload& upload) {
+  return run_cycle_image(image, params, options, &upload);
 }
 
 }  // namespace saarcor::units

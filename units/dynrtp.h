@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "memif/host_bus.h"
 #include "memif/image_format.h"
 #include "units/cycle_params.h"
 #include "units/functional_model.h"
@@ -100,6 +101,12 @@ struct CycleFrame {
   std::uint64_t module_evaluations = 0;  // host work: evaluate() calls (sleeping modules skip)
   std::vector<CycleFigures> series;      // with interval != 0: the figures of each interval
   std::string stats_json;                // the hw/ statistics registry
+  // With a host upload (run_cycle with a memif::HostUpload): the bytes it sent over the host bus
+  // (SRAM words and registers) and the cycle by which its last word was stored, counted from the
+  // frame's start like `cycles`; it exceeds `cycles` when the upload outlasts the frame, and the
+  // run then goes on until it is done. The figures above are the frame's alone.
+  std::uint64_t upload_bytes = 0;
+  std::uint64_t upload_cycles = 0;
 };
 
 // Renders the image's frame: an fp24 image (the prototype), or e7m23 (the same units 31 bits wide,
@@ -115,5 +122,14 @@ FunctionalParams functional_params(const CycleParams& p, FunctionalParams shadin
 
 CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
                      const CycleRunOptions& options = {});
+
+// The same frame while the host uploads the next frame's changes over the host bus (paper
+// section 5: "uploading changes to the scene between frames ... can be performed in parallel to
+// rendering"; docs/frames.md): the upload's words reach `image` through the memory controller,
+// competing with the frame's reads for the banks; its registers take bus time and go to no bank.
+// Throws std::runtime_error (one line naming the range) before the first cycle when a run of the
+// upload overlaps upload.frame_reads: writing what the frame in flight reads is refused.
+CycleFrame run_cycle(memif::MemoryImage& image, const CycleParams& params,
+                     const CycleRunOptions& options, const memif::HostUpload& upload);
 
 }  // namespace saarcor::units

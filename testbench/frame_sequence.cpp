@@ -1,0 +1,843 @@
+// `saarcor render SCENE --frames N`: frame sequences of dynamic scenes (docs/frames.md).
+#include "testbench/frame_sequence.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "host/frame_upload.h"
+#include "host/tree_settings.h"
+#include "hw/kernel.h"
+#include "memif/memory_system.h"
+#include "testbench/heartbeat.h"
+#include "testbench/run_dir.h"
+#include "units/functional_model.h"
+
+namespace saarcor {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+constexpr int kMaxFrames = 10000;
+// The frame registers and the scene regions' bases travel over the bus with each upload into the
+// chip's shadow registers, which the frame swap latches (memif/image_format.h).
+constexpr std::uint32_t kRegisterWords =
+    (sizeof(memif::FrameRegisters) + sizeof(memif::SceneRegions)) / 4;
+
+// FNV-1a over every hit record (t, u, v, cos, ids, ray) and the image: equal digests, equal frames.
+std::uint64_t digest(const units::FunctionalFrame& f) {
+  std::uint64_t h = 1469598103934665603ull;
+  const auto mix = [&h](std::uint32_t w) {
+    for (int i = 0; i < 4; ++i) {
+      h ^= (w >> (8 * i)) & 0xFFu;
+      h *= 1099511628211ull;
+    }
+  };
+  for (const units::FrameSink::Pixel& p : f.pixels) {
+    for (std::uint32_t w : {p.t, p.u, p.v, p.cos, p.instance, p.triangle})
+      mix(w);
+    for (int k = 0; k < 3; ++k) {
+      mix(p.o[static_cast<std::size_t>(k)]);
+      mix(p.d[static_cast<std::size_t>(k)]);
+    }
+  }
+  for (std::uint8_t c : f.rgb)
+    mix(c);
+  return h;
+}
+
+std::uint64_t rays_of(const units::FunctionalFrame& f) {
+  std::uint64_t n = 0;
+  for (std::uint64_t r : f.rays_issued)
+    n += r;
+  return n;
+}
+
+// The cycle model's frame k against the functional model's (DESIGN.md section 9: bit for bit).
+void check_frame(const units::FunctionalFrame& c, const units::FunctionalFrame& ref, int index,
+                 double time) {
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < ref.pixels.size() && i < c.pixels.size(); ++i) {
+    const units::FrameSink::Pixel &a = c.pixels[i], &b = ref.pixels[i];
+    if (a.t != b.t || a.u != b.u || a.v != b.v || a.cos != b.cos || a.instance != b.instance ||
+        a.triangle != b.triangle || a.o != b.o || a.d != b.d)
+      ++differ;
+  }
+  char buf[200];
+  if (c.pixels.size() != ref.pixels.size() || differ != 0 || c.rgb != ref.rgb ||
+      rays_of(c) != rays_of(ref)) {
+    std::snprintf(
+        buf, sizeof buf,
+        "frame %d (t = %g s): the cycle model's frame differs from the functional "
+        "model's (%zu hit records differ, image %s, %" PRIu64 " rays against %" PRIu64 ")",
+        index, time, differ, c.rgb == ref.rgb ? "identical" : "differs", rays_of(c), rays_of(ref));
+    throw std::runtime_error(buf);
+  }
+}
+
+// Every data word of the shading and scene banks: what the host writes before the first frame.
+memif::HostUpload initial_load(const host::BuiltImage& b) {
+  memif::HostUpload u;
+  for (const memif::BankRange& r : host::data_words(b)) {
+    const auto& src = b.image.bank(r.bank);
+    u.runs.push_back(
+        {r.bank, r.begin, std::vector<std::uint32_t>(src.begin() + r.begin, src.begin() + r.end)});
+  }
+  u.register_words = kRegisterWords;
+  return u;
+}
+
+// An upload with nothing rendering (the initial load, a frame gap): the cycle model's memory
+// system with only its host bus busy. Returns the cycles until its last word is stored.
+std::uint64_t upload_alone(memif::MemoryImage& board, const units::CycleParams& p,
+                           memif::HostUpload u) {
+  u.frame_reads.clear();  // no frame in flight
+  hw::KernelConfig kc;
+  const double burst_cycles =
+      4.0 * p.hostbus_burst_words * p.clock_mhz * 1e6 / (p.hostbus_mb_s * 1048576.0);
+  kc.watchdog_cycles =
+      std::max<std::uint64_t>(p.watchdog, static_cast<std::uint64_t>(2.0 * burst_cycles) + 16);
+  hw::Kernel k(kc);
+  memif::MemorySystem mi(k, board, units::memory_system_config(p));
+  mi.host().upload(u);
+  return k.run_to_completion([&] { return mi.host().stored(); });
+}
+
+void apply_runs(memif::MemoryImage& board, const std::vector<memif::UploadRun>& runs) {
+  for (const memif::UploadRun& r : runs)
+    std::copy(r.words.begin(), r.words.end(),
+              board.bank(r.bank).begin() + static_cast<std::ptrdiff_t>(r.offset));
+}
+
+// The model's own consistency: after an upload the board holds what the host built.
+void require_same_data(const memif::MemoryImage& board, const memif::MemoryImage& host, int index) {
+  for (int bank = memif::kShadingBank; bank < memif::kNumBanks; ++bank)
+    if (board.bank(bank) != host.bank(bank))
+      throw std::runtime_error("frame " + std::to_string(index) + ": after the upload bank " +
+                               std::to_string(bank) + " differs from the host's image");
+}
+
+Rgb8Image image_of(const units::FunctionalFrame& f) {
+  return {f.width, f.height, f.rgb};
+}
+
+double mb(std::uint64_t bytes) {
+  return static_cast<double>(bytes) / 1048576.0;
+}
+
+// What the host prepared for the next frame while this one renders.
+struct NextFrame {
+  SequenceFrame row;
+  memif::HostUpload upload;
+};
+
+// Frame k + 1's rebuild and upload (paper section 2: only the top level is rebuilt).
+NextFrame prepare_next(host::Scene& scene, host::BuiltImage& host, const memif::MemoryImage& board,
+                       const std::vector<memif::BankRange>& reads, int index, double time) {
+  NextFrame n;
+  n.row.index = index;
+  scene.set_time(time);
+  n.row.time = scene.time;
+  const std::uint64_t top0 = host.stats.top_level_builds;
+  const std::uint64_t bottom0 = host.stats.bottom_level_builds;
+  const auto t0 = Clock::now();
+  const host::UploadDelta d = host::rebuild_top_level(host, scene);
+  n.row.host_rebuild_seconds = seconds_since(t0);
+  n.row.top_rebuilt = d.top_rebuilt;
+  n.row.moved_instances = d.moved_instances;
+  n.row.top_level_builds = host.stats.top_level_builds - top0;
+  n.row.bottom_level_builds = host.stats.bottom_level_builds - bottom0;
+  n.upload.runs = host::changed_words(board, host.image);
+  n.upload.register_words = kRegisterWords;
+  n.upload.frame_reads = reads;
+  n.row.gap = host::overlaps(n.upload.runs, reads);
+  n.row.upload_bytes = n.upload.bytes();
+  n.row.upload_words = n.upload.sram_bytes() / 4;
+  n.row.upload_runs = n.upload.runs.size();
+  return n;
+}
+
+void take_figures(SequenceFrame& row, const units::CycleFrame& c) {
+  row.cycles = c.cycles;
+  row.fps = c.fps;
+  row.rays = c.rays;
+  for (int i = 0; i < 4; ++i)
+    row.usage[i] = c.figures.usage[static_cast<std::size_t>(i)];
+  for (int i = 0; i < 3; ++i)
+    row.hit[i] = c.figures.cache_hit[static_cast<std::size_t>(i)];
+  row.bw_dynrtc = c.figures.bw_dynrtc;
+  row.cycles_per_packet =
+      c.packets == 0 ? 0.0 : static_cast<double>(c.cycles) / static_cast<double>(c.packets);
+}
+
+units::CycleRunOptions cycle_run_options(const RenderSettings& s, Heartbeat& beat, int index,
+                                         int frames) {
+  units::CycleRunOptions ro;
+  ro.shading = functional_params(s);
+  if (s.cycle.host_threads != 0)
+    ro.programs =
+        s.cycle.host_threads == 2 ? units::ProgramMode::kAhead : units::ProgramMode::kPacketFirst;
+  if (beat.enabled())
+    ro.progress = [&beat, index, frames](std::uint64_t cycles, int done, int total) {
+      beat.beat("frame " + std::to_string(index + 1) + " / " + std::to_string(frames) + ", " +
+                Heartbeat::cycle_status(cycles, done, total, beat.seconds()));
+    };
+  return ro;
+}
+
+void check_options(const ModelSpec& model, const SequenceOptions& o) {
+  if (model.kind == ModelKind::kFloat)
+    throw std::runtime_error(
+        "--frames needs a model that reads the memory image (fp24, e7mM, cycle, cycle-e7m23); the "
+        "float reference has none to upload to");
+  if (o.frames < 1 || o.frames > kMaxFrames)
+    throw std::runtime_error("bad --frames " + std::to_string(o.frames) + ": expected 1.." +
+                             std::to_string(kMaxFrames));
+  if (!std::isfinite(o.dt))
+    throw std::runtime_error("bad --dt: expected seconds >= 0 between frames");
+  if (!std::isfinite(o.start) || o.start < 0.0)
+    throw std::runtime_error("bad --time " + std::to_string(o.start) + ": expected seconds >= 0");
+}
+
+// The timeline (docs/frames.md): frame k + 1 starts when frame k has rendered and k + 1's upload
+// is stored; an upload in a gap starts only when frame k has rendered.
+void place(SequenceFrame& next, const SequenceFrame& cur, std::uint64_t gap_cycles) {
+  const std::uint64_t end = cur.start_cycle + cur.cycles;
+  if (next.gap) {
+    next.upload_cycles = cur.cycles + gap_cycles;
+    next.hidden = false;
+  } else {
+    next.hidden = next.upload_cycles <= cur.cycles;
+  }
+  next.start_cycle = cur.start_cycle + std::max(cur.cycles, next.upload_cycles);
+  next.stall_cycles = next.start_cycle - end;
+}
+
+}  // namespace
+
+std::uint64_t SequenceResult::total_cycles() const {
+  if (frames.empty()) return 0;
+  return frames.back().start_cycle + frames.back().cycles;
+}
+
+double SequenceResult::fps() const {
+  const std::uint64_t c = total_cycles();
+  return c == 0 ? 0.0
+                : static_cast<double>(frames.size()) * clock_mhz * 1e6 / static_cast<double>(c);
+}
+
+double SequenceResult::render_fps() const {
+  std::uint64_t c = 0;
+  for (const SequenceFrame& f : frames)
+    c += f.cycles;
+  return c == 0 ? 0.0
+                : static_cast<double>(frames.size()) * clock_mhz * 1e6 / static_cast<double>(c);
+}
+
+int SequenceResult::gaps() const {
+  int n = 0;
+  for (std::size_t k = 1; k < frames.size(); ++k)
+    n += frames[k].gap ? 1 : 0;
+  return n;
+}
+
+int SequenceResult::hidden_uploads() const {
+  int n = 0;
+  for (std::size_t k = 1; k < frames.size(); ++k)
+    n += frames[k].hidden ? 1 : 0;
+  return n;
+}
+
+double SequenceResult::break_even_mb_s() const {
+  double worst = 0.0;
+  for (std::size_t k = 1; k < frames.size(); ++k) {
+    if (frames[k].gap) continue;  // no bandwidth hides an upload that waits for the frame's end
+    const double render_s = static_cast<double>(frames[k - 1].cycles) / (clock_mhz * 1e6);
+    if (render_s > 0) worst = std::max(worst, mb(frames[k].upload_bytes) / render_s);
+  }
+  return worst;
+}
+
+SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
+                            const RenderSettings& settings, const SequenceOptions& opts,
+                            const FrameSink& sink) {
+  check_options(model, opts);
+  const bool cycle = model.kind == ModelKind::kCycle;
+  units::CycleParams cp;
+  if (cycle) cp = resolve_cycle_params(settings.cycle);  // a bad --set fails before the load
+  RenderSettings s = settings;
+  s.time = opts.start;
+  s.top_level_buffers = opts.frame_gap ? 1 : 2;
+  PreparedScene prep = prepare_scene(spec, s, ff::Format{7, model.mantissa});
+  host::BuiltImage& host = prep.built;
+  host::Scene& scene = prep.scene;
+
+  SequenceResult r;
+  r.scene = spec;
+  r.model = model.name;
+  r.width = s.res.width;
+  r.height = s.res.height;
+  r.cycle = cycle;
+  r.frame_gap = opts.frame_gap;
+  r.clock_mhz = cycle ? cp.clock_mhz : 0.0;
+  r.bus_mb_s = cycle ? cp.hostbus_mb_s : 0.0;
+  r.dt = opts.dt >= 0.0 ? opts.dt : scene.animation_seconds / opts.frames;
+  r.objects = scene.objects.size();
+  r.instances = scene.instances.size();
+  for (const host::Instance& i : scene.instances)
+    r.dynamic_instances += i.dynamic ? 1 : 0;
+  r.top_copy_bytes = 8ull * host.top_node_capacity + 4ull * host.top_list_capacity +
+                     4ull * static_cast<std::uint64_t>(ff::row_words(host.params.format)) *
+                         memif::kInstanceRows * host.instances.size();
+  const units::FunctionalParams fparams =
+      cycle ? units::functional_params(cp, functional_params(s)) : functional_params(s);
+
+  // The initial load: the board's banks written over the bus before anything renders.
+  const memif::HostUpload load = initial_load(host);
+  r.initial_load_bytes = load.bytes();
+  memif::MemoryImage board(host.image.format(), host.image.bank_words());
+  if (cycle) {
+    progress("uploading the scene over the host bus (" + std::to_string(load.bytes()) + " bytes)");
+    r.initial_load_cycles = upload_alone(board, cp, load);
+  } else {
+    apply_runs(board, load.runs);
+  }
+  require_same_data(board, host.image, 0);
+
+  Heartbeat beat("sequence", s.heartbeat && heartbeat_enabled());
+  SequenceFrame cur;
+  cur.time = scene.time;
+  cur.top_rebuilt = true;  // frame 0: both levels built with the image
+  cur.top_level_builds = host.stats.top_level_builds;
+  cur.bottom_level_builds = host.stats.bottom_level_builds;
+  cur.host_rebuild_seconds = host.stats.top_build_seconds;
+  for (int k = 0; k < opts.frames; ++k) {
+    const auto t0 = Clock::now();
+    // The swap: the registers the host sent latch, the frame buffers alternate.
+    cur.index = k;
+    cur.frame_bank = k % 2 == 0 ? memif::kFrameBank0 : memif::kFrameBank1;
+    cur.top_copy = static_cast<int>(host.top_buffer);
+    host.image.registers().frame_bank = static_cast<std::uint32_t>(cur.frame_bank);
+    board.registers() = host.image.registers();
+    board.regions() = host.image.regions();  // they move only with a relayout (in a gap)
+    const std::vector<memif::BankRange> reads = host::frame_reads(host, cur.frame_bank);
+    units::FunctionalFrame reference;
+    if (!cycle || opts.check) reference = units::run_functional(board, fparams);
+    // The host prepares the next frame while this one renders.
+    const bool more = k + 1 < opts.frames;
+    NextFrame next;
+    if (more) next = prepare_next(scene, host, board, reads, k + 1, opts.start + (k + 1) * r.dt);
+    std::uint64_t gap_cycles = 0;
+    units::FunctionalFrame frame;
+    if (cycle) {
+      const units::CycleRunOptions ro = cycle_run_options(s, beat, k, opts.frames);
+      units::CycleFrame c = more && !next.row.gap ? units::run_cycle(board, cp, ro, next.upload)
+                                                  : units::run_cycle(std::as_const(board), cp, ro);
+      if (more && next.row.gap) gap_cycles = upload_alone(board, cp, next.upload);
+      next.row.upload_cycles = c.upload_cycles;
+      take_figures(cur, c);
+      if (opts.check) {
+        check_frame(c.frame, reference, k, cur.time);
+        cur.checked = true;
+      }
+      frame = std::move(c.frame);
+    } else {
+      if (more) apply_runs(board, next.upload.runs);
+      cur.rays = rays_of(reference);
+      frame = std::move(reference);
+    }
+    if (more) require_same_data(board, host.image, k + 1);
+    cur.digest = digest(frame);
+    cur.host_seconds = seconds_since(t0);
+    if (sink) sink(cur, image_of(frame));
+    beat.beat("frame " + std::to_string(k + 1) + " / " + std::to_string(opts.frames) + " done");
+    if (more && cycle) place(next.row, cur, gap_cycles);
+    r.frames.push_back(cur);
+    if (more) cur = next.row;
+  }
+  beat.finish("frames " + std::to_string(opts.frames) + " / " + std::to_string(opts.frames));
+  return r;
+}
+
+// ---- report ---------------------------------------------------------------------------------
+
+nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
+  nlohmann::json j;
+  j["scene"] = r.scene;
+  j["model"] = r.model;
+  j["resolution"] = {{"width", r.width}, {"height", r.height}};
+  j["frames"] = r.frames.size();
+  j["dt"] = r.dt;
+  j["top_level"] = r.frame_gap ? "one copy (every upload in a frame gap)" : "two copies";
+  j["instances"] = r.instances;
+  j["dynamic_instances"] = r.dynamic_instances;
+  j["objects"] = r.objects;
+  j["initial_load"] = {{"bytes", r.initial_load_bytes}};
+  j["top_level_copy_bytes"] = r.top_copy_bytes;
+  if (r.cycle) {
+    j["clock_mhz"] = r.clock_mhz;
+    j["hostbus_mb_s"] = r.bus_mb_s;
+    j["initial_load"]["cycles"] = r.initial_load_cycles;
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::uint64_t bytes = 0, max_bytes = 0, top = 0, bottom = 0;
+  for (const SequenceFrame& f : r.frames) {
+    nlohmann::json e = {{"frame", f.index},
+                        {"time", f.time},
+                        {"frame_bank", f.frame_bank},
+                        {"top_copy", f.top_copy},
+                        {"top_rebuilt", f.top_rebuilt},
+                        {"moved_instances", f.moved_instances},
+                        {"top_level_builds", f.top_level_builds},
+                        {"bottom_level_builds", f.bottom_level_builds},
+                        {"upload_bytes", f.upload_bytes},
+                        {"upload_words", f.upload_words},
+                        {"upload_runs", f.upload_runs},
+                        {"upload_in_gap", f.gap},
+                        {"rays", f.rays},
+                        {"digest", f.digest}};
+    if (host_times) e["host_rebuild_ms"] = f.host_rebuild_seconds * 1e3;
+    if (r.cycle) {
+      e["upload_cycles"] = f.upload_cycles;
+      e["upload_hidden"] = f.hidden;
+      e["stall_cycles"] = f.stall_cycles;
+      e["start_cycle"] = f.start_cycle;
+      e["cycles"] = f.cycles;
+      e["fps"] = f.fps;
+      e["cycles_per_packet"] = f.cycles_per_packet;
+      for (int i = 0; i < 4; ++i)
+        e["usage"][units::kTable4UnitNames[i]] = f.usage[i];
+      for (int i = 0; i < 3; ++i)
+        e["cache_hit"][units::cache_unit_name(units::CacheUnit(i))] = f.hit[i];
+      e["bandwidth_mb_s"]["dynrtc"] = f.bw_dynrtc;
+      e["bit_identical_to_functional_model"] = f.checked;
+    }
+    if (f.index > 0) {
+      bytes += f.upload_bytes;
+      max_bytes = std::max(max_bytes, f.upload_bytes);
+    }
+    if (f.index > 0) {  // frame 0's trees are the first build, not rebuilds
+      top += f.top_level_builds;
+      bottom += f.bottom_level_builds;
+    }
+    rows.push_back(e);
+  }
+  j["per_frame"] = rows;
+  const std::size_t n = r.frames.size();
+  nlohmann::json sum = {
+      {"upload_bytes_total", bytes},
+      {"upload_bytes_mean", n > 1 ? static_cast<double>(bytes) / (n - 1) : 0.0},
+      {"upload_bytes_max", max_bytes},
+      {"top_level_rebuilds", top},
+      {"bottom_level_rebuilds", bottom},
+      {"bottom_level_trees", r.frames.empty() ? 0 : r.frames.front().bottom_level_builds}};
+  if (r.cycle) {
+    sum["cycles"] = r.total_cycles();
+    sum["fps"] = r.fps();
+    sum["render_fps"] = r.render_fps();
+    sum["uploads_hidden"] = r.hidden_uploads();
+    sum["uploads_in_gaps"] = r.gaps();
+    sum["uploads"] = n > 0 ? n - 1 : 0;
+    sum["break_even_mb_s"] = r.break_even_mb_s();
+  }
+  j["summary"] = sum;
+  return j;
+}
+
+std::string sequence_table(const SequenceResult& r) {
+  std::string s;
+  char buf[400];
+  std::snprintf(
+      buf, sizeof buf, "frames: %s, model %s, %dx%d, %zu frames %g s apart, %s\n", r.scene.c_str(),
+      r.model.c_str(), r.width, r.height, r.frames.size(), r.dt,
+      r.frame_gap ? "one top-level copy (uploads in frame gaps)" : "two top-level copies");
+  s += buf;
+  std::snprintf(buf, sizeof buf,
+                "  %" PRIu64 " objects, %" PRIu64 " instances (%" PRIu64
+                " dynamic); a top-level copy %.1f KB; initial load %.2f MB",
+                r.objects, r.instances, r.dynamic_instances,
+                static_cast<double>(r.top_copy_bytes) / 1024.0, mb(r.initial_load_bytes));
+  s += buf;
+  if (r.cycle) {
+    std::snprintf(buf, sizeof buf, ", %" PRIu64 " cycles = %.1f ms over the %g MB/s host bus",
+                  r.initial_load_cycles,
+                  static_cast<double>(r.initial_load_cycles) / (r.clock_mhz * 1e3), r.bus_mb_s);
+    s += buf;
+  }
+  s += "\n";
+  if (r.cycle) {
+    s += "frame  time s bank copy moved top bot  upload B  upload cyc hidden    stall  "
+         "render cyc    fps trav list xfrm  int  hit t  l  x  rebuild ms\n";
+  } else {
+    s += "frame  time s bank copy moved top bot  upload B  gap  rebuild ms\n";
+  }
+  for (const SequenceFrame& f : r.frames) {
+    std::snprintf(buf, sizeof buf, "%5d %7.3f %4d %4d %5u %3" PRIu64 " %3" PRIu64 " ", f.index,
+                  f.time, f.frame_bank, f.top_copy, f.moved_instances, f.top_level_builds,
+                  f.bottom_level_builds);
+    s += buf;
+    if (f.index == 0) {
+      s += r.cycle ? "   (initial load)                   " : "   (initial load)";
+    } else if (r.cycle) {
+      std::snprintf(buf, sizeof buf, "%9" PRIu64 " %11" PRIu64 " %-6s %8" PRIu64 " ",
+                    f.upload_bytes, f.upload_cycles,
+                    f.gap      ? "gap"
+                    : f.hidden ? "yes"
+                               : "no",
+                    f.stall_cycles);
+      s += buf;
+    } else {
+      std::snprintf(buf, sizeof buf, "%9" PRIu64 "  %-3s", f.upload_bytes, f.gap ? "yes" : "no");
+      s += buf;
+    }
+    if (r.cycle) {
+      std::snprintf(buf, sizeof buf,
+                    "%11" PRIu64 " %6.1f %4.0f %4.0f %4.0f %4.0f %4.0f %2.0f %2.0f", f.cycles,
+                    f.fps, f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.hit[0], f.hit[1],
+                    f.hit[2]);
+      s += buf;
+    }
+    // The host's top-level (re)build on this machine: not on the model's clock (D46).
+    std::snprintf(buf, sizeof buf, " %11.2f\n", f.host_rebuild_seconds * 1e3);
+    s += buf;
+  }
+  const nlohmann::json j = sequence_json(r);
+  const nlohmann::json& sum = j["summary"];
+  std::snprintf(buf, sizeof buf,
+                "summary: uploads %.0f B per frame on average, at most %" PRIu64
+                " B; top-level rebuilds %" PRIu64 ", bottom-level rebuilds %" PRIu64 " (%" PRIu64
+                " bottom-level trees built for frame 0, reused since)\n",
+                sum["upload_bytes_mean"].get<double>(),
+                sum["upload_bytes_max"].get<std::uint64_t>(),
+                sum["top_level_rebuilds"].get<std::uint64_t>(),
+                sum["bottom_level_rebuilds"].get<std::uint64_t>(),
+                sum["bottom_level_trees"].get<std::uint64_t>());
+  s += buf;
+  if (r.cycle && !r.frames.empty()) {
+    std::snprintf(buf, sizeof buf,
+                  "  %" PRIu64
+                  " cycles = %.2f fps at %g MHz with the uploads (%.2f fps rendering "
+                  "alone); uploads hidden behind the previous frame: %d of %zu (%d in frame "
+                  "gaps); the others would fit down to %.3g MB/s\n",
+                  r.total_cycles(), r.fps(), r.clock_mhz, r.render_fps(), r.hidden_uploads(),
+                  r.frames.size() - 1, r.gaps(), r.break_even_mb_s());
+    s += buf;
+  }
+  return s;
+}
+
+std::string sequence_csv(const SequenceResult& r) {
+  std::string s =
+      "frame,time,frame_bank,top_copy,top_rebuilt,moved_instances,top_level_builds,"
+      "bottom_level_builds,upload_bytes,upload_words,upload_runs,upload_in_gap";
+  if (r.cycle)
+    s += ",upload_cycles,upload_hidden,stall_cycles,start_cycle,cycles,fps,usage_traversal,"
+         "usage_list,usage_transformation,usage_intersection,cache_hit_traversal,cache_hit_list,"
+         "cache_hit_transformation,bandwidth_mb_s_dynrtc,cycles_per_packet";
+  s += ",rays,digest\n";
+  char buf[600];
+  for (const SequenceFrame& f : r.frames) {
+    std::snprintf(buf, sizeof buf,
+                  "%d,%.17g,%d,%d,%d,%u,%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64
+                  ",%d",
+                  f.index, f.time, f.frame_bank, f.top_copy, f.top_rebuilt ? 1 : 0,
+                  f.moved_instances, f.top_level_builds, f.bottom_level_builds, f.upload_bytes,
+                  f.upload_words, f.upload_runs, f.gap ? 1 : 0);
+    s += buf;
+    if (r.cycle) {
+      std::snprintf(buf, sizeof buf,
+                    ",%" PRIu64 ",%d,%" PRIu64 ",%" PRIu64 ",%" PRIu64
+                    ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                    f.upload_cycles, f.hidden ? 1 : 0, f.stall_cycles, f.start_cycle, f.cycles,
+                    f.fps, f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.hit[0], f.hit[1],
+                    f.hit[2], f.bw_dynrtc, f.cycles_per_packet);
+      s += buf;
+    }
+    std::snprintf(buf, sizeof buf, ",%" PRIu64 ",%016" PRIx64 "\n", f.rays, f.digest);
+    s += buf;
+  }
+  return s;
+}
+
+// ---- bus sweep ------------------------------------------------------------------------------
+
+std::vector<double> parse_bus_sweep(const std::string& text) {
+  const auto bad = [&](const std::string& why) {
+    return std::runtime_error("bad --bus-sweep '" + text + "': " + why);
+  };
+  std::vector<double> out;
+  std::istringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      throw bad("expected bandwidths in MB/s like 1,8,132");
+    }
+    if (used != item.size() || !std::isfinite(v) || v <= 0.0 || v > 1e6)
+      throw bad("'" + item + "' is not a bandwidth in (0, 1000000] MB/s");
+    if (std::ranges::find(out, v) != out.end()) throw bad(item + " is given twice");
+    out.push_back(v);
+  }
+  if (out.empty() || text.back() == ',') throw bad("expected bandwidths in MB/s like 1,8,132");
+  return out;
+}
+
+std::vector<SequenceResult> run_bus_sweep(const std::string& scene, const ModelSpec& model,
+                                          const RenderSettings& settings,
+                                          const SequenceOptions& opts,
+                                          const std::vector<double>& mb_s) {
+  if (model.kind != ModelKind::kCycle)
+    throw std::runtime_error("--bus-sweep needs --model cycle (the host bus is timed there)");
+  std::vector<SequenceResult> points;
+  for (std::size_t i = 0; i < mb_s.size(); ++i) {
+    RenderSettings s = settings;
+    char kv[64];
+    std::snprintf(kv, sizeof kv, "hostbus.mb_s=%.17g", mb_s[i]);
+    s.cycle.set.emplace_back(kv);
+    SequenceOptions o = opts;
+    o.check = opts.check && i == 0;  // the others must give the first point's frames
+    progress("bus sweep: " + std::to_string(mb_s[i]) + " MB/s");
+    points.push_back(run_sequence(scene, model, s, o));
+    const SequenceResult& p = points.back();
+    for (std::size_t k = 0; k < p.frames.size(); ++k)
+      if (p.frames[k].digest != points.front().frames[k].digest)
+        throw std::runtime_error("bus sweep: at " + std::string(kv) + " frame " +
+                                 std::to_string(k) + " differs from the first point's");
+  }
+  return points;
+}
+
+std::string bus_sweep_table(const std::vector<SequenceResult>& points) {
+  std::string s =
+      "bus MB/s  uploads hidden  frames delayed  max stall cyc  mean upload cyc  sequence fps  "
+      "render fps\n";
+  char buf[300];
+  for (const SequenceResult& p : points) {
+    std::uint64_t max_stall = 0, sum_upload = 0;
+    int delayed = 0;
+    for (std::size_t k = 1; k < p.frames.size(); ++k) {
+      max_stall = std::max(max_stall, p.frames[k].stall_cycles);
+      sum_upload += p.frames[k].upload_cycles;
+      delayed += p.frames[k].stall_cycles > 0 ? 1 : 0;
+    }
+    const std::size_t n = p.frames.size() > 1 ? p.frames.size() - 1 : 1;
+    std::snprintf(
+        buf, sizeof buf, "%8.4g  %7d of %-4zu  %14d  %13" PRIu64 "  %15.0f  %12.2f  %10.2f\n",
+        p.bus_mb_s, p.hidden_uploads(), p.frames.size() - 1, delayed, max_stall,
+        static_cast<double>(sum_upload) / static_cast<double>(n), p.fps(), p.render_fps());
+    s += buf;
+  }
+  if (!points.empty())
+    s += "(uploads fit behind rendering down to about " +
+         std::to_string(points.front().break_even_mb_s()) +
+         " MB/s by bytes over render time, without bank contention)\n";
+  return s;
+}
+
+nlohmann::json bus_sweep_json(const std::vector<SequenceResult>& points) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const SequenceResult& p : points) {
+    nlohmann::json e = sequence_json(p);
+    e["hostbus_mb_s"] = p.bus_mb_s;
+    j.push_back(e);
+  }
+  return j;
+}
+
+// ---- the command ----------------------------------------------------------------------------
+
+namespace {
+
+void refuse_single_frame_options(const RenderOptions& o) {
+  if (!o.pixel.empty()) throw std::runtime_error("--pixel traces one frame: drop --frames");
+  if (o.exr || o.hits_asked)
+    throw std::runtime_error("--exr and --hits write one frame's files: drop them with --frames");
+  if (o.trace.any() || o.trace.window_given)
+    throw std::runtime_error("--trace and --konata trace one frame: drop them with --frames");
+  if (!o.cycle.vcd.empty() || o.cycle.interval != 0)
+    throw std::runtime_error("--vcd and --interval trace one frame: drop them with --frames");
+}
+
+SequenceOptions sequence_options(const RenderOptions& o) {
+  SequenceOptions s;
+  s.frames = o.frames;
+  s.start = o.time;
+  s.frame_gap = o.frame_gap;
+  if (o.fps_given && o.dt_given) throw std::runtime_error("give --fps or --dt, not both");
+  if (o.fps_given) {
+    if (!std::isfinite(o.fps) || o.fps <= 0.0)
+      throw std::runtime_error("bad --fps " + std::to_string(o.fps) +
+                               ": expected frames per animation second > 0");
+    s.dt = 1.0 / o.fps;
+  }
+  if (o.dt_given) {
+    if (!std::isfinite(o.dt) || o.dt < 0.0)
+      throw std::runtime_error("bad --dt " + std::to_string(o.dt) +
+                               ": expected seconds >= 0 between frames");
+    s.dt = o.dt;
+  }
+  return s;
+}
+
+// The shortest frame at the modelled clock (0 without a clock): what the host's rebuild, done
+// while the frame before renders, has to fit in.
+double shortest_frame_ms(const SequenceResult& r) {
+  if (!r.cycle || r.frames.empty()) return 0.0;
+  std::uint64_t c = r.frames.front().cycles;
+  for (const SequenceFrame& f : r.frames)
+    c = std::min(c, f.cycles);
+  return static_cast<double>(c) / (r.clock_mhz * 1e3);
+}
+
+std::string numbered(const std::string& prefix, int index) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%04d", index);
+  return prefix + buf + ".png";
+}
+
+nlohmann::json configuration(const RenderOptions& o, const RenderSettings& s, bool cycle) {
+  nlohmann::json c = {
+      {"time", o.time}, {"shadows", s.shadows}, {"depth", s.depth}, {"bank_mb", s.bank_mb}};
+  if (cycle)
+    for (const units::CycleParamInfo& p : units::describe(resolve_cycle_params(s.cycle)))
+      c["cycle"][p.name] = {{"value", p.value}, {"unit", p.unit}, {"help", p.help}};
+  host::ImageParams trees;
+  for (const std::string& kv : s.cycle.set)
+    if (host::is_tree_setting(kv)) host::apply_tree_setting(trees, kv);
+  for (const host::TreeSettingInfo& t : host::describe_tree_settings(trees))
+    c["trees"][t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
+  return c;
+}
+
+std::vector<StatLine> sequence_stats(const nlohmann::json& j) {
+  std::vector<StatLine> lines;
+  for (const auto& [k, v] : j["summary"].items())
+    lines.push_back({"sequence." + k,
+                     v.is_boolean() ? (v.get<bool>() ? 1.0 : 0.0) : v.get<double>(),
+                     "the sequence's " + k});
+  for (const nlohmann::json& f : j["per_frame"]) {
+    const std::string pre = "frame" + std::to_string(f["frame"].get<int>()) + ".";
+    for (const auto& [k, v] : f.items()) {
+      if (v.is_number())
+        lines.push_back({pre + k, v.get<double>(), k});
+      else if (v.is_boolean())
+        lines.push_back({pre + k, v.get<bool>() ? 1.0 : 0.0, k + " (1 = yes)"});
+    }
+  }
+  return lines;
+}
+
+}  // namespace
+
+int run_frame_sequence(const RenderOptions& opts) {
+  const ModelSpec model = parse_model(opts.model);
+  refuse_single_frame_options(opts);
+  SequenceOptions so = sequence_options(opts);
+  RenderSettings settings =
+      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
+  settings.cycle = opts.cycle;
+  if (model.kind != ModelKind::kCycle && opts.cycle.any_given())
+    throw std::runtime_error(
+        "--preset, --set (but kd.* keys), --interval, --host-threads and --vcd apply to --model "
+        "cycle only");
+  const bool in_dir = !opts.out_dir.empty();
+  if (in_dir) {
+    check_out_dir(opts.out_dir);
+    if (opts.out_given || !opts.report.empty())
+      throw std::runtime_error("--out-dir names every file it writes: drop --out and --report");
+  }
+  if (!opts.report.empty() && !opts.report.ends_with(".json"))
+    throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
+  std::vector<double> sweep;
+  if (!opts.bus_sweep.empty()) {
+    sweep = parse_bus_sweep(opts.bus_sweep);
+    if (model.kind != ModelKind::kCycle)
+      throw std::runtime_error("--bus-sweep needs --model cycle (the host bus is timed there)");
+  }
+  if (model.kind == ModelKind::kCycle) resolve_cycle_params(settings.cycle);
+  if (!std::isfinite(opts.time) || opts.time < 0.0)
+    throw std::runtime_error("bad --time " + std::to_string(opts.time) + ": expected seconds >= 0");
+  check_options(model, so);
+
+  nlohmann::json report;
+  std::string printout;
+  nlohmann::json host = nlohmann::json::object();
+  std::vector<std::pair<std::string, std::string>> outputs;
+  const std::string prefix =
+      in_dir ? run_file(opts.out_dir, "frame_") : output_prefix(opts.out, {".png"}) + "_";
+  std::string csv;
+  if (!sweep.empty()) {
+    const std::vector<SequenceResult> points =
+        run_bus_sweep(opts.scene, model, settings, so, sweep);
+    report["bus_sweep"] = bus_sweep_json(points);
+    printout = sequence_table(points.front()) + "bus sweep:\n" + bus_sweep_table(points);
+  } else {
+    int written = 0;
+    const FrameSink sink = [&](const SequenceFrame& f, const Rgb8Image& image) {
+      write_rgb8(numbered(prefix, f.index), image);
+      ++written;
+    };
+    const SequenceResult r = run_sequence(opts.scene, model, settings, so, sink);
+    report = sequence_json(r, !in_dir);  // a run folder keeps host times in host.json
+    printout = sequence_table(r);
+    csv = sequence_csv(r);
+    nlohmann::json frames = nlohmann::json::array();
+    double rebuild_max = 0.0;
+    for (const SequenceFrame& f : r.frames) {
+      frames.push_back({{"frame", f.index},
+                        {"rebuild_seconds", f.host_rebuild_seconds},
+                        {"seconds", f.host_seconds}});
+      if (f.index > 0) rebuild_max = std::max(rebuild_max, f.host_rebuild_seconds);
+    }
+    host["per_frame"] = frames;
+    host["top_level_rebuild_seconds_max"] = rebuild_max;
+    char buf[300];
+    std::snprintf(buf, sizeof buf,
+                  "  host: top-level rebuild at most %.2f ms per frame after the first (this host",
+                  rebuild_max * 1e3);
+    printout += buf;
+    if (r.cycle) {
+      std::snprintf(buf, sizeof buf, "; the shortest frame at the clock: %.2f ms",
+                    shortest_frame_ms(r));
+      printout += buf;
+    }
+    printout += ")\n";
+    outputs.push_back({"images", numbered(prefix, 0) + " .. " + numbered(prefix, written - 1)});
+  }
+  report["configuration"] = configuration(opts, settings, model.kind == ModelKind::kCycle);
+  if (in_dir) {
+    if (!csv.empty()) {
+      write_text_file(run_file(opts.out_dir, "frames.csv"), csv);
+      outputs.push_back({"csv", run_file(opts.out_dir, "frames.csv")});
+    }
+    write_text_file(run_file(opts.out_dir, "report.json"), report.dump(2) + "\n");
+    write_text_file(run_file(opts.out_dir, "config.json"), report["configuration"].dump(2) + "\n");
+    write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
+    write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
+    if (report.contains("per_frame"))
+      write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text(sequence_stats(report)));
+    for (const char* f : {"report.json", "config.json", "command.txt", "host.json"})
+      outputs.push_back({f, run_file(opts.out_dir, f)});
+  } else if (!opts.report.empty()) {
+    write_text_file(opts.report, report.dump(2) + "\n");
+    outputs.push_back({"report", opts.report});
+  }
+  std::printf("%s", printout.c_str());
+  for (const auto& [k, v] : outputs)
+    std::printf("  %-11s %s\n", (k + ":").c_str(), v.c_str());
+  return 0;
+}
+
+}  // namespace saarcor
