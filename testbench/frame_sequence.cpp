@@ -176,6 +176,8 @@ void take_figures(SequenceFrame& row, const units::CycleFrame& c) {
   for (int i = 0; i < 3; ++i)
     row.hit[i] = c.figures.cache_hit[static_cast<std::size_t>(i)];
   row.bw_dynrtc = c.figures.bw_dynrtc;
+  row.bw_shading = c.figures.bw_shading + c.figures.bw_frame;
+  row.shading_bytes_per_pixel = c.shading_bytes_per_pixel;
   row.cycles_per_packet =
       c.packets == 0 ? 0.0 : static_cast<double>(c.cycles) / static_cast<double>(c.packets);
 }
@@ -420,6 +422,8 @@ nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
       for (int i = 0; i < 3; ++i)
         e["cache_hit"][units::cache_unit_name(units::CacheUnit(i))] = f.hit[i];
       e["bandwidth_mb_s"]["dynrtc"] = f.bw_dynrtc;
+      e["bandwidth_mb_s"]["shading"] = f.bw_shading;
+      e["shading_bytes_per_pixel"] = f.shading_bytes_per_pixel;
       e["bit_identical_to_functional_model"] = f.checked;
     }
     if (f.index > 0) {
@@ -543,7 +547,8 @@ std::string sequence_csv(const SequenceResult& r) {
   if (r.cycle)
     s += ",upload_cycles,upload_hidden,stall_cycles,start_cycle,cycles,fps,usage_traversal,"
          "usage_list,usage_transformation,usage_intersection,cache_hit_traversal,cache_hit_list,"
-         "cache_hit_transformation,bandwidth_mb_s_dynrtc,cycles_per_packet";
+         "cache_hit_transformation,bandwidth_mb_s_dynrtc,cycles_per_packet,"
+         "bandwidth_mb_s_shading,shading_bytes_per_pixel";
   s += ",rays,digest\n";
   char buf[600];
   for (const SequenceFrame& f : r.frames) {
@@ -557,10 +562,11 @@ std::string sequence_csv(const SequenceResult& r) {
     if (r.cycle) {
       std::snprintf(buf, sizeof buf,
                     ",%" PRIu64 ",%d,%" PRIu64 ",%" PRIu64 ",%" PRIu64
-                    ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                    ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
                     f.upload_cycles, f.hidden ? 1 : 0, f.stall_cycles, f.start_cycle, f.cycles,
                     f.fps, f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.hit[0], f.hit[1],
-                    f.hit[2], f.bw_dynrtc, f.cycles_per_packet);
+                    f.hit[2], f.bw_dynrtc, f.cycles_per_packet, f.bw_shading,
+                    f.shading_bytes_per_pixel);
       s += buf;
     }
     std::snprintf(buf, sizeof buf, ",%" PRIu64 ",%016" PRIx64 "\n", f.rays, f.digest);
