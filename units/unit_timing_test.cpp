@@ -493,6 +493,22 @@ TEST(UnitTimingInputs, HigherPriorityPathIsAcceptedFirst) {
   EXPECT_EQ(sink.got_at(1), visible + u64(kReadyToIssue + (steps - 1) + depth + kPathLatency));
 }
 
+// The RGS's neighbours: path g in (a source pushing returning threads), path a out (a sink).
+struct RgsNeighbours {
+  RgsNeighbours(hw::Kernel& k, RaySource& rgs)
+      : a(path(k, "t.path_a")),
+        g(path(k, "t.path_g")),
+        src(k, "t.source", g, {}),
+        sink(k, "t.sink", {&a}) {
+    rgs.add_input(&g);
+    rgs.set_output(UnitId::kTransformation, &a);
+  }
+  ThreadPath& a;
+  ThreadPath& g;
+  Source src;
+  Sink sink;
+};
+
 // (5b) Ray source: one packet admitted per granted cycle to the oldest free thread, on path a;
 // a returning packet runs its RGS phase, retires after the RGS depth, and its thread takes the
 // next packet in that same cycle.
@@ -504,12 +520,9 @@ TEST(UnitTimingRaySource, AdmitsOnePacketPerGrantedCycleAndReadmitsARetiredThrea
   RayGenerationController rgc(packets, 1);
   const int rgs_depth = 1;  // units/dynrtp.cpp
   auto& rgs = k.make<RaySource>("t.rgs", threads, rgs_depth, rgc, 0, 0, threads_count);
-  ThreadPath& a = path(k, "t.path_a");
-  ThreadPath& g = path(k, "t.path_g");
-  rgs.add_input(&g);
-  rgs.set_output(UnitId::kTransformation, &a);
-  Source src(k, "t.source", g, {});
-  Sink sink(k, "t.sink", {&a});
+  RgsNeighbours n(k, rgs);
+  Source& src = n.src;
+  Sink& sink = n.sink;
   k.run_to_completion([&] { return sink.got.size() == 2; }, 1000);
 
   // One pipeline: every cycle is granted; packets 0 and 1 go out in cycles 0 and 1.
@@ -550,13 +563,8 @@ TEST(UnitTimingRaySource, RoundRobinGrantAdmitsEveryPipelinesCycle) {
   ScriptedThreads threads(k, {{}, {}, {}, {}}, {generate(kP + 1)}, 8);
   RayGenerationController rgc(8, pipelines);
   auto& rgs = k.make<RaySource>("t.rgs1", threads, 1, rgc, pipeline, 2, 2);  // threads 2, 3
-  ThreadPath& a = path(k, "t.path_a");
-  ThreadPath& g = path(k, "t.path_g");
-  rgs.add_input(&g);
-  rgs.set_output(UnitId::kTransformation, &a);
-  Source src(k, "t.source", g, {});
-  Sink sink(k, "t.sink", {&a});
-  k.run_to_completion([&] { return sink.got.size() == 2; }, 1000);
+  RgsNeighbours n(k, rgs);
+  k.run_to_completion([&] { return n.sink.got.size() == 2; }, 1000);
   ASSERT_EQ(threads.starts.size(), 2u);
   EXPECT_EQ(threads.starts[0].cycle, u64(pipeline));              // the first granted cycle
   EXPECT_EQ(threads.starts[1].cycle, u64(pipeline + pipelines));  // one round later
@@ -599,12 +607,9 @@ TEST(UnitTimingRgs, ReadsInDependentWavesThenShadingDepthThenOneWritePerCycle) {
   ScriptedThreads threads(k, {{}}, {generate(kP + 1)}, packets);
   RayGenerationController rgc(packets, 1);
   auto& rgs = k.make<RaySource>("t.rgs", threads, rgs_depth, rgc, 0, 0, 1, ports);
-  ThreadPath& a = path(k, "t.path_a");
-  ThreadPath& g = path(k, "t.path_g");
-  rgs.add_input(&g);
-  rgs.set_output(UnitId::kTransformation, &a);
-  Source src(k, "t.source", g, {});
-  Sink sink(k, "t.sink", {&a});
+  RgsNeighbours n(k, rgs);
+  Source& src = n.src;
+  Sink& sink = n.sink;
   k.run_to_completion([&] { return sink.got.size() == 1; }, 1000);
 
   // The packet returns with its last RGS phase: record (4 words), material (4), texel (1), then
