@@ -376,8 +376,8 @@ class RgsStep {
     // The children are built in the next three pending slots, whose lane vectors are kept from
     // earlier packets (no allocation per packet); the reflection packet is traced first.
     if (pending_.size() < pending_size_ + 3) pending_.resize(pending_size_ + 3);
-    Children ch{&pending_[pending_size_ + 2], &pending_[pending_size_ + 1],
-                &pending_[pending_size_]};
+    Children ch{
+        {&pending_[pending_size_ + 2], &pending_[pending_size_ + 1], &pending_[pending_size_]}};
     const RayKind kinds[3] = {RayKind::kReflection, RayKind::kTransparency, RayKind::kRefraction};
     for (int k = 0; k < 3; ++k) {
       GenPacket<F>& pk = *ch.packet[k];
