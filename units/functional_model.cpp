@@ -214,8 +214,7 @@ PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& 
         static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
     trace.pixel = sink.pixels[i];
     for (std::size_t k = 0; k < 3; ++k)
-      trace.rgb[k] = static_cast<std::uint8_t>(
-          std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
+      trace.rgb[k] = pixel_channel(sink.colour_sum[i][k]);
     return trace;
   });
 }

@@ -126,8 +126,7 @@ void collect_frame(FunctionalFrame& frame, const PipelineUnits<F>& u, FrameSink&
   frame.rgb.resize(sink.pixels.size() * 3u);
   for (std::size_t i = 0; i < sink.pixels.size(); ++i)
     for (std::size_t k = 0; k < 3; ++k)
-      frame.rgb[3u * i + k] = static_cast<std::uint8_t>(
-          std::min<std::uint32_t>(255u, (sink.colour_sum[i][k] + 127u) / 255u));
+      frame.rgb[3u * i + k] = pixel_channel(sink.colour_sum[i][k]);
   frame.pixels = std::move(sink.pixels);
 }
 

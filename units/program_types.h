@@ -169,13 +169,17 @@ struct RgsAccess {
   bool write = false;
 };
 
+// A pixel channel from its weighted colour sum (docs/shading.md section 7): the sum / 255, rounded
+// and clamped to 8 bits.
+inline std::uint8_t pixel_channel(std::uint32_t colour_sum) {
+  return static_cast<std::uint8_t>(std::min<std::uint32_t>(255u, (colour_sum + 127u) / 255u));
+}
 // A finished pixel as the RGS writes it into the frame buffer: R, G, B in bits 0..7, 8..15,
-// 16..23 (the shading bank's RGB8 packing), each channel the rounded, clamped weighted sum /255.
+// 16..23 (the shading bank's RGB8 packing).
 inline std::uint32_t pixel_word(const std::array<std::uint32_t, 3>& colour_sum) {
   std::uint32_t w = 0;
   for (int k = 0; k < 3; ++k)
-    w |= std::min<std::uint32_t>(255u, (colour_sum[static_cast<std::size_t>(k)] + 127u) / 255u)
-         << (8 * k);
+    w |= std::uint32_t{pixel_channel(colour_sum[static_cast<std::size_t>(k)])} << (8 * k);
   return w;
 }
 
