@@ -2,6 +2,7 @@
 #include "memif/memory_controller.h"
 
 #include <algorithm>
+#include <bit>
 #include <sstream>
 #include <stdexcept>
 
@@ -36,22 +37,25 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
       config_(std::move(config)),
       banks_(kNumBanks),
       inflight_limit_(config_.latency + 2) {
+  due_.fill(hw::kNever);
   sleep_when_idle();  // its timers are in next_wakeup, its inputs are its ports
   hw::Stats& s = stats();
   const std::string& n = this->name();
   for (int b = 0; b < kNumBanks; ++b) {
     const int p = config_.bank_path[static_cast<std::size_t>(b)];
     if (static_cast<int>(paths_.size()) <= p) paths_.resize(static_cast<std::size_t>(p) + 1);
-    paths_[static_cast<std::size_t>(p)].banks.push_back(b);
+    paths_[static_cast<std::size_t>(p)].banks |= 1u << b;
     const std::string bn = n + ".bank" + std::to_string(b);
     Bank& bank = banks_[static_cast<std::size_t>(b)];
+    bank.queue = hw::Ring<Queued>(config_.queue_depth);
+    bank.inflight = hw::Ring<InFlight>(inflight_limit_);
     bank.reads = &s.counter(bn + ".reads", "requests", "read requests started");
     bank.writes = &s.counter(bn + ".writes", "requests", "write requests started");
     bank.words = &s.counter(bn + ".busy_cycles", "cycles", "cycles transferring a word");
     bank.max_queue = &s.counter(bn + ".max_queue", "requests", "largest bank queue occupancy");
   }
   for (std::size_t p = 0; p < paths_.size(); ++p) {
-    if (paths_[p].banks.empty()) continue;
+    if (paths_[p].banks == 0) continue;
     paths_[p].switches = &s.counter(n + ".path" + std::to_string(p) + ".bank_switches", "events",
                                     "starts on a bank other than the path's open bank");
   }
@@ -110,9 +114,7 @@ std::uint64_t MemoryController::bank_switches() const {
 }
 
 bool MemoryController::idle() const {
-  for (const Bank& b : banks_) {
-    if (!b.queue.empty() || !b.inflight.empty()) return false;
-  }
+  if (queued_ != 0 || inflight_ != 0) return false;
   for (const auto& p : ports_) {
     if (!p->requests.empty() || !p->responses.empty()) return false;
   }
@@ -125,10 +127,10 @@ bool MemoryController::port_idle(const Port& port) const {
   for (std::size_t p = 0; p < ports_.size(); ++p)
     if (ports_[p].get() == &port) index = static_cast<int>(p);
   for (const Bank& b : banks_) {
-    for (const Queued& q : b.queue)
-      if (q.port == index) return false;
-    for (const InFlight& f : b.inflight)
-      if (f.port == index) return false;
+    for (std::size_t i = 0; i < b.queue.size(); ++i)
+      if (b.queue[i].port == index) return false;
+    for (std::size_t i = 0; i < b.inflight.size(); ++i)
+      if (b.inflight[i].port == index) return false;
   }
   return true;
 }
@@ -148,28 +150,29 @@ int MemoryController::retire_responses() {
   int moved = 0;
   for (;;) {
     int best = -1;
-    for (int b = 0; b < kNumBanks; ++b) {
-      const Bank& bank = banks_[static_cast<std::size_t>(b)];
-      if (bank.inflight.empty() || bank.inflight.front().due > now()) continue;
-      if (!ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.can_push()) {
-        continue;
-      }
-      if (best < 0 ||
-          bank.inflight.front().due < banks_[static_cast<std::size_t>(best)].inflight.front().due) {
+    for (unsigned bits = inflight_; bits != 0; bits &= bits - 1) {
+      const int b = std::countr_zero(bits);
+      if (due_[static_cast<std::size_t>(b)] > now()) continue;
+      const int port = banks_[static_cast<std::size_t>(b)].inflight.front().port;
+      if (!ports_[static_cast<std::size_t>(port)]->responses.can_push()) continue;
+      if (best < 0 || due_[static_cast<std::size_t>(b)] < due_[static_cast<std::size_t>(best)])
         best = b;
-      }
     }
     if (best < 0) break;
     Bank& bank = banks_[static_cast<std::size_t>(best)];
     ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.push(
         bank.inflight.front().resp);
     bank.inflight.pop_front();
-    --inflight_;
+    if (bank.inflight.empty()) {
+      inflight_ &= ~(1u << best);
+      due_[static_cast<std::size_t>(best)] = hw::kNever;
+    } else {
+      due_[static_cast<std::size_t>(best)] = bank.inflight.front().due;
+    }
     ++moved;
   }
-  for (const Bank& bank : banks_) {
-    if (!bank.inflight.empty() && bank.inflight.front().due <= now()) stall();  // port full
-  }
+  for (unsigned bits = inflight_; bits != 0; bits &= bits - 1)
+    if (due_[static_cast<std::size_t>(std::countr_zero(bits))] <= now()) stall();  // port full
   return moved;
 }
 
@@ -177,7 +180,10 @@ void MemoryController::start(int b, std::uint64_t when) {
   Bank& bank = banks_[static_cast<std::size_t>(b)];
   const Queued q = bank.queue.front();
   bank.queue.pop_front();
-  --queued_;
+  if (bank.queue.empty())
+    queued_ &= ~(1u << b);
+  else
+    oldest_[static_cast<std::size_t>(b)] = bank.queue.front().seq;
   const MemRequest& r = q.req;
   bank.free_at = when + r.words;
   *bank.words += r.words;
@@ -198,31 +204,34 @@ void MemoryController::start(int b, std::uint64_t when) {
   f.resp.count = r.words;
   for (int i = 0; i < r.words; ++i)
     f.resp.words[static_cast<std::size_t>(i)] = mem[r.offset + static_cast<std::uint32_t>(i)];
+  if (bank.inflight.empty()) {
+    inflight_ |= 1u << b;
+    due_[static_cast<std::size_t>(b)] = f.due;
+  }
   bank.inflight.push_back(f);
-  ++inflight_;
 }
 
 int MemoryController::issue() {
   if (queued_ == 0) return 0;
   int started = 0;
   for (Path& path : paths_) {
-    if (path.banks.empty() || path.free_at > now()) continue;
+    const unsigned waiting = path.banks & queued_;
+    if (waiting == 0 || path.free_at > now()) continue;
     auto startable = [&](int b) {
       const Bank& bank = banks_[static_cast<std::size_t>(b)];
-      return !bank.queue.empty() && bank.free_at <= now() &&
+      return (queued_ >> b & 1u) != 0 && bank.free_at <= now() &&
              static_cast<int>(bank.inflight.size()) < inflight_limit_;
     };
+    auto older = [&](int b, int than) {
+      return than < 0 ||
+             oldest_[static_cast<std::size_t>(b)] < oldest_[static_cast<std::size_t>(than)];
+    };
     int oldest_any = -1, oldest_startable = -1, others_waiting = 0;
-    for (int b : path.banks) {
-      const Bank& bank = banks_[static_cast<std::size_t>(b)];
-      if (bank.queue.empty()) continue;
+    for (unsigned bits = waiting; bits != 0; bits &= bits - 1) {
+      const int b = std::countr_zero(bits);
       if (b != path.open) ++others_waiting;
-      auto older = [&](int than) {
-        return than < 0 ||
-               bank.queue.front().seq < banks_[static_cast<std::size_t>(than)].queue.front().seq;
-      };
-      if (older(oldest_any)) oldest_any = b;
-      if (startable(b) && older(oldest_startable)) oldest_startable = b;
+      if (older(b, oldest_any)) oldest_any = b;
+      if (startable(b) && older(b, oldest_startable)) oldest_startable = b;
     }
     int chosen = -1;
     if (config_.reorder) {
@@ -230,7 +239,7 @@ int MemoryController::issue() {
       // it becomes free no later than a switch would let another bank start: such a switch
       // would be needless. Otherwise switch to the free bank with the oldest request.
       const Bank* open = path.open >= 0 ? &banks_[static_cast<std::size_t>(path.open)] : nullptr;
-      const bool open_wanted = open != nullptr && !open->queue.empty() &&
+      const bool open_wanted = open != nullptr && (queued_ >> path.open & 1u) != 0 &&
                                (path.burst < config_.max_burst || others_waiting == 0);
       if (open_wanted && startable(path.open)) {
         chosen = path.open;
@@ -281,8 +290,11 @@ int MemoryController::accept_requests() {
       stall();
       continue;
     }
+    if (bank.queue.empty()) {
+      queued_ |= 1u << r.bank;
+      oldest_[r.bank] = seq_;
+    }
     bank.queue.push_back({in.pop(), static_cast<int>(p), seq_++});
-    ++queued_;
     bank.max_queue->set_max(bank.queue.size());
     ++accepted;
   }
@@ -291,17 +303,16 @@ int MemoryController::accept_requests() {
 
 std::uint64_t MemoryController::next_wakeup(std::uint64_t now) const {
   std::uint64_t t = hw::kNever;
-  for (int b = 0; b < kNumBanks; ++b) {
-    const Bank& bank = banks_[static_cast<std::size_t>(b)];
-    if (!bank.inflight.empty() && bank.inflight.front().due > now) {
-      t = std::min(t, bank.inflight.front().due);
-    }
-    if (!bank.queue.empty()) {
-      const Path& path =
-          paths_[static_cast<std::size_t>(config_.bank_path[static_cast<std::size_t>(b)])];
-      const std::uint64_t ready = std::max(bank.free_at, path.free_at);
-      if (ready > now) t = std::min(t, ready);
-    }
+  for (unsigned bits = inflight_; bits != 0; bits &= bits - 1) {
+    const std::uint64_t due = due_[static_cast<std::size_t>(std::countr_zero(bits))];
+    if (due > now) t = std::min(t, due);
+  }
+  for (unsigned bits = queued_; bits != 0; bits &= bits - 1) {
+    const int b = std::countr_zero(bits);
+    const Path& path =
+        paths_[static_cast<std::size_t>(config_.bank_path[static_cast<std::size_t>(b)])];
+    const std::uint64_t ready = std::max(banks_[static_cast<std::size_t>(b)].free_at, path.free_at);
+    if (ready > now) t = std::min(t, ready);
   }
   return t;
 }

@@ -25,13 +25,14 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "hw/kernel.h"
+#include "hw/ring.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
@@ -95,25 +96,27 @@ class MemoryController : public hw::Module {
  private:
   struct Queued {
     MemRequest req;
-    int port;
-    std::uint64_t seq;  // arrival order, for oldest-first
+    int port = 0;
+    std::uint64_t seq = 0;  // arrival order, for oldest-first
   };
   struct InFlight {
-    std::uint64_t due;
-    int port;
+    std::uint64_t due = 0;
+    int port = 0;
     MemResponse resp;
   };
+  // A bank's queue holds at most queue_depth requests and its reads in flight at most
+  // inflight_limit_ (a bank starts no read beyond it), so both are fixed rings.
   struct Bank {
-    std::deque<Queued> queue;
-    std::deque<InFlight> inflight;  // reads, in start order (due cycles increase)
-    std::uint64_t free_at = 0;      // first cycle the bank can start another request
+    hw::Ring<Queued> queue;
+    hw::Ring<InFlight> inflight;  // reads, in start order (due cycles increase)
+    std::uint64_t free_at = 0;    // first cycle the bank can start another request
     hw::Counter* reads = nullptr;
     hw::Counter* writes = nullptr;
     hw::Counter* words = nullptr;
     hw::Counter* max_queue = nullptr;
   };
   struct Path {
-    std::vector<int> banks;
+    unsigned banks = 0;  // bit b: bank b is on this path
     int open = -1;
     int burst = 0;
     std::uint64_t free_at = 0;
@@ -137,8 +140,12 @@ class MemoryController : public hw::Module {
   std::vector<Path> paths_;
   std::vector<Client> clients_;
   std::uint64_t seq_ = 0;
-  int queued_ = 0, inflight_ = 0;  // over all banks: the stages skip their loops when 0
   int inflight_limit_;
+  // What the per-cycle stages scan, kept beside the banks so a cycle reads a few words: bit b of
+  // queued_ / inflight_ says bank b has a queued request / a read in flight, and then oldest_[b]
+  // is its front request's arrival number and due_[b] its front read's due cycle.
+  unsigned queued_ = 0, inflight_ = 0;
+  std::array<std::uint64_t, kNumBanks> oldest_{}, due_{};
 };
 
 }  // namespace saarcor::memif

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "hw/kernel.h"
+#include "hw/ring.h"
 #include "memif/cache.h"
 #include "units/request_trace.h"
 #include "units/thread_program.h"
@@ -59,29 +60,9 @@ class ThreadTable {
   std::vector<Request> requests_;  // one per thread
 };
 
-// A FIFO of at most `capacity` items in a power-of-two ring (the units' ready queue, pipeline and
-// free list hold thread ids, at most one entry per thread, so the capacity is the thread count).
-template <class T>
-class Ring {
- public:
-  explicit Ring(int capacity) {
-    std::size_t n = 1;
-    while (n < static_cast<std::size_t>(capacity))
-      n *= 2;
-    items_.resize(n);
-    mask_ = n - 1;
-  }
-  bool empty() const { return head_ == tail_; }
-  std::size_t size() const { return tail_ - head_; }
-  const T& front() const { return items_[head_ & mask_]; }
-  const T& operator[](std::size_t k) const { return items_[(head_ + k) & mask_]; }
-  void push_back(const T& v) { items_[tail_++ & mask_] = v; }
-  void pop_front() { ++head_; }
-
- private:
-  std::vector<T> items_;
-  std::size_t mask_ = 0, head_ = 0, tail_ = 0;
-};
+// The ready queue, pipeline and free list hold thread ids, at most one entry per thread, so their
+// capacity is the thread count.
+using hw::Ring;
 
 // A thread id on a path between units.
 using ThreadToken = std::uint32_t;
