@@ -139,11 +139,13 @@ class RaySource : public CycleUnit {
   // FIFOs at a time: its wave's reads to issue (reading_), its shading (shading_, in order of
   // `due`), its pixels to write (writing_), its path out (leaving_).
   struct Held {
-    std::vector<RgsAccess> access;  // the reads, then the writes (as the program lists them)
-    std::size_t reads = 0;          // access[0, reads) are reads
-    std::size_t next = 0;           // the next access to issue
-    int outstanding = 0;            // reads issued and not answered
-    std::uint64_t due = 0;          // the cycle its shading is done
+    // The reads, then the writes, as the program lists them: the thread table's own list, which
+    // stays put while the thread is held (its next request executes only after it left).
+    const std::vector<RgsAccess>* access = nullptr;
+    std::size_t reads = 0;  // access[0, reads) are reads
+    std::size_t next = 0;   // the next access to issue
+    int outstanding = 0;    // reads issued and not answered
+    std::uint64_t due = 0;  // the cycle its shading is done
   };
   Held& held(ThreadToken t) { return held_[t - first_]; }
   const Held& held(ThreadToken t) const { return held_[t - first_]; }

@@ -63,10 +63,10 @@ bool RaySource::hold(ThreadToken thread) {
   const std::vector<RgsAccess>& access = threads_.rgs_memory(thread);
   if (access.empty()) return false;
   Held& h = held(thread);
-  h.access.assign(access.begin(), access.end());
+  h.access = &access;
   h.reads = static_cast<std::size_t>(
-      std::find_if(h.access.begin(), h.access.end(), [](const RgsAccess& a) { return a.write; }) -
-      h.access.begin());
+      std::find_if(access.begin(), access.end(), [](const RgsAccess& a) { return a.write; }) -
+      access.begin());
   h.next = 0;
   h.outstanding = 0;
   if (h.reads == 0)
@@ -120,7 +120,7 @@ int RaySource::receive_shading() {
 
 void RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t client,
                              ThreadToken t, Held& h) {
-  const RgsAccess& a = h.access[h.next++];
+  const RgsAccess& a = (*h.access)[h.next++];
   memif::MemRequest m;
   m.client = client;
   m.tag = t;
@@ -139,11 +139,11 @@ int RaySource::issue_read() {
   if (reading_.empty() || !ports_.shading->requests.can_push()) return 0;
   const ThreadToken t = reading_.front();
   Held& h = held(t);
-  const std::uint8_t wave = h.access[h.next].wave;
+  const std::uint8_t wave = (*h.access)[h.next].wave;
   ++h.outstanding;
   issue_access(*ports_.shading, ports_.shading_client, t, h);
   ++*reads_;
-  if (h.next == h.reads || h.access[h.next].wave != wave) reading_.pop_front();
+  if (h.next == h.reads || (*h.access)[h.next].wave != wave) reading_.pop_front();
   return 1;
 }
 
@@ -154,7 +154,7 @@ int RaySource::write_and_leave() {
   while (!shading_.empty() && held(shading_.front()).due <= now()) {
     const ThreadToken t = shading_.front();
     shading_.pop_front();
-    (held(t).next < held(t).access.size() ? writing_ : leaving_).push_back(t);
+    (held(t).next < held(t).access->size() ? writing_ : leaving_).push_back(t);
   }
   if (!writing_.empty() && ports_.frame->requests.can_push()) {
     const ThreadToken t = writing_.front();
@@ -162,7 +162,7 @@ int RaySource::write_and_leave() {
     issue_access(*ports_.frame, ports_.frame_client, t, h);
     ++*writes_;
     ++progress;
-    if (h.next == h.access.size()) {
+    if (h.next == h.access->size()) {
       writing_.pop_front();
       leaving_.push_back(t);
     }
