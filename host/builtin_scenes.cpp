@@ -302,6 +302,27 @@ Scene make_cube() {
   return s;
 }
 
+// The inside of a box-shaped room spanning [-w, w] x [0, h] x [-w, w]: the floor as cells x cells
+// textured quads, the ceiling and the four walls one quad each (builtin:room, builtin:glass).
+struct RoomShell {
+  double w, h;
+  int floor_cells;
+  glm::dvec2 floor_uv;
+  std::uint32_t floor, ceiling, back, walls;
+  glm::dvec2 back_uv{1.0, 1.0};
+};
+
+void add_room_shell(MeshBuilder& b, const RoomShell& r) {
+  const double w = r.w, h = r.h;
+  const int n = r.floor_cells;
+  b.grid({-w, 0, w}, {2 * w, 0, 0}, {0, 0, -2 * w}, n, n, r.floor, r.floor_uv);  // 2 n^2
+  b.grid({-w, h, -w}, {2 * w, 0, 0}, {0, 0, 2 * w}, 1, 1, r.ceiling);            // 2
+  b.grid({-w, 0, -w}, {2 * w, 0, 0}, {0, h, 0}, 1, 1, r.back, r.back_uv);        // back, 2
+  b.grid({w, 0, w}, {-2 * w, 0, 0}, {0, h, 0}, 1, 1, r.walls);                   // front, 2
+  b.grid({-w, 0, w}, {0, 0, -2 * w}, {0, h, 0}, 1, 1, r.walls);                  // left, 2
+  b.grid({w, 0, -w}, {0, 0, 2 * w}, {0, h, 0}, 1, 1, r.walls);                   // right, 2
+}
+
 // ---- builtin:room (Scene6: "a simple room with table and chairs", 806 triangles, 1 object) -----
 
 Scene make_room() {
@@ -320,13 +341,7 @@ Scene make_room() {
   const std::uint32_t vase_m = add_material(s, "vase", {0.15f, 0.30f, 0.75f}, 0.3f, 0.15f);
 
   MeshBuilder b("room");
-  const double w = 3.0, h = 3.0;  // the room spans [-3, 3] x [0, 3] x [-3, 3]
-  b.grid({-w, 0, w}, {2 * w, 0, 0}, {0, 0, -2 * w}, 12, 12, floor_m, {6, 6});  // 288
-  b.grid({-w, h, -w}, {2 * w, 0, 0}, {0, 0, 2 * w}, 1, 1, ceil_m);             // 2
-  b.grid({-w, 0, -w}, {2 * w, 0, 0}, {0, h, 0}, 1, 1, wall_m);                 // back, 2
-  b.grid({w, 0, w}, {-2 * w, 0, 0}, {0, h, 0}, 1, 1, wall_m);                  // front, 2
-  b.grid({-w, 0, w}, {0, 0, -2 * w}, {0, h, 0}, 1, 1, wall_m);                 // left, 2
-  b.grid({w, 0, -w}, {0, 0, 2 * w}, {0, h, 0}, 1, 1, wall_m);                  // right, 2
+  add_room_shell(b, {3.0, 3.0, 12, {6, 6}, floor_m, ceil_m, wall_m, wall_m});  // 288 + 10
   // Table: top and four legs (60).
   const glm::dvec3 tc(0, 0, -0.5);
   b.box(tc + glm::dvec3(-0.8, 0.72, -0.45), tc + glm::dvec3(0.8, 0.78, 0.45), wood_m);
@@ -824,13 +839,8 @@ Scene make_glass() {
   const std::uint32_t block_m = add_glass(s, "crystal", {1.0f, 0.95f, 0.85f}, 0.85f, 1.7f);
 
   MeshBuilder room("room");
-  const double w = 2.0, h = 2.5;  // the room spans [-2, 2] x [0, 2.5] x [-2, 2]
-  room.grid({-w, 0, w}, {2 * w, 0, 0}, {0, 0, -2 * w}, 4, 4, floor_m, {4, 4});  // 32
-  room.grid({-w, h, -w}, {2 * w, 0, 0}, {0, 0, 2 * w}, 1, 1, wall_m);           // ceiling, 2
-  room.grid({-w, 0, -w}, {2 * w, 0, 0}, {0, h, 0}, 1, 1, back_m, {3, 1});       // back, 2
-  room.grid({w, 0, w}, {-2 * w, 0, 0}, {0, h, 0}, 1, 1, wall_m);                // front, 2
-  room.grid({-w, 0, w}, {0, 0, -2 * w}, {0, h, 0}, 1, 1, wall_m);               // left, 2
-  room.grid({w, 0, -w}, {0, 0, 2 * w}, {0, h, 0}, 1, 1, wall_m);                // right, 2
+  const double w = 2.0;
+  add_room_shell(room, {w, 2.5, 4, {4, 4}, floor_m, wall_m, back_m, wall_m, {3, 1}});  // 32 + 10
   // A mirror before the back wall, behind the block (2).
   room.grid({0.4, 0.3, -w + 0.02}, {1.4, 0, 0}, {0, 1.5, 0}, 1, 1, mirror_m);
   // A green post behind the sphere, seen through it; its foot below the floor, so no face lies
