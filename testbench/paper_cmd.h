@@ -56,7 +56,12 @@ struct PaperOptions {
   std::string json;
 };
 
-// The result: one entry per table and scene, with the model's whole cycle report.
+// The --set keys a paper scene's frames run with: the user's, and the paper's texture filter for
+// that scene (unfiltered for Scene6 and Office, bilinear for the others) unless the user set one.
+std::vector<std::string> paper_settings(const PaperOptions& opts, const std::string& paper);
+
+// The result: one entry per table and scene, with the model's whole cycle report and the
+// settings it ran with.
 nlohmann::json run_paper_tables(const PaperOptions& opts);
 // The room at the Table 3 setting with 1, 2, 4, ..., 64 threads: fps, speed-up over one thread,
 // and the speed-up of each doubling beside the paper's (x2 up to 32 threads, about x1.10 from 32

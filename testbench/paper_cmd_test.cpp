@@ -106,10 +106,28 @@ TEST(Paper, RoomRowsBesideThePapers) {
   EXPECT_NE(text.find("  ratio model/paper"), std::string::npos) << text;
   const std::string csv = paper_csv(r);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 + 14);
-  // The paper's setting: textures unfiltered, listed in the configuration.
-  EXPECT_EQ(r["configuration"][0], "image.bilinear=0");
+  // The paper's setting for Scene6: textures unfiltered, listed in the entry's configuration.
+  EXPECT_EQ(t3["configuration"][0], "image.bilinear=0");
+  EXPECT_NE(text.find("Scene6, unfiltered"), std::string::npos) << text;
   EXPECT_GT(t4["figures"]["shading_bytes_per_pixel"]["model"].get<double>(), 16.0);
   EXPECT_NE(csv.find("4,Scene6,builtin:room,stand-in,64x48,usage_list,"), std::string::npos);
+}
+
+// The paper's filters: "all scenes use bilinear filtered textures, Scene6 and Office were rendered
+// with unfiltered textures"; a filter the user sets wins for every scene.
+TEST(Paper, EachSceneRendersWithThePapersTextureFilter) {
+  PaperOptions o;
+  o.set = {"threads=32"};
+  EXPECT_EQ(paper_settings(o, "Scene6"),
+            (std::vector<std::string>{"image.bilinear=0", "threads=32"}));
+  EXPECT_EQ(paper_settings(o, "Office"),
+            (std::vector<std::string>{"image.bilinear=0", "threads=32"}));
+  EXPECT_EQ(paper_settings(o, "Terrain"),
+            (std::vector<std::string>{"image.bilinear=1", "threads=32"}));
+  EXPECT_EQ(paper_settings(o, "SunCOR"),
+            (std::vector<std::string>{"image.bilinear=1", "threads=32"}));
+  o.set = {"image.bilinear=0"};
+  EXPECT_EQ(paper_settings(o, "Terrain"), (std::vector<std::string>{"image.bilinear=0"}));
 }
 
 // The thread curve: seven frames, speed-ups over one thread, and the paper's doubling steps.
