@@ -64,6 +64,9 @@ class ChannelBase {
     return tail_ != head_ ? ready_at_[head_ & mask_] : kNever;
   }
 
+  // Cycle from which the producer may push: kNever while full (a pop wakes the producer then).
+  std::uint64_t push_ready_cycle() const { return push_ready_; }
+
   // (The hottest tests of a model: one compare against a cached cycle each, see pop_ready_.)
   bool can_push() const { return push_ready_ <= *now_; }
   bool can_pop() const { return pop_ready_ <= *now_; }
