@@ -34,9 +34,10 @@ struct Aabb {
 struct KdBuildParams {
   // Costs in the DynRTP's terms (docs/kdtree.md "Costs for this hardware"): a traversal step is a
   // traversal-unit cycle, a triangle test P + 1 transformation cycles on another unit running
-  // in parallel. 30 : 20 balances the two units' SAH-expected loads on the room and keeps large
-  // meshes under 4 nodes per triangle (Wald & Havran's software defaults were 15 : 20 with an
-  // empty-space bonus of 0.8, which made long chains of empty cuts).
+  // in parallel. 30 : 20 balances the two units' SAH-expected loads on the room and keeps most
+  // large meshes under 4 nodes per triangle (the node bound below keeps all; Wald & Havran's
+  // software defaults were 15 : 20 with an empty-space bonus of 0.8, which made long chains of
+  // empty cuts).
   float traversal_cost = 30.0f;
   float intersection_cost = 20.0f;
   float empty_bonus = 1.0f;  // cost factor for a split that cuts off empty space
@@ -55,7 +56,7 @@ struct KdBuildParams {
   // Node bound (docs/kdtree.md "Node bound"): a tree over N items has at most
   // max(max_nodes_per_item * N, node_floor) nodes. A node is 2 words of scene memory and a
   // triangle's matrix 9, so 4 nodes per triangle keep a tree below the data it indexes; small
-  // trees (the room's face slabs take 14 nodes per triangle) are never bound. Where a tree
+  // trees (the room's face slabs take 6 nodes per triangle) are never bound. Where a tree
   // is over, the builder adds a cost per node (by the node's share of the root's area, the
   // least cost that fits) and builds again. 0: no bound.
   float max_nodes_per_item = 4.0f;
