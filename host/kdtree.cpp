@@ -255,8 +255,9 @@ struct BinnedSplit {
 class Builder {
  public:
   // Parameters are checked before anything is derived from them (the grid needs a valid format).
-  Builder(const KdBuildParams& params, KdTree& tree)
-      : p_(checked(params)),
+  Builder(const KdBuildParams& params, KdTree& tree, double node_cost)
+      : node_cost_(node_cost),
+        p_(checked(params)),
         grid_(params.split_format),
         tree_(tree),
         step_rel_(std::ldexp(1.0, -params.split_format.man_bits)),
@@ -282,6 +283,22 @@ class Builder {
     return child;
   }
   void check_coordinate(float v, const char* what, std::size_t index) const;
+  // K_T at a node of half area `area` (> 0): the node bound's cost per node (build_kdtree's
+  // search) divided by the node's share of the root's area, so that a node of the whole tree
+  // weighs as much in every node's decision (the SAH weighs a node's costs by that share).
+  double node_kt(double area) const {
+    const double kt = p_.traversal_cost;
+    return node_cost_ > 0.0 ? kt + node_cost_ * (root_half_area_ / area) : kt;
+  }
+  // A plane's cost with leaf steps (KdBuildParams::leaf_step) from the children's half areas
+  // and item counts: K_T and K_I * items per non-empty child, by its share of the node's area
+  // (the node's own step is paid whether it is split or not). The bonus where a side is empty.
+  double leaf_step_cost(double kt, double al, double ar, std::uint32_t nl, std::uint32_t nr,
+                        double inv_area) const {
+    const double ki = p_.intersection_cost;
+    const double c = al * (nl == 0 ? 0.0 : kt + ki * nl) + ar * (nr == 0 ? 0.0 : kt + ki * nr);
+    return (nl == 0 || nr == 0 ? p_.empty_bonus : 1.0) * inv_area * c;
+  }
   void start(std::size_t items);
   void add_item(std::uint32_t id, const float lo[3], const float hi[3]);
   // Grid neighbours of a grid value.
@@ -312,12 +329,13 @@ class Builder {
   Split find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
                    std::uint32_t n) const;
   void face_slabs(const Box& box, int k, double sum, double prod, std::size_t b, std::size_t e,
-                  std::uint32_t n, double inv_area, Split& best) const;
+                  std::uint32_t n, double kt, double inv_area, Split& best) const;
   int clip_split(std::uint32_t id, const Box& box, int axis, float split, float llo[3],
                  float lhi[3], float rlo[3], float rhi[3]) const;
   void add_clipped(std::uint32_t id, const float lo[3], const float hi[3], std::vector<Key>* out);
 
-  KdBuildParams p_;  // a copy: run() resolves the automatic depth limit
+  double node_cost_;  // the node bound's cost per node (node_kt), 0 when unbound
+  KdBuildParams p_;   // a copy: run() resolves the automatic depth limit
   SplitGrid grid_;
   KdTree& tree_;
   // The split format's grid step relative to the magnitude, and its smallest normal (the bins).
@@ -344,6 +362,7 @@ class Builder {
   std::uint32_t item_count_ = 0;
   Box root_{};
   double min_half_area_ = 0.0;  // nodes below it are leaves (kMinAreaShare of the root's)
+  double root_half_area_ = 0.0;
 };
 
 const KdBuildParams& Builder::checked(const KdBuildParams& p) {
@@ -361,6 +380,9 @@ const KdBuildParams& Builder::checked(const KdBuildParams& p) {
   if (p.binned_above < 0)
     throw std::runtime_error("kd-tree: negative binned-above threshold " +
                              std::to_string(p.binned_above));
+  if (!(p.max_nodes_per_item >= 0.0f && p.max_nodes_per_item <= 1e6f) || p.node_floor < 0)
+    throw std::runtime_error(
+        "kd-tree: node bound needs 0 <= nodes per item <= 1e6 (0: no bound) and a floor >= 0");
   if (p.bins < 2 || p.bins > kMaxBins)
     throw std::runtime_error("kd-tree: bins " + std::to_string(p.bins) + " outside 2.." +
                              std::to_string(kMaxBins));
@@ -480,7 +502,8 @@ void Builder::run() {
   tree_.bounds.hi = glm::vec3(root_.hi[0], root_.hi[1], root_.hi[2]);
   const std::size_t n = items_.top_;
   p_.max_depth = kd_max_depth(p_, item_count_);
-  min_half_area_ = half_area(root_) * kMinAreaShare;
+  root_half_area_ = half_area(root_);
+  min_half_area_ = root_half_area_ * kMinAreaShare;
   bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n));
 }
 
@@ -675,7 +698,7 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
   const double area = half_area(d);
   if (!(area > 0.0)) return best;
   const double inv_area = 1.0 / area;
-  const double kt = p_.traversal_cost;
+  const double kt = node_kt(area);
   const double ki = p_.intersection_cost;
   const double bonus = p_.empty_bonus;
   // Fewer bins for smaller nodes: the per-node cost is proportional to the bins, the per-item
@@ -813,10 +836,15 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
     auto cost_at = [&](double x, std::uint32_t nl, std::uint32_t nr) {
       const double al = (x - lo) * sum + prod;
       const double ar = (hi - x) * sum + prod;
+      if (p_.leaf_step) return leaf_step_cost(kt, al, ar, nl, nr, inv_area);
       return (nl == 0 || nr == 0 ? bonus : 1.0) * (kt + ki * inv_area * (al * nl + ar * nr));
     };
     if (sw.best_j[k] >= 0) {
-      const double c = kt + ki * inv_area * sw.best_m[k];
+      // Both children hold items and their half areas add up to d * sum + 2 * prod on every
+      // plane of this axis: the leaf steps add the same amount to each (BinScan's order holds).
+      const double c = p_.leaf_step
+                           ? inv_area * (ki * sw.best_m[k] + kt * (d[k] * sum + 2.0 * prod))
+                           : kt + ki * inv_area * sw.best_m[k];
       if (c < best.cost) {
         best = BinnedSplit{c, k, 0.0f, false, 0, 0};  // counts summed once the winner is known
         bin_j = sw.best_j[k];                         // and s_j searched
@@ -962,7 +990,7 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
   const double area = half_area(d);
   if (!(area > 0.0)) return best;  // a line or a point: no plane can separate anything
   const double inv_area = 1.0 / area;
-  const double kt = p_.traversal_cost;
+  const double kt = node_kt(area);
   const double ki = p_.intersection_cost;
   const double bonus = p_.empty_bonus;
   Split face;  // the best face slab (Builder::face_slabs)
@@ -979,8 +1007,12 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
     // kt + ki * m / area is compared only when m beats the best so far; the empty-space bonus
     // (possible only where one side is empty) takes the exact path.
     const double scale = ki * inv_area;
+    // With leaf steps the cost is scale * (m + step * (aL + aR)) (both sides hold items here)
+    // and has no constant term.
+    const double step = p_.leaf_step ? kt / ki : 0.0;
+    const double kt0 = p_.leaf_step ? 0.0 : kt;
     double best_m =
-        std::isinf(best.cost) ? std::numeric_limits<double>::infinity() : (best.cost - kt) / scale;
+        std::isinf(best.cost) ? std::numeric_limits<double>::infinity() : (best.cost - kt0) / scale;
     const Key* ev = ev_[k].data();
     std::uint32_t nl = 0;
     std::uint32_t nr = n;
@@ -1006,24 +1038,28 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
           // One side may be empty: both planar placements with the bonus, exactly.
           const std::uint32_t nl1 = nl + np;
           const std::uint32_t nr2 = nr + np;
-          const double c1 = (nl1 == 0 || nr == 0 ? bonus : 1.0) *
-                            (kt + ki * (al * inv_area * nl1 + ar * inv_area * nr));
-          const double c2 = (nl == 0 || nr2 == 0 ? bonus : 1.0) *
-                            (kt + ki * (al * inv_area * nl + ar * inv_area * nr2));
+          const double c1 = p_.leaf_step
+                                ? leaf_step_cost(kt, al, ar, nl1, nr, inv_area)
+                                : (nl1 == 0 || nr == 0 ? bonus : 1.0) *
+                                      (kt + ki * (al * inv_area * nl1 + ar * inv_area * nr));
+          const double c2 = p_.leaf_step
+                                ? leaf_step_cost(kt, al, ar, nl, nr2, inv_area)
+                                : (nl == 0 || nr2 == 0 ? bonus : 1.0) *
+                                      (kt + ki * (al * inv_area * nl + ar * inv_area * nr2));
           if (c1 < best.cost || c2 < best.cost) {
             best = c1 <= c2 ? Split{c1, k, pos, true} : Split{c2, k, pos, false};
-            best_m = (best.cost - kt) / scale;
+            best_m = (best.cost - kt0) / scale;
           }
-        } else if (m < best_m) {
-          best_m = m;
-          best = Split{kt + scale * m, k, pos, al <= ar};
+        } else if (const double ms = m + step * (al + ar); ms < best_m) {
+          best_m = ms;
+          best = Split{kt0 + scale * ms, k, pos, al <= ar};
         }
       }
       nl += pending;
       pending = 0;
       np = 0;
     }
-    if (p_.face_slabs) face_slabs(box, k, sum, prod, b[k], e[k], n, inv_area, face);
+    if (p_.face_slabs) face_slabs(box, k, sum, prod, b[k], e[k], n, kt, inv_area, face);
   }
   // A face slab wins when it is cheaper, and also when no other plane beats the leaf but the slab
   // lies within the slack (build_node applies the slack to it).
@@ -1041,7 +1077,8 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
 // rounded plane distances (about 2^-15 of the distance, fp24) cannot skip the slab.
 // sum, prod: the sum and product of the box's two other extents (the sweep's per-axis constants).
 void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::size_t b,
-                         std::size_t e, std::uint32_t n, double inv_area, Split& best) const {
+                         std::size_t e, std::uint32_t n, double kt, double inv_area,
+                         Split& best) const {
   const double width = (static_cast<double>(root_.hi[k]) - root_.lo[k]) * kFaceSlabShare;
   const float lo = box.lo[k];
   const float hi = box.hi[k];
@@ -1051,8 +1088,10 @@ void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::si
     const double al = (static_cast<double>(x) - lo) * sum + prod;
     const double ar = (static_cast<double>(hi) - x) * sum + prod;
     // The interior side is empty where every item lies in the face.
-    const double cost = (nl == 0 || nr == 0 ? p_.empty_bonus : 1.0) *
-                        (p_.traversal_cost + p_.intersection_cost * inv_area * (al * nl + ar * nr));
+    const double cost = p_.leaf_step
+                            ? leaf_step_cost(kt, al, ar, nl, nr, inv_area)
+                            : (nl == 0 || nr == 0 ? p_.empty_bonus : 1.0) *
+                                  (kt + p_.intersection_cost * inv_area * (al * nl + ar * nr));
     if (cost < best.cost) best = Split{cost, k, ordered(x), true, true};
   };
   // Near the low face: left = items with lo < x, right = items with hi > x.
@@ -1469,6 +1508,7 @@ float kd_split_round_up(float v, const ff::Format& f) {
 KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params) {
   KdTreeStats st;
   st.build_seconds = tree.stats.build_seconds;
+  st.node_cost = tree.stats.node_cost;
   st.nodes = static_cast<std::uint32_t>(tree.nodes.size());
   if (tree.nodes.empty()) return st;
   Box root{};
@@ -1519,25 +1559,89 @@ KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params
   return st;
 }
 
-KdTree build_kdtree(std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
-                    std::span<const std::uint8_t> skip, const KdBuildParams& params) {
+namespace {
+
+// The node bound's search (docs/kdtree.md "Node bound"): the least cost per node that fits,
+// found by steps of kNodeCostGrowth from kFirstNodeCost times K_T (up while over the bound,
+// down while within) and kNodeCostBisections geometric bisections of the bracket (within a
+// factor 4^(2^-3) = 1.19 of the least). The first guess fits the 2CylinderEngine's and the
+// arena's trees (5 and 4.2 nodes per triangle at no cost) in one or two steps.
+constexpr double kFirstNodeCost = 0x1p-16;
+constexpr double kNodeCostGrowth = 4.0;
+constexpr int kMaxNodeCostSteps = 10;
+constexpr int kNodeCostBisections = 3;
+
+// build_once(node_cost) builds one tree with that cost per node.
+template <class BuildOnce>
+KdTree build_bounded(const KdBuildParams& params, std::size_t items, BuildOnce build_once) {
   const auto t0 = std::chrono::steady_clock::now();
-  KdTree tree;
-  Builder(params, tree).build_triangles(positions, tris, skip);
+  KdTree tree = build_once(0.0);
+  const double budget = std::max(static_cast<double>(params.max_nodes_per_item) * items,
+                                 static_cast<double>(params.node_floor));
+  auto fits = [&](const KdTree& t) { return static_cast<double>(t.nodes.size()) <= budget; };
+  if (params.max_nodes_per_item > 0.0f && !fits(tree)) {
+    const double unit =
+        params.traversal_cost > 0.0f ? params.traversal_cost : params.intersection_cost;
+    double over = 0.0;    // the largest cost known to give too many nodes
+    double within = 0.0;  // the least cost known to fit (tree holds its tree)
+    double c = unit * kFirstNodeCost;
+    for (int i = 0; i < kMaxNodeCostSteps && (over == 0.0 || within == 0.0); ++i) {
+      KdTree t = build_once(c);
+      if (fits(t)) {
+        within = c;
+        tree = std::move(t);
+        c /= kNodeCostGrowth;
+      } else {
+        over = c;
+        if (within == 0.0) tree = std::move(t);  // the smallest so far, if none fits
+        c *= kNodeCostGrowth;
+      }
+    }
+    for (int i = 0; i < kNodeCostBisections && over > 0.0 && within > 0.0; ++i) {
+      const double mid = std::sqrt(over * within);
+      KdTree t = build_once(mid);
+      if (fits(t)) {
+        tree = std::move(t);
+        within = mid;
+      } else {
+        over = mid;
+      }
+    }
+  }
+  tree.stats = compute_kdtree_stats(tree, params);
   tree.stats.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  tree.stats = compute_kdtree_stats(tree, params);
   return tree;
 }
 
+std::size_t used_items(std::size_t n, std::span<const std::uint8_t> skip) {
+  if (skip.size() != n) return n;  // the builder refuses a skip list of the wrong length
+  return n - static_cast<std::size_t>(
+                 std::count_if(skip.begin(), skip.end(), [](std::uint8_t v) { return v != 0; }));
+}
+
+}  // namespace
+
+KdTree build_kdtree(std::span<const glm::vec3> positions, std::span<const glm::uvec3> tris,
+                    std::span<const std::uint8_t> skip, const KdBuildParams& params) {
+  const std::size_t items = skip.empty() ? tris.size() : used_items(tris.size(), skip);
+  return build_bounded(params, items, [&](double node_cost) {
+    KdTree tree;
+    Builder(params, tree, node_cost).build_triangles(positions, tris, skip);
+    tree.stats.node_cost = node_cost;
+    return tree;
+  });
+}
+
 KdTree build_kdtree(std::span<const Aabb> boxes, const KdBuildParams& params) {
-  const auto t0 = std::chrono::steady_clock::now();
-  KdTree tree;
-  Builder(params, tree).build_boxes(boxes);
-  tree.stats.build_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  tree.stats = compute_kdtree_stats(tree, params);
-  return tree;
+  const auto items = static_cast<std::size_t>(
+      std::count_if(boxes.begin(), boxes.end(), [](const Aabb& b) { return !b.empty(); }));
+  return build_bounded(params, items, [&](double node_cost) {
+    KdTree tree;
+    Builder(params, tree, node_cost).build_boxes(boxes);
+    tree.stats.node_cost = node_cost;
+    return tree;
+  });
 }
 
 }  // namespace saarcor::host

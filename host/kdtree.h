@@ -34,12 +34,18 @@ struct Aabb {
 struct KdBuildParams {
   // Costs in the DynRTP's terms (docs/kdtree.md "Costs for this hardware"): a traversal step is a
   // traversal-unit cycle, a triangle test P + 1 transformation cycles on another unit running
-  // in parallel. 30 : 20 balances the two units' SAH-expected loads on the room and keeps large
-  // meshes under 4 nodes per triangle (Wald & Havran's software defaults were 15 : 20 with an
-  // empty-space bonus of 0.8, which made long chains of empty cuts).
+  // in parallel. 30 : 20 balances the two units' SAH-expected loads on the room and keeps most
+  // large meshes under 4 nodes per triangle (the node bound below keeps all; Wald & Havran's
+  // software defaults were 15 : 20 with an empty-space bonus of 0.8, which made long chains of
+  // empty cuts).
   float traversal_cost = 30.0f;
   float intersection_cost = 20.0f;
   float empty_bonus = 1.0f;  // cost factor for a split that cuts off empty space
+  // Leaf steps (docs/kdtree.md "Costs for this hardware"): the traversal unit spends a step on
+  // every node it fetches, a non-empty leaf as much as an inner node, while an empty child is
+  // skipped in its parent (traversal.skip_empty) and costs none. With it a split pays K_T for
+  // each non-empty child by the child's area share instead of K_T once.
+  bool leaf_step = false;
   // Nodes at this depth are leaves (root = depth 0). kAutoDepth: 8 + 1.3 * floor(log2 N) for N
   // items (pbrt's and Mitsuba's rule), so a small object is not cut down to slivers and a large
   // one may go deeper. Per level; the image builder caps it so that top + bottom fit the
@@ -47,6 +53,14 @@ struct KdBuildParams {
   int max_depth = kAutoDepth;
   static constexpr int kAutoDepth = -1;
   int leaf_size = 0;  // never split a node with this many items or fewer (0: SAH decides)
+  // Node bound (docs/kdtree.md "Node bound"): a tree over N items has at most
+  // max(max_nodes_per_item * N, node_floor) nodes. A node is 2 words of scene memory and a
+  // triangle's matrix 9, so 4 nodes per triangle keep a tree below the data it indexes; small
+  // trees (the room's face slabs take 6 nodes per triangle) are never bound. Where a tree
+  // is over, the builder adds a cost per node (by the node's share of the root's area, the
+  // least cost that fits) and builds again. 0: no bound.
+  float max_nodes_per_item = 4.0f;
+  int node_floor = 16384;
   // Face slabs (docs/kdtree.md): planes a thin slab inside a node face that peel items lying in
   // the face (walls) off the interior, so rays crossing the face's leaves do not meet the wall's
   // triangles in each (the triangle mailbox only saves the repeats within one packet).
@@ -83,7 +97,9 @@ struct KdTreeStats {
   double expected_traversal_steps = 0.0;
   double expected_leaf_visits = 0.0;
   double expected_item_tests = 0.0;
-  double build_seconds = 0.0;
+  double build_seconds = 0.0;  // every build of the node bound's search included
+  // The node bound's cost per node (in SAH cost units at the root), 0 when the first build fit.
+  double node_cost = 0.0;
 };
 
 struct KdTree {

@@ -1104,6 +1104,14 @@ TEST(KdTree, BadInputIsRefusedWithOneClearLine) {
   p = {};
   p.split_format = ff::Format{9, 30};
   expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, "kd-tree: invalid split format");
+  const std::string bound_error =
+      "kd-tree: node bound needs 0 <= nodes per item <= 1e6 (0: no bound) and a floor >= 0";
+  p = {};
+  p.max_nodes_per_item = -1.0f;
+  expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, bound_error);
+  p = {};
+  p.node_floor = -1;
+  expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, bound_error);
 }
 
 }  // namespace
@@ -1199,6 +1207,54 @@ TEST(KdTree, TreesOfFixedInputsAreUnchanged) {
   const KdTree top = build_kdtree(boxes, {});
   EXPECT_EQ(tree_hash(top), 0x211123f28b8665beull)
       << "boxes: " << top.nodes.size() << " nodes, hash 0x" << std::hex << tree_hash(top);
+}
+
+// The node bound (docs/kdtree.md "Node bound"): a tree over the bound is built again with a cost
+// per node, the least that fits; a tree within it is the tree the plain SAH builds.
+TEST(KdTree, NodeBoundKeepsTreesWithinNodesPerItem) {
+  Mesh m = sphere(24, 32, glm::vec3(0.0f), 3.0f);
+  append(m, sphere(12, 16, glm::vec3(2.5f, 0.5f, 0.0f), 1.0f));
+  KdBuildParams free;
+  free.max_nodes_per_item = 0.0f;
+  const KdTree unbound = build_kdtree(m.pos, m.tris, {}, free);
+  EXPECT_EQ(tree_hash(build_kdtree(m.pos, m.tris, {})), tree_hash(unbound));  // under the floor
+  EXPECT_EQ(unbound.stats.node_cost, 0.0);
+  const double items = static_cast<double>(m.tris.size());
+  const double per_item = static_cast<double>(unbound.nodes.size()) / items;
+  KdBuildParams bound;
+  bound.node_floor = 0;
+  bound.max_nodes_per_item = static_cast<float>(0.75 * per_item);
+  const KdTree cut = build_kdtree(m.pos, m.tris, {}, bound);
+  EXPECT_LE(static_cast<double>(cut.nodes.size()), bound.max_nodes_per_item * items);
+  // The least cost that fits (within the search's factor 1.19): not far below the bound.
+  EXPECT_GT(static_cast<double>(cut.nodes.size()), 0.6 * per_item * items);
+  EXPECT_GT(cut.stats.node_cost, 0.0);
+  // The nodes the cost removes are the ones that save least: the expected cost moves by little.
+  EXPECT_LT(cut.stats.sah_cost, unbound.stats.sah_cost * 1.05);
+  check_triangle_tree(cut, m, bound);
+  check_rays(cut, m, 2000 / kScale, 21);
+  check_points(cut, m, 200 / kScale, 22);
+  // A bound that no tree can meet keeps the smallest tree the search built.
+  bound.max_nodes_per_item = 0.01f;
+  const KdTree least = build_kdtree(m.pos, m.tris, {}, bound);
+  EXPECT_LT(least.nodes.size(), cut.nodes.size());
+  check_triangle_tree(least, m, bound);
+}
+
+// Leaf steps (docs/kdtree.md "Costs for this hardware"): K_T for each non-empty child by its
+// area share makes cuts through cubes dearer and cuts of empty space cheaper; the trees are
+// smaller at the same costs and stay correct.
+TEST(KdTree, LeafStepsChargeEveryNonEmptyChild) {
+  const Mesh t = terrain(40 / kScale, 30 / kScale, 5);
+  KdBuildParams p;
+  p.leaf_step = true;
+  const KdTree stepped = build_kdtree(t.pos, t.tris, {}, p);
+  const KdTree plain = build_kdtree(t.pos, t.tris, {});
+  EXPECT_LT(stepped.nodes.size(), plain.nodes.size());
+  EXPECT_GT(stepped.stats.items_per_leaf, plain.stats.items_per_leaf);
+  check_triangle_tree(stepped, t, p);
+  check_rays(stepped, t, 2000 / kScale, 31);
+  check_points(stepped, t, 200 / kScale, 32);
 }
 
 }  // namespace

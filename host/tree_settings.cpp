@@ -46,6 +46,22 @@ const std::vector<Binding>& bindings() {
       {{"kd.leaf_size", 0, "items", "never split a node with this many items or fewer", 0, 1e6},
        true,
        SAARCOR_TREE_FIELD(kd.leaf_size, int)},
+      {{"kd.leaf_step", 0, "bool",
+        "SAH charges K_T for every non-empty child (the traversal unit steps into leaves too; "
+        "empty children are skipped)",
+        0, 1},
+       true,
+       SAARCOR_TREE_FIELD(kd.leaf_step, bool)},
+      {{"kd.nodes_per_item", 0, "nodes",
+        "node bound: at most this many nodes per triangle in a bottom tree (or kd.node_floor), "
+        "0 = no bound",
+        0, 1e6},
+       false,
+       SAARCOR_TREE_FIELD(kd.max_nodes_per_item, float)},
+      {{"kd.node_floor", 0, "nodes",
+        "node bound: a tree of this many nodes or fewer is never bound", 0, 1e9},
+       true,
+       SAARCOR_TREE_FIELD(kd.node_floor, int)},
       {{"kd.face_slabs", 0, "bool",
         "thin slabs peeling items that lie in a node face (for hardware without a triangle "
         "mailbox)",

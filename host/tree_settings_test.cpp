@@ -49,6 +49,12 @@ TEST(TreeSettings, SetThenDescribeGivesTheValueBack) {
   apply_tree_setting(p, "kd.face_slabs=0");
   apply_tree_setting(p, "kd.stack=32");
   apply_tree_setting(p, "kd.top_item_cost=4");
+  apply_tree_setting(p, "kd.leaf_step=1");
+  apply_tree_setting(p, "kd.nodes_per_item=3.5");
+  apply_tree_setting(p, "kd.node_floor=1000");
+  EXPECT_TRUE(p.kd.leaf_step);
+  EXPECT_EQ(p.kd.max_nodes_per_item, 3.5f);
+  EXPECT_EQ(p.kd.node_floor, 1000);
   EXPECT_EQ(p.kd.traversal_cost, 12.5f);
   EXPECT_EQ(p.kd.max_depth, 17);
   EXPECT_FALSE(p.kd.face_slabs);

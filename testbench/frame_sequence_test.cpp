@@ -198,7 +198,18 @@ TEST(FrameSequence, FrameGapModeDelaysEveryFrameAndChangesNoImage) {
       EXPECT_GT(one.frames[k].stall_cycles, 0u);
     }
   }
-  EXPECT_GT(one.total_cycles(), two.total_cycles());
+  // The gaps add the stalls to the sequence; the frames' render times themselves differ between
+  // one top-level copy and two (the copy's place in the scene banks changes the caches' hits:
+  // up to 6 % per frame at 32x24, more than the stalls since the node bound reshaped the arena's
+  // tree), so the time outside rendering is compared.
+  auto idle = [](const SequenceResult& r) {
+    std::uint64_t render = 0;
+    for (const SequenceFrame& f : r.frames)
+      render += f.cycles;
+    return r.total_cycles() - render;
+  };
+  EXPECT_EQ(idle(two), 0u);
+  EXPECT_GT(idle(one), 0u);
 }
 
 TEST(FrameSequence, AWriteIntoTheFrameInFlightIsRefused) {
