@@ -47,6 +47,11 @@ units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
                                    const CycleRenderOptions& opts, bool heartbeat = true,
                                    const units::RunTraceOptions& trace = {});
 
+// The figures of a span (units/figures.h kFigures) into `j` at their dotted names: those the
+// frame's report writes ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}), or with
+// `sequence_row` those a frame sequence's per-frame row writes, at their names there.
+void add_figures(nlohmann::json& j, const units::CycleFigures& f, bool sequence_row = false);
+
 // The per-frame report: cycles, fps, rays, rays_per_s, usage, cache_hit, bandwidth_mb_s, per_ray,
 // simd_efficiency, host, configuration, (time_series).
 nlohmann::json cycle_report_json(const units::CycleFrame& frame);

@@ -171,12 +171,7 @@ void take_figures(SequenceFrame& row, const units::CycleFrame& c) {
   row.cycles = c.cycles;
   row.fps = c.fps;
   row.rays = c.rays;
-  for (int i = 0; i < 4; ++i)
-    row.usage[i] = c.figures.usage[static_cast<std::size_t>(i)];
-  for (int i = 0; i < 3; ++i)
-    row.hit[i] = c.figures.cache_hit[static_cast<std::size_t>(i)];
-  row.bw_dynrtc = c.figures.bw_dynrtc;
-  row.bw_shading = c.figures.bw_shading + c.figures.bw_frame;
+  row.figures = c.figures;
   row.shading_bytes_per_pixel = c.shading_bytes_per_pixel;
   row.cycles_per_packet =
       c.packets == 0 ? 0.0 : static_cast<double>(c.cycles) / static_cast<double>(c.packets);
@@ -417,12 +412,7 @@ nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
       e["cycles"] = f.cycles;
       e["fps"] = f.fps;
       e["cycles_per_packet"] = f.cycles_per_packet;
-      for (int i = 0; i < 4; ++i)
-        e["usage"][units::kTable4UnitNames[i]] = f.usage[i];
-      for (int i = 0; i < 3; ++i)
-        e["cache_hit"][units::cache_unit_name(units::CacheUnit(i))] = f.hit[i];
-      e["bandwidth_mb_s"]["dynrtc"] = f.bw_dynrtc;
-      e["bandwidth_mb_s"]["shading"] = f.bw_shading;
+      add_figures(e, f.figures, true);
       e["shading_bytes_per_pixel"] = f.shading_bytes_per_pixel;
       e["bit_identical_to_functional_model"] = f.checked;
     }
@@ -507,8 +497,9 @@ std::string sequence_table(const SequenceResult& r) {
     if (r.cycle) {
       std::snprintf(buf, sizeof buf,
                     "%11" PRIu64 " %6.1f %4.0f %4.0f %4.0f %4.0f %4.0f %2.0f %2.0f", f.cycles,
-                    f.fps, f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.hit[0], f.hit[1],
-                    f.hit[2]);
+                    f.fps, f.figures.usage(0), f.figures.usage(1), f.figures.usage(2),
+                    f.figures.usage(3), f.figures.cache_hit(0), f.figures.cache_hit(1),
+                    f.figures.cache_hit(2));
       s += buf;
     }
     // The host's top-level (re)build on this machine: not on the model's clock (D46).
@@ -564,9 +555,10 @@ std::string sequence_csv(const SequenceResult& r) {
                     ",%" PRIu64 ",%d,%" PRIu64 ",%" PRIu64 ",%" PRIu64
                     ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
                     f.upload_cycles, f.hidden ? 1 : 0, f.stall_cycles, f.start_cycle, f.cycles,
-                    f.fps, f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.hit[0], f.hit[1],
-                    f.hit[2], f.bw_dynrtc, f.cycles_per_packet, f.bw_shading,
-                    f.shading_bytes_per_pixel);
+                    f.fps, f.figures.usage(0), f.figures.usage(1), f.figures.usage(2),
+                    f.figures.usage(3), f.figures.cache_hit(0), f.figures.cache_hit(1),
+                    f.figures.cache_hit(2), f.figures.bw_dynrtc(), f.cycles_per_packet,
+                    f.figures.bw_rgs(), f.shading_bytes_per_pixel);
       s += buf;
     }
     std::snprintf(buf, sizeof buf, ",%" PRIu64 ",%016" PRIx64 "\n", f.rays, f.digest);

@@ -18,7 +18,7 @@ namespace saarcor::units {
 // Item caches of the DynRTC by the unit that reads them.
 enum class CacheUnit { kTraversal = 0, kList = 1, kTransformation = 2 };
 inline constexpr int kCacheUnits = 3;
-inline const char* cache_unit_name(CacheUnit c) {
+constexpr const char* cache_unit_name(CacheUnit c) {
   constexpr const char* kNames[] = {"traversal", "list", "transformation"};
   return kNames[static_cast<int>(c)];
 }

@@ -104,15 +104,6 @@ void read_frame_buffer(const memif::MemoryImage& image, int bank, CycleFrame& ou
   out.frame_bank = bank;
 }
 
-double mb_per_s(std::uint64_t bytes, std::uint64_t cycles, double clock_mhz) {
-  if (cycles == 0) return 0.0;
-  return static_cast<double>(bytes) * clock_mhz * 1e6 / static_cast<double>(cycles) / 1048576.0;
-}
-
-double percent(std::uint64_t a, std::uint64_t b) {
-  return b == 0 ? 0.0 : 100.0 * static_cast<double>(a) / static_cast<double>(b);
-}
-
 // One DynRTP: its units and the paths a-g between them, over its pipeline's caches in the shared
 // memory system; its threads are ids [pipeline x threads, (pipeline + 1) x threads) of the table.
 class DynRtp {
@@ -200,17 +191,9 @@ class Chip {
   std::vector<std::unique_ptr<DynRtp>> pipes_;
 };
 
-// Cumulative counts the figures are computed from.
-struct Snapshot {
-  std::uint64_t cycle = 0;
-  std::array<std::uint64_t, kTable4Units> issued{};
-  std::array<std::uint64_t, kCacheUnits> requests{}, hits{}, bytes{};
-  std::uint64_t shading_bytes = 0, frame_bytes = 0;
-  int pipelines = 1;  // usage is per unit: issue cycles over cycles x pipelines
-};
-
-Snapshot snapshot(hw::Kernel& k, Chip& chip) {
-  Snapshot s;
+// The counts the figures are computed from (units/figures.h), summed over the DynRTPs.
+FigureCounts snapshot(hw::Kernel& k, Chip& chip) {
+  FigureCounts s;
   s.cycle = k.now();
   s.pipelines = chip.pipelines();
   for (int p = 0; p < chip.pipelines(); ++p) {
@@ -229,25 +212,6 @@ Snapshot snapshot(hw::Kernel& k, Chip& chip) {
     s.frame_bytes += k.stats().get_counter(pre + "frame.mem_bytes").value;
   }
   return s;
-}
-
-CycleFigures figures(const Snapshot& a, const Snapshot& b, double clock_mhz) {
-  CycleFigures f;
-  f.cycle = b.cycle;
-  const std::uint64_t n = b.cycle - a.cycle;
-  for (std::size_t i = 0; i < kTable4Units; ++i)
-    f.usage[i] = percent(b.issued[i] - a.issued[i], n * static_cast<std::uint64_t>(b.pipelines));
-  std::uint64_t dyn = 0;
-  for (std::size_t c = 0; c < kCacheUnits; ++c) {
-    const std::uint64_t req = b.requests[c] - a.requests[c];
-    f.cache_hit[c] = req == 0 ? 100.0 : percent(b.hits[c] - a.hits[c], req);
-    dyn += b.bytes[c] - a.bytes[c];
-  }
-  f.bw_dynrtc = mb_per_s(dyn, n, clock_mhz);
-  f.bw_shading = mb_per_s(b.shading_bytes - a.shading_bytes, n, clock_mhz);
-  f.bw_frame = mb_per_s(b.frame_bytes - a.frame_bytes, n, clock_mhz);
-  f.bw_total = f.bw_dynrtc + f.bw_shading + f.bw_frame;
-  return f;
 }
 
 // With several DynRTPs each thread also names its pipeline (thread t is pipeline t / threads').
@@ -274,7 +238,7 @@ void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, co
               const CycleRunOptions& opt, CycleFrame& out, std::function<bool()> done = {}) {
   if (!done) done = [&] { return chip.finished(); };
   const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
-  Snapshot last = snapshot(k, chip);
+  FigureCounts last = snapshot(k, chip);
   while (!done()) {
     std::uint64_t budget = chunk;
     if (opt.max_cycles != 0) {
@@ -289,8 +253,8 @@ void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, co
                                ": no progress for " + std::to_string(p.watchdog) + " cycles\n" +
                                thread_report(threads, p) + "\n" + r.report);
     if (opt.interval != 0) {
-      const Snapshot now = snapshot(k, chip);
-      if (now.cycle > last.cycle) out.series.push_back(figures(last, now, p.clock_mhz));
+      const FigureCounts now = snapshot(k, chip);
+      if (now.cycle > last.cycle) out.series.push_back(compute_figures(last, now, p.clock_mhz));
       last = now;
     }
     if (opt.progress)
@@ -330,7 +294,7 @@ void finish_upload(hw::Kernel& k, Chip& chip, const CycleParams& p, CycleFrame& 
 }
 
 // Per pipeline and in total: packets, unit issue and stall cycles, requests, cache counts.
-void collect_units(const hw::Kernel& k, Chip& chip, const Snapshot& end, CycleFrame& out) {
+void collect_units(const hw::Kernel& k, Chip& chip, const FigureCounts& end, CycleFrame& out) {
   std::uint64_t served = 0;
   out.per_pipeline.resize(static_cast<std::size_t>(chip.pipelines()));
   for (int pi = 0; pi < chip.pipelines(); ++pi) {
@@ -388,7 +352,8 @@ void check_run(const memif::MemoryImage& image, const CycleParams& p, const Cycl
 }
 
 // The frame as the RGS left it: the image read back from the bank it wrote, and its traffic.
-void collect_rgs(const memif::MemoryImage& image, int bank, const Snapshot& end, CycleFrame& out) {
+void collect_rgs(const memif::MemoryImage& image, int bank, const FigureCounts& end,
+                 CycleFrame& out) {
   read_frame_buffer(image, bank, out);
   out.shading_bytes = end.shading_bytes;
   out.frame_bytes = end.frame_bytes;
@@ -430,19 +395,19 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   CycleFrame out;
   out.params = p;
   out.packets = static_cast<std::uint64_t>(threads.packets());
-  const Snapshot start = snapshot(k, chip);
+  const FigureCounts start = snapshot(k, chip);
   const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
   simulate(k, chip, threads, p, opt, out);
   if (opt.vcd != nullptr) k.finish_trace();
   if (tracer) tracer->finish();
-  const Snapshot end = snapshot(k, chip);
+  const FigureCounts end = snapshot(k, chip);
   out.cycles = k.now();
   if (uploading) finish_upload(k, chip, p, out);
 
   threads.finish();
   collect(out.frame, threads);
   collect_rgs(image, frame_bank, end, out);
-  out.figures = figures(start, end, p.clock_mhz);
+  out.figures = compute_figures(start, end, p.clock_mhz);
   collect_units(k, chip, end, out);
   frame_rates(p, out);
   out.packets_retired = chip.packets_retired();

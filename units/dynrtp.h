@@ -17,15 +17,11 @@
 #include "memif/host_bus.h"
 #include "memif/image_format.h"
 #include "units/cycle_params.h"
+#include "units/figures.h"
 #include "units/functional_model.h"
 #include "units/run_trace.h"
 
 namespace saarcor::units {
-
-// The four DynRTC units Table 4 reports, in its column order.
-inline constexpr int kTable4Units = 4;
-inline constexpr const char* kTable4UnitNames[kTable4Units] = {"traversal", "list",
-                                                               "transformation", "intersection"};
 
 // Where a simulated thread's requests come from:
 enum class ProgramMode {
@@ -58,23 +54,13 @@ struct CycleRunOptions {
   std::function<void(std::uint64_t cycles, int packets_done, int packets)> progress;
 };
 
-// Unit usage, cache hit rates and bandwidth over a span of cycles.
-struct CycleFigures {
-  std::uint64_t cycle = 0;                      // end of the span
-  std::array<double, kTable4Units> usage{};     // percent of cycles issuing a step
-  std::array<double, kCacheUnits> cache_hit{};  // percent, (hits + merges) / requests
-  // MB/s (2^20 bytes) at the modelled clock: the DynRTC's caches, the RGS's shading-bank reads,
-  // its frame-buffer writes, all three.
-  double bw_dynrtc = 0, bw_shading = 0, bw_frame = 0, bw_total = 0;
-};
-
 struct CycleFrame {
   FunctionalFrame frame;  // hit records, image, per-ray counters, op counts (as the fp24 model)
   CycleParams params;
   std::uint64_t cycles = 0;
   std::uint64_t rays = 0;          // rays issued, all kinds
   double fps = 0, rays_per_s = 0;  // at the modelled clock
-  CycleFigures figures;            // the whole frame
+  CycleFigures figures;            // the whole frame (units/figures.h)
   std::array<std::uint64_t, kTable4Units> issue_cycles{}, stall_cycles{}, requests{};
   struct CacheCount {
     std::uint64_t requests = 0, hits = 0, misses = 0, merges = 0, mem_bytes = 0;
