@@ -59,26 +59,6 @@ std::string path_name(UnitId from, UnitId to) {
   return std::string(unit_name(from)) + "_to_" + unit_name(to);
 }
 
-// Input priorities (D25): in-flight work before new rays; a unit's own loop first. Only the
-// hand-overs the thread program can make are listed (a path nobody reads would hold its thread
-// until the watchdog names it).
-std::vector<UnitId> input_order(UnitId u) {
-  switch (u) {
-    case UnitId::kTraversal:  // loop (next node, pop), f, end of a leaf's list, shadow rays, b
-      return {UnitId::kTraversal, UnitId::kIntersection, UnitId::kList, UnitId::kRgs,
-              UnitId::kTransformation};
-    case UnitId::kList:  // loop (mailbox skip), after an intersection, c
-      return {UnitId::kList, UnitId::kIntersection, UnitId::kTraversal};
-    case UnitId::kTransformation:  // d before a (D25)
-      return {UnitId::kList, UnitId::kRgs};
-    case UnitId::kIntersection:  // e
-      return {UnitId::kTransformation};
-    default:  // the RGS: g, the end of a list or an intersection, shadow-ray generation
-      return {UnitId::kTraversal, UnitId::kList, UnitId::kIntersection, UnitId::kTransformation,
-              UnitId::kRgs};
-  }
-}
-
 // The frame buffer: one word per pixel from word 0 of the back bank (FrameRegisters::frame_bank).
 void check_frame_buffer(const memif::MemoryImage& image) {
   const auto& r = image.registers();
@@ -103,56 +83,6 @@ void read_frame_buffer(const memif::MemoryImage& image, int bank, CycleFrame& ou
       rgb[3 * i + k] = static_cast<std::uint8_t>((fb[i] >> (8 * k)) & 255u);
   out.frame_bank = bank;
 }
-
-// One DynRTP: its units and the paths a-g between them, over its pipeline's caches in the shared
-// memory system; its threads are ids [pipeline x threads, (pipeline + 1) x threads) of the table.
-class DynRtp {
- public:
-  DynRtp(hw::Kernel& k, memif::MemorySystem& mi, const CycleParams& p, ThreadTable& threads,
-         RayGenerationController& rgc, int pipeline) {
-    const std::string pre = "dynrtp" + std::to_string(pipeline) + ".";
-    const RgsPorts ports{&mi.shading_port(pipeline), &mi.frame_port(pipeline),
-                         mi.shading_client(pipeline), mi.frame_client(pipeline)};
-    rgs_ = &k.make<RaySource>(pre + "rgs", threads, p.rgs_depth, rgc, pipeline,
-                              static_cast<ThreadToken>(pipeline * p.threads), p.threads, ports);
-    units_[unit_index(UnitId::kRgs)] = rgs_;
-    units_[unit_index(UnitId::kTraversal)] =
-        &k.make<TraversalUnit>(pre + "traversal", threads, p.traversal_depth(),
-                               mi.cache(pipeline, memif::ItemType::kNode));
-    units_[unit_index(UnitId::kList)] = &k.make<ListUnit>(
-        pre + "list", threads, p.list_depth(), mi.cache(pipeline, memif::ItemType::kList));
-    units_[unit_index(UnitId::kTransformation)] =
-        &k.make<TransformationUnit>(pre + "transformation", threads, p.transformation_depth(),
-                                    mi.cache(pipeline, memif::ItemType::kRow));
-    units_[unit_index(UnitId::kIntersection)] =
-        &k.make<IntersectionUnit>(pre + "intersection", threads, p.intersection_depth());
-    // Thread-id queues hold every thread of the pipeline: a full path can never hold a unit
-    // (deadlock freedom by construction); the priorities of D25 decide only the order.
-    const int capacity = p.threads + 1;
-    for (int from = 0; from < kUnitCount; ++from)
-      for (int to = 0; to < kUnitCount; ++to) {
-        const auto f = static_cast<UnitId>(from), t = static_cast<UnitId>(to);
-        paths_[from][to] = &k.make_channel<ThreadToken>(pre + path_name(f, t), capacity, 1);
-        units_[from]->set_output(t, paths_[from][to]);
-      }
-    for (int to = 0; to < kUnitCount; ++to)
-      for (UnitId from : input_order(static_cast<UnitId>(to)))
-        units_[to]->add_input(paths_[unit_index(from)][to]);
-  }
-
-  RaySource& rgs() { return *rgs_; }
-  const RaySource& rgs() const { return *rgs_; }
-  CycleUnit& unit(UnitId u) { return *units_[unit_index(u)]; }
-  void observe(UnitObserver* o) {
-    for (CycleUnit* u : units_)
-      u->set_observer(o);
-  }
-
- private:
-  RaySource* rgs_ = nullptr;
-  std::array<CycleUnit*, kUnitCount> units_{};
-  std::array<std::array<ThreadPath*, kUnitCount>, kUnitCount> paths_{};
-};
 
 // The chip of Figure 2: the RGC, `pipelines` DynRTPs and the memory interface they share.
 class Chip {
@@ -435,6 +365,85 @@ FunctionalParams functional_params(const CycleParams& p, FunctionalParams shadin
   shading.clip_faces_per_step = p.clip_faces_per_step;
   shading.shared_origin = p.shared_origin;
   return shading;
+}
+
+namespace {
+
+// Figure 2's units, each over its pipeline's cache (the RGS over its memory ports).
+CycleUnit& make_rgs(const UnitContext& c) {
+  const int pipe = c.pipeline;
+  const RgsPorts ports{&c.memory.shading_port(pipe), &c.memory.frame_port(pipe),
+                       c.memory.shading_client(pipe), c.memory.frame_client(pipe)};
+  return c.kernel.make<RaySource>(c.name, c.threads, c.params.rgs_depth, c.rgc, pipe,
+                                  static_cast<ThreadToken>(pipe * c.params.threads),
+                                  c.params.threads, ports);
+}
+CycleUnit& make_traversal(const UnitContext& c) {
+  return c.kernel.make<TraversalUnit>(c.name, c.threads, c.params.traversal_depth(),
+                                      c.memory.cache(c.pipeline, memif::ItemType::kNode));
+}
+CycleUnit& make_list(const UnitContext& c) {
+  return c.kernel.make<ListUnit>(c.name, c.threads, c.params.list_depth(),
+                                 c.memory.cache(c.pipeline, memif::ItemType::kList));
+}
+CycleUnit& make_transformation(const UnitContext& c) {
+  return c.kernel.make<TransformationUnit>(c.name, c.threads, c.params.transformation_depth(),
+                                           c.memory.cache(c.pipeline, memif::ItemType::kRow));
+}
+CycleUnit& make_intersection(const UnitContext& c) {
+  return c.kernel.make<IntersectionUnit>(c.name, c.threads, c.params.intersection_depth());
+}
+
+}  // namespace
+
+// Input priorities (D25): in-flight work before new rays; a unit's own loop first. Only the
+// hand-overs the thread program can make are listed.
+std::vector<UnitSpec> dynrtc_units() {
+  using U = UnitId;
+  return {
+      // The RGS: g, the end of a list or an intersection, shadow-ray generation.
+      {U::kRgs, {U::kTraversal, U::kList, U::kIntersection, U::kTransformation, U::kRgs}, make_rgs},
+      // Traversal: loop (next node, pop), f, end of a leaf's list, shadow rays, b.
+      {U::kTraversal,
+       {U::kTraversal, U::kIntersection, U::kList, U::kRgs, U::kTransformation},
+       make_traversal},
+      // List: loop (mailbox skip), after an intersection, c.
+      {U::kList, {U::kList, U::kIntersection, U::kTraversal}, make_list},
+      // Transformation: d before a (D25).
+      {U::kTransformation, {U::kList, U::kRgs}, make_transformation},
+      // Intersection: e.
+      {U::kIntersection, {U::kTransformation}, make_intersection},
+  };
+}
+
+// The units in the order given, then the paths between every two (by unit id), then each unit's
+// inputs in its priority order. Thread-id queues hold every thread of the pipeline: a full path can
+// never hold a unit (deadlock freedom by construction); the priorities decide only the order.
+DynRtp::DynRtp(hw::Kernel& k, memif::MemorySystem& mi, const CycleParams& p, ThreadTable& threads,
+               RayGenerationController& rgc, int pipeline, const std::vector<UnitSpec>& units) {
+  const std::string pre = "dynrtp" + std::to_string(pipeline) + ".";
+  std::array<const UnitSpec*, kMaxUnits> spec{};
+  for (const UnitSpec& s : units) {
+    const auto i = static_cast<std::size_t>(unit_index(s.id));
+    if (s.id == UnitId::kNone || i >= spec.size() || spec[i] != nullptr)
+      throw std::logic_error("DynRTP: unit id " + std::to_string(i) + " is kNone or given twice");
+    spec[i] = &s;
+    units_[i] = &s.make({k, mi, p, threads, rgc, pipeline, pre + unit_name(s.id)});
+  }
+  rgs_ = dynamic_cast<RaySource*>(units_[static_cast<std::size_t>(unit_index(UnitId::kRgs))]);
+  if (rgs_ == nullptr) throw std::logic_error("DynRTP: no ray source (UnitId::kRgs)");
+  const int capacity = p.threads + 1;
+  for (std::size_t from = 0; from < spec.size(); ++from)
+    for (std::size_t to = 0; to < spec.size(); ++to) {
+      if (spec[from] == nullptr || spec[to] == nullptr) continue;
+      const UnitId f = spec[from]->id, t = spec[to]->id;
+      paths_[from][to] = &k.make_channel<ThreadToken>(pre + path_name(f, t), capacity, 1);
+      units_[from]->set_output(t, paths_[from][to]);
+    }
+  for (std::size_t to = 0; to < spec.size(); ++to)
+    if (spec[to] != nullptr)
+      for (UnitId from : spec[to]->inputs)
+        units_[to]->add_input(paths_[static_cast<std::size_t>(unit_index(from))][to]);
 }
 
 // The CycleParams as the memory system's parameters (every memif knob of the table).

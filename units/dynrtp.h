@@ -16,12 +16,62 @@
 
 #include "memif/host_bus.h"
 #include "memif/image_format.h"
+#include "memif/memory_system.h"
 #include "units/cycle_params.h"
+#include "units/dynrtc_units.h"
 #include "units/figures.h"
 #include "units/functional_model.h"
 #include "units/run_trace.h"
 
 namespace saarcor::units {
+
+// What a unit of the DynRTP is built with: the kernel, the memory system its cache and ports are
+// in, the parameters, the thread table, the RGC, its pipeline and its kernel name
+// ("dynrtpN.<unit name>").
+struct UnitContext {
+  hw::Kernel& kernel;
+  memif::MemorySystem& memory;
+  const CycleParams& params;
+  ThreadTable& threads;
+  RayGenerationController& rgc;
+  int pipeline;
+  std::string name;
+};
+
+// A unit's place in the DynRTP (README "adding a unit"): its id, the units whose paths it reads in
+// priority order (D25; a path nobody reads would hold its thread until the watchdog names it),
+// and how it is built.
+struct UnitSpec {
+  UnitId id = UnitId::kNone;
+  std::vector<UnitId> inputs;
+  std::function<CycleUnit&(const UnitContext&)> make;
+};
+
+// Figure 2's units in the order the DynRTP builds them, with their input priorities.
+std::vector<UnitSpec> dynrtc_units();
+
+// One DynRTP: its units and a path between every two of them (a unit's own loop included), over
+// its pipeline's caches in the shared memory system; its threads are ids [pipeline x threads,
+// (pipeline + 1) x threads) of the table. `units` must hold the RGS (the ray source).
+class DynRtp {
+ public:
+  DynRtp(hw::Kernel& k, memif::MemorySystem& mi, const CycleParams& p, ThreadTable& threads,
+         RayGenerationController& rgc, int pipeline,
+         const std::vector<UnitSpec>& units = dynrtc_units());
+
+  RaySource& rgs() { return *rgs_; }
+  const RaySource& rgs() const { return *rgs_; }
+  CycleUnit& unit(UnitId u) { return *units_[static_cast<std::size_t>(unit_index(u))]; }
+  void observe(UnitObserver* o) {
+    for (CycleUnit* u : units_)
+      if (u != nullptr) u->set_observer(o);
+  }
+
+ private:
+  RaySource* rgs_ = nullptr;
+  std::array<CycleUnit*, kMaxUnits> units_{};
+  std::array<std::array<ThreadPath*, kMaxUnits>, kMaxUnits> paths_{};
+};
 
 // Where a simulated thread's requests come from:
 enum class ProgramMode {
