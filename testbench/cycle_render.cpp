@@ -31,12 +31,11 @@ units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
   return p;
 }
 
-units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
-                                   const units::FunctionalParams& shading,
-                                   const CycleRenderOptions& opts, bool heartbeat,
-                                   const units::RunTraceOptions& trace) {
+CycleFrame run_cycle_render(const memif::MemoryImage& image, const units::FunctionalParams& shading,
+                            const CycleRenderOptions& opts, bool heartbeat,
+                            const units::RunTraceOptions& trace) {
   const units::CycleParams p = resolve_cycle_params(opts);
-  units::CycleRunOptions ro;
+  CycleRunOptions ro;
   ro.shading = shading;
   ro.trace = trace;
   ro.interval = opts.interval;
@@ -59,7 +58,7 @@ units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
     ro.vcd_to = opts.vcd_to;
   }
   try {
-    units::CycleFrame f = units::run_cycle(image, p, ro);
+    CycleFrame f = run_cycle(image, p, ro);
     if (!opts.vcd.empty()) {
       vcd.close();
       if (!vcd) throw std::runtime_error("cannot write --vcd '" + opts.vcd + "'");
@@ -84,7 +83,7 @@ double per(std::uint64_t a, std::uint64_t b) {
 // The RGS's traffic (the table's "shade" column is shading reads + frame-buffer writes, as the
 // paper's shading bandwidth), with the paper's bytes per pixel beside it: its shading MB/s over
 // its frame rate at 1024x768.
-std::string rgs_text(const units::CycleFrame& c, const Table4Row* paper) {
+std::string rgs_text(const CycleFrame& c, const Table4Row* paper) {
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "RGS: shading reads %.0f MB/s, frame-buffer writes %.0f MB/s, %.1f bytes per pixel "
@@ -114,7 +113,7 @@ void add_figures(nlohmann::json& j, const units::CycleFigures& f, bool sequence_
   }
 }
 
-nlohmann::json cycle_report_json(const units::CycleFrame& c) {
+nlohmann::json cycle_report_json(const CycleFrame& c) {
   nlohmann::json j;
   add_figures(j, c.figures);
   j["cycles"] = c.cycles;
@@ -148,7 +147,7 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
   j["units"] = units;
   // Per DynRTP (one in the prototype): the packets the RGC handed it, its units' usage.
   nlohmann::json pipes = nlohmann::json::array();
-  for (const units::CycleFrame::PipelineCount& pc : c.per_pipeline) {
+  for (const CycleFrame::PipelineCount& pc : c.per_pipeline) {
     nlohmann::json e;
     e["packets"] = pc.packets;
     for (int i = 0; i < units::kTable4Units; ++i)
@@ -220,7 +219,7 @@ const Table4Row* paper_row_for(const std::string& scene) {
   return nullptr;
 }
 
-std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
+std::string table4_text(const CycleFrame& c, const std::string& scene) {
   std::string s;
   char buf[512];
   s += "Table 4 layout (paper: 1024x768, 90 MHz, 1 DynRTP, 64 threads; the paper's fps scaled to "
@@ -266,7 +265,7 @@ std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
   if (c.per_pipeline.size() > 1) {
     s += std::to_string(c.per_pipeline.size()) +
          " DynRTPs (usage: the mean over them; the paper's row is one DynRTP), packets each:";
-    for (const units::CycleFrame::PipelineCount& pc : c.per_pipeline)
+    for (const CycleFrame::PipelineCount& pc : c.per_pipeline)
       s += " " + std::to_string(pc.packets);
     s += "\n";
   }

@@ -3,7 +3,7 @@
 // width, caches, latencies, shadow and secondary rays); ray and thread conservation; thread
 // scaling; the prototype configuration on the room beside the paper's Table 4 row for Scene6;
 // parameters and bad input.
-#include "units/dynrtp.h"
+#include "testbench/chip.h"
 
 #include <gtest/gtest.h>
 

@@ -15,6 +15,7 @@
 #include "host/tree_settings.h"
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
+#include "testbench/chip.h"
 #include "testbench/heartbeat.h"
 #include "testbench/run_dir.h"
 #include "units/functional_model.h"
@@ -167,7 +168,7 @@ NextFrame prepare_next(host::Scene& scene, host::BuiltImage& host, const memif::
   return n;
 }
 
-void take_figures(SequenceFrame& row, const units::CycleFrame& c) {
+void take_figures(SequenceFrame& row, const CycleFrame& c) {
   row.cycles = c.cycles;
   row.fps = c.fps;
   row.rays = c.rays;
@@ -177,9 +178,8 @@ void take_figures(SequenceFrame& row, const units::CycleFrame& c) {
       c.packets == 0 ? 0.0 : static_cast<double>(c.cycles) / static_cast<double>(c.packets);
 }
 
-units::CycleRunOptions cycle_run_options(const RenderSettings& s, Heartbeat& beat, int index,
-                                         int frames) {
-  units::CycleRunOptions ro;
+CycleRunOptions cycle_run_options(const RenderSettings& s, Heartbeat& beat, int index, int frames) {
+  CycleRunOptions ro;
   ro.shading = functional_params(s);
   if (s.cycle.host_threads != 0)
     ro.programs =
@@ -337,9 +337,9 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
     std::uint64_t gap_cycles = 0;
     units::FunctionalFrame frame;
     if (cycle) {
-      const units::CycleRunOptions ro = cycle_run_options(s, beat, k, opts.frames);
-      units::CycleFrame c = more && !next.row.gap ? units::run_cycle(board, cp, ro, next.upload)
-                                                  : units::run_cycle(std::as_const(board), cp, ro);
+      const CycleRunOptions ro = cycle_run_options(s, beat, k, opts.frames);
+      CycleFrame c = more && !next.row.gap ? run_cycle(board, cp, ro, next.upload)
+                                           : run_cycle(std::as_const(board), cp, ro);
       if (more && next.row.gap) gap_cycles = upload_alone(board, cp, next.upload);
       next.row.upload_cycles = c.upload_cycles;
       take_figures(cur, c);

@@ -12,8 +12,8 @@
 
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "testbench/chip.h"
 #include "testbench/dynrtc_testing.h"
-#include "units/dynrtp.h"
 #include "units/functional_model.h"
 
 namespace saarcor::units {

@@ -93,7 +93,7 @@ void check_cycle_params(const CycleParams& params);
 // The resolved configuration: every parameter with its current value.
 std::vector<CycleParamInfo> describe(const CycleParams& params);
 // The memory interface the parameters describe (pipelines, caches, controller, routing, host
-// bus): what the cycle model's chip instantiates (units/dynrtp.cpp).
+// bus): what the cycle model's chip instantiates (testbench/chip.cpp).
 memif::MemorySystemConfig memory_system_config(const CycleParams& params);
 
 }  // namespace saarcor::units
