@@ -1,4 +1,4 @@
-// Speed of the cycle model (units/dynrtp.h) on the built-in room, 512x384 primary rays, prototype
+// Speed of the cycle model (testbench/chip.h) on the built-in room, 512x384 primary rays, prototype
 // configuration, with the functional fp24 model on the same image and frame in the same run as the
 // yardstick: host seconds per frame, simulated cycles per host second (target >= 5 M), and the
 // slowdown against the functional model (target <= 20x).

@@ -1,4 +1,4 @@
-// The cycle model of the DynRTP (units/dynrtp.h; docs/cycle-model.md): bit-identical to the
+// The cycle model of the DynRTP (testbench/chip.h; docs/cycle-model.md): bit-identical to the
 // functional fp24 model on every scene under a covering design of configurations (threads, packet
 // width, caches, latencies, shadow and secondary rays); ray and thread conservation; thread
 // scaling; the prototype configuration on the room beside the paper's Table 4 row for Scene6;
