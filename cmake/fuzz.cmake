@@ -25,12 +25,13 @@ add_subdirectory(memif)
 add_subdirectory(host)
 # Of units/ and testbench/ only the files the harnesses call (their folder libraries need the
 # whole cycle model and every tool): the parameter tables and the vector file's reader with the
-# datapath it checks against.
+# datapath it checks against, and the names of added units that unit_name and phase_name look up.
 add_library(saarcor_fuzz_units STATIC
   ${PROJECT_SOURCE_DIR}/units/cycle_params.cpp
   ${PROJECT_SOURCE_DIR}/units/unit_vectors.cpp
   ${PROJECT_SOURCE_DIR}/units/functional_model.cpp
-  ${PROJECT_SOURCE_DIR}/units/request_trace.cpp)
+  ${PROJECT_SOURCE_DIR}/units/request_trace.cpp
+  ${PROJECT_SOURCE_DIR}/units/unit_registry.cpp)
 target_include_directories(saarcor_fuzz_units PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(saarcor_fuzz_units PUBLIC saarcor::memif saarcor::fixedfloat
   PRIVATE saarcor_warnings)

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <string_view>
 
 #include "testbench/heartbeat.h"
 
@@ -30,12 +31,11 @@ units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
   return p;
 }
 
-units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
-                                   const units::FunctionalParams& shading,
-                                   const CycleRenderOptions& opts, bool heartbeat,
-                                   const units::RunTraceOptions& trace) {
+CycleFrame run_cycle_render(const memif::MemoryImage& image, const units::FunctionalParams& shading,
+                            const CycleRenderOptions& opts, bool heartbeat,
+                            const units::RunTraceOptions& trace) {
   const units::CycleParams p = resolve_cycle_params(opts);
-  units::CycleRunOptions ro;
+  CycleRunOptions ro;
   ro.shading = shading;
   ro.trace = trace;
   ro.interval = opts.interval;
@@ -58,7 +58,7 @@ units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
     ro.vcd_to = opts.vcd_to;
   }
   try {
-    units::CycleFrame f = units::run_cycle(image, p, ro);
+    CycleFrame f = run_cycle(image, p, ro);
     if (!opts.vcd.empty()) {
       vcd.close();
       if (!vcd) throw std::runtime_error("cannot write --vcd '" + opts.vcd + "'");
@@ -76,20 +76,6 @@ units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
 
 namespace {
 
-nlohmann::json figures_json(const units::CycleFigures& f) {
-  nlohmann::json j;
-  for (int i = 0; i < units::kTable4Units; ++i)
-    j["usage"][units::kTable4UnitNames[i]] = f.usage[static_cast<std::size_t>(i)];
-  for (int c = 0; c < units::kCacheUnits; ++c)
-    j["cache_hit"][units::cache_unit_name(units::CacheUnit(c))] =
-        f.cache_hit[static_cast<std::size_t>(c)];
-  j["bandwidth_mb_s"] = {{"dynrtc", f.bw_dynrtc},
-                         {"shading", f.bw_shading},
-                         {"frame_buffer", f.bw_frame},
-                         {"total", f.bw_total}};
-  return j;
-}
-
 double per(std::uint64_t a, std::uint64_t b) {
   return b == 0 ? 0.0 : static_cast<double>(a) / static_cast<double>(b);
 }
@@ -97,12 +83,13 @@ double per(std::uint64_t a, std::uint64_t b) {
 // The RGS's traffic (the table's "shade" column is shading reads + frame-buffer writes, as the
 // paper's shading bandwidth), with the paper's bytes per pixel beside it: its shading MB/s over
 // its frame rate at 1024x768.
-std::string rgs_text(const units::CycleFrame& c, const Table4Row* paper) {
+std::string rgs_text(const CycleFrame& c, const Table4Row* paper) {
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "RGS: shading reads %.0f MB/s, frame-buffer writes %.0f MB/s, %.1f bytes per pixel "
                 "(frame in bank %d)",
-                c.figures.bw_shading, c.figures.bw_frame, c.shading_bytes_per_pixel, c.frame_bank);
+                c.figures.bw_shading(), c.figures.bw_frame(), c.shading_bytes_per_pixel,
+                c.frame_bank);
   std::string s = buf;
   if (paper != nullptr && paper->fps > 0) {
     const double paper_bpp = paper->bw[1] * 1048576.0 / (paper->fps * 1024.0 * 768.0);
@@ -115,8 +102,20 @@ std::string rgs_text(const units::CycleFrame& c, const Table4Row* paper) {
 
 }  // namespace
 
-nlohmann::json cycle_report_json(const units::CycleFrame& c) {
-  nlohmann::json j = figures_json(c.figures);
+void add_figures(nlohmann::json& j, const units::CycleFigures& f, bool sequence_row) {
+  for (int i = 0; i < units::kFigureCount; ++i) {
+    const units::FigureInfo& info = units::kFigures[i];
+    const char* name = sequence_row ? info.sequence_name : info.in_report ? info.name : nullptr;
+    if (name == nullptr) continue;
+    const std::string_view n = name;
+    const std::size_t dot = n.find('.');
+    j[std::string(n.substr(0, dot))][std::string(n.substr(dot + 1))] = f.at(i);
+  }
+}
+
+nlohmann::json cycle_report_json(const CycleFrame& c) {
+  nlohmann::json j;
+  add_figures(j, c.figures);
   j["cycles"] = c.cycles;
   j["fps"] = c.fps;
   j["rgs"] = {{"shading_bytes", c.shading_bytes},
@@ -148,7 +147,7 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
   j["units"] = units;
   // Per DynRTP (one in the prototype): the packets the RGC handed it, its units' usage.
   nlohmann::json pipes = nlohmann::json::array();
-  for (const units::CycleFrame::PipelineCount& pc : c.per_pipeline) {
+  for (const CycleFrame::PipelineCount& pc : c.per_pipeline) {
     nlohmann::json e;
     e["packets"] = pc.packets;
     for (int i = 0; i < units::kTable4Units; ++i)
@@ -182,7 +181,8 @@ nlohmann::json cycle_report_json(const units::CycleFrame& c) {
   if (!c.series.empty()) {
     nlohmann::json s = nlohmann::json::array();
     for (const units::CycleFigures& f : c.series) {
-      nlohmann::json e = figures_json(f);
+      nlohmann::json e;
+      add_figures(e, f);
       e["cycle"] = f.cycle;
       s.push_back(e);
     }
@@ -219,7 +219,7 @@ const Table4Row* paper_row_for(const std::string& scene) {
   return nullptr;
 }
 
-std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
+std::string table4_text(const CycleFrame& c, const std::string& scene) {
   std::string s;
   char buf[512];
   s += "Table 4 layout (paper: 1024x768, 90 MHz, 1 DynRTP, 64 threads; the paper's fps scaled to "
@@ -235,10 +235,9 @@ std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
   std::snprintf(buf, sizeof buf,
                 "%-22s | %6.1f | %4.0f %4.0f %4.0f %4.0f | %4.0f %4.0f %4.0f | %6.0f %5.0f %5.0f "
                 "| %7.1f | %5.2f\n",
-                ("model " + scene).substr(0, 22).c_str(), c.fps, f.usage[0], f.usage[1], f.usage[2],
-                f.usage[3], f.cache_hit[0], f.cache_hit[1], f.cache_hit[2], f.bw_dynrtc,
-                f.bw_shading + f.bw_frame, f.bw_total, per(c.cycles, c.packets),
-                c.rays_per_s / 1e6);
+                ("model " + scene).substr(0, 22).c_str(), c.fps, f.usage(0), f.usage(1), f.usage(2),
+                f.usage(3), f.cache_hit(0), f.cache_hit(1), f.cache_hit(2), f.bw_dynrtc(),
+                f.bw_rgs(), f.bw_total(), per(c.cycles, c.packets), c.rays_per_s / 1e6);
   s += buf;
   if (const Table4Row* r = paper_row_for(scene)) {
     // The paper's cycles per packet and rays/s follow from its fps at 1024x768 and 4-ray packets.
@@ -266,7 +265,7 @@ std::string table4_text(const units::CycleFrame& c, const std::string& scene) {
   if (c.per_pipeline.size() > 1) {
     s += std::to_string(c.per_pipeline.size()) +
          " DynRTPs (usage: the mean over them; the paper's row is one DynRTP), packets each:";
-    for (const units::CycleFrame::PipelineCount& pc : c.per_pipeline)
+    for (const CycleFrame::PipelineCount& pc : c.per_pipeline)
       s += " " + std::to_string(pc.packets);
     s += "\n";
   }

@@ -11,7 +11,7 @@
 #include "host/tree_settings.h"
 
 #include "memif/image_format.h"
-#include "units/dynrtp.h"
+#include "testbench/chip.h"
 
 namespace saarcor {
 
@@ -42,14 +42,18 @@ units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts);
 // `heartbeat`: the terminal heartbeat (testbench/heartbeat.h) when stderr wants one; the sweep's
 // parallel frames run without, their one heartbeat counts points.
 // `trace`: the request trace and Kanata log to write (units/run_trace.h; none by default).
-units::CycleFrame run_cycle_render(const memif::MemoryImage& image,
-                                   const units::FunctionalParams& shading,
-                                   const CycleRenderOptions& opts, bool heartbeat = true,
-                                   const units::RunTraceOptions& trace = {});
+CycleFrame run_cycle_render(const memif::MemoryImage& image, const units::FunctionalParams& shading,
+                            const CycleRenderOptions& opts, bool heartbeat = true,
+                            const units::RunTraceOptions& trace = {});
+
+// The figures of a span (units/figures.h kFigures) into `j` at their dotted names: those the
+// frame's report writes ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}), or with
+// `sequence_row` those a frame sequence's per-frame row writes, at their names there.
+void add_figures(nlohmann::json& j, const units::CycleFigures& f, bool sequence_row = false);
 
 // The per-frame report: cycles, fps, rays, rays_per_s, usage, cache_hit, bandwidth_mb_s, per_ray,
 // simd_efficiency, host, configuration, (time_series).
-nlohmann::json cycle_report_json(const units::CycleFrame& frame);
+nlohmann::json cycle_report_json(const CycleFrame& frame);
 
 // One row of the paper's Table 4 (1024x768, 90 MHz, one DynRTP, 64 threads).
 struct Table4Row {
@@ -65,6 +69,6 @@ const Table4Row* paper_row_for(const std::string& scene);
 
 // The model's figures as a Table 4 row (with cycles per packet and rays/s, which do not depend on
 // the resolution), and the paper's row beneath when there is one.
-std::string table4_text(const units::CycleFrame& frame, const std::string& scene);
+std::string table4_text(const CycleFrame& frame, const std::string& scene);
 
 }  // namespace saarcor

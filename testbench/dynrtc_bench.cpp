@@ -1,4 +1,4 @@
-// Speed of the cycle model (units/dynrtp.h) on the built-in room, 512x384 primary rays, prototype
+// Speed of the cycle model (testbench/chip.h) on the built-in room, 512x384 primary rays, prototype
 // configuration, with the functional fp24 model on the same image and frame in the same run as the
 // yardstick: host seconds per frame, simulated cycles per host second (target >= 5 M), and the
 // slowdown against the functional model (target <= 20x).
@@ -26,7 +26,7 @@
 #include "host/float_reference.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
-#include "units/dynrtp.h"
+#include "testbench/chip.h"
 #include "units/functional_model.h"
 
 namespace {
@@ -107,16 +107,16 @@ void BM_CycleModelFrame(benchmark::State& state) {
   p.threads = static_cast<int>(state.range(0));
   p.pipelines = static_cast<int>(state.range(3));
   const bool shade = state.range(1) != 0;
-  units::CycleRunOptions options;
+  CycleRunOptions options;
   options.shading.shade = shade;
   options.programs = static_cast<units::ProgramMode>(state.range(2));
   const bool ahead = options.programs == units::ProgramMode::kAhead;
   const auto clock = ahead ? wall_seconds : thread_cpu_seconds;
   FrameTimes times, cpu;
-  units::CycleFrame last;
+  CycleFrame last;
   for (auto _ : state) {
     const double t0 = clock(), c0 = process_cpu_seconds();
-    last = units::run_cycle(r.built.image, p, options);
+    last = run_cycle(r.built.image, p, options);
     times.add(clock() - t0);
     cpu.add(process_cpu_seconds() - c0);
   }

@@ -1,9 +1,9 @@
-// The cycle model of the DynRTP (units/dynrtp.h; docs/cycle-model.md): bit-identical to the
+// The cycle model of the DynRTP (testbench/chip.h; docs/cycle-model.md): bit-identical to the
 // functional fp24 model on every scene under a covering design of configurations (threads, packet
 // width, caches, latencies, shadow and secondary rays); ray and thread conservation; thread
 // scaling; the prototype configuration on the room beside the paper's Table 4 row for Scene6;
 // parameters and bad input.
-#include "units/dynrtp.h"
+#include "testbench/chip.h"
 
 #include <gtest/gtest.h>
 
@@ -162,7 +162,7 @@ TEST(DynRtc, PipelinesShareTheFrame) {
   // when fewer packets than threads are left, is the same length with four pipelines).
   EXPECT_LT(c.cycles * 2, a.cycles) << a.cycles << " vs " << c.cycles;
   EXPECT_NEAR(
-      c.figures.usage[0],
+      c.figures.usage(0),
       100.0 * static_cast<double>(c.issue_cycles[0]) / (4.0 * static_cast<double>(c.cycles)), 1e-9);
   // Eight DynRTPs wait on the scene banks' one issue path (D21); a path per bank relieves it.
   CycleParams eight = prototype_params();
@@ -263,8 +263,8 @@ TEST(DynRtc, ThreadScalingOnTheRoom) {
     std::printf("%7d %8llu %14.1f %9.2f %5.1f %5.1f %5.1f %5.1f\n", t,
                 static_cast<unsigned long long>(c.cycles),
                 static_cast<double>(c.cycles) / static_cast<double>(c.packets),
-                static_cast<double>(cycles[1]) / static_cast<double>(c.cycles), c.figures.usage[0],
-                c.figures.usage[1], c.figures.usage[2], c.figures.usage[3]);
+                static_cast<double>(cycles[1]) / static_cast<double>(c.cycles), c.figures.usage(0),
+                c.figures.usage(1), c.figures.usage(2), c.figures.usage(3));
   }
   EXPECT_GE(static_cast<double>(cycles[1]) / static_cast<double>(cycles[32]), 8.0);
   const double gain = static_cast<double>(cycles[32]) / static_cast<double>(cycles[64]) - 1.0;
@@ -283,7 +283,7 @@ TEST(DynRtc, PrototypeOnTheRoomBesideTable4) {
   const auto& f = c.figures;
   const double per_packet = static_cast<double>(c.cycles) / static_cast<double>(c.packets);
   const UnitStats& u = c.frame.units;
-  const double ratio = f.usage[3] / f.usage[2];
+  const double ratio = f.usage(3) / f.usage(2);
   const double op_ratio = static_cast<double>(u.traversal_ops.total()) /
                           static_cast<double>(u.intersection_ops.total());
   const double step_ratio = static_cast<double>(c.per_ray_sum.traversal_steps) /
@@ -294,16 +294,16 @@ TEST(DynRtc, PrototypeOnTheRoomBesideTable4) {
   std::printf(
       "                 usage %% trav list xfrm  int | hit %% trav list xfrm | cycles/packet\n");
   std::printf("model room             %4.0f %4.0f %4.0f %4.0f |       %4.0f %4.0f %4.0f | %6.1f\n",
-              f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.cache_hit[0], f.cache_hit[1],
-              f.cache_hit[2], per_packet);
+              f.usage(0), f.usage(1), f.usage(2), f.usage(3), f.cache_hit(0), f.cache_hit(1),
+              f.cache_hit(2), per_packet);
   std::printf("paper Scene6             68   16   85   41 |         99   97   99 |   29.9\n");
   std::printf("intersection/transformation usage %.2f (paper 0.41-0.65 over all scenes)\n", ratio);
   std::printf("traversal/intersection: ops %.2f, steps per ray %.2f (paper: about 4:1)\n", op_ratio,
               step_ratio);
   std::printf("triangle tests per packet %.1f (Scene6 calibration: about 3); DynRTC %.1f MB/s\n",
-              tri_per_packet, f.bw_dynrtc);
+              tri_per_packet, f.bw_dynrtc());
   for (int k = 0; k < kCacheUnits; ++k)
-    EXPECT_GT(f.cache_hit[static_cast<std::size_t>(k)], 90.0) << cache_unit_name(CacheUnit(k));
+    EXPECT_GT(f.cache_hit(k), 90.0) << cache_unit_name(CacheUnit(k));
   // Usage is the work the thread program asks for, spread over the frame: P intersection cycles
   // per triangle test and n+1 transformation steps per matrix (D30, D31). The ratio follows from
   // the scene's triangle tests per packet.
@@ -559,10 +559,10 @@ TEST(DynRtc, TimeSeriesAddsUpToTheFrame) {
   std::uint64_t prev = 0;
   for (const CycleFigures& f : c.series) {
     EXPECT_GT(f.cycle, prev);
-    busy += f.usage[2] * static_cast<double>(f.cycle - prev);
+    busy += f.usage(2) * static_cast<double>(f.cycle - prev);
     prev = f.cycle;
   }
-  EXPECT_NEAR(busy / static_cast<double>(c.cycles), c.figures.usage[2], 1e-9);
+  EXPECT_NEAR(busy / static_cast<double>(c.cycles), c.figures.usage(2), 1e-9);
 }
 
 // A statistic of the frame's hw/ registry (CycleFrame::stats_json) by its full name.

@@ -12,7 +12,7 @@
 #include "host/builtin_scenes.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
-#include "units/dynrtp.h"
+#include "testbench/chip.h"
 
 namespace saarcor::units::testing {
 

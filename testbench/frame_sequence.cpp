@@ -15,6 +15,7 @@
 #include "host/tree_settings.h"
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
+#include "testbench/chip.h"
 #include "testbench/heartbeat.h"
 #include "testbench/run_dir.h"
 #include "units/functional_model.h"
@@ -167,24 +168,18 @@ NextFrame prepare_next(host::Scene& scene, host::BuiltImage& host, const memif::
   return n;
 }
 
-void take_figures(SequenceFrame& row, const units::CycleFrame& c) {
+void take_figures(SequenceFrame& row, const CycleFrame& c) {
   row.cycles = c.cycles;
   row.fps = c.fps;
   row.rays = c.rays;
-  for (int i = 0; i < 4; ++i)
-    row.usage[i] = c.figures.usage[static_cast<std::size_t>(i)];
-  for (int i = 0; i < 3; ++i)
-    row.hit[i] = c.figures.cache_hit[static_cast<std::size_t>(i)];
-  row.bw_dynrtc = c.figures.bw_dynrtc;
-  row.bw_shading = c.figures.bw_shading + c.figures.bw_frame;
+  row.figures = c.figures;
   row.shading_bytes_per_pixel = c.shading_bytes_per_pixel;
   row.cycles_per_packet =
       c.packets == 0 ? 0.0 : static_cast<double>(c.cycles) / static_cast<double>(c.packets);
 }
 
-units::CycleRunOptions cycle_run_options(const RenderSettings& s, Heartbeat& beat, int index,
-                                         int frames) {
-  units::CycleRunOptions ro;
+CycleRunOptions cycle_run_options(const RenderSettings& s, Heartbeat& beat, int index, int frames) {
+  CycleRunOptions ro;
   ro.shading = functional_params(s);
   if (s.cycle.host_threads != 0)
     ro.programs =
@@ -342,9 +337,9 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
     std::uint64_t gap_cycles = 0;
     units::FunctionalFrame frame;
     if (cycle) {
-      const units::CycleRunOptions ro = cycle_run_options(s, beat, k, opts.frames);
-      units::CycleFrame c = more && !next.row.gap ? units::run_cycle(board, cp, ro, next.upload)
-                                                  : units::run_cycle(std::as_const(board), cp, ro);
+      const CycleRunOptions ro = cycle_run_options(s, beat, k, opts.frames);
+      CycleFrame c = more && !next.row.gap ? run_cycle(board, cp, ro, next.upload)
+                                           : run_cycle(std::as_const(board), cp, ro);
       if (more && next.row.gap) gap_cycles = upload_alone(board, cp, next.upload);
       next.row.upload_cycles = c.upload_cycles;
       take_figures(cur, c);
@@ -417,12 +412,7 @@ nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
       e["cycles"] = f.cycles;
       e["fps"] = f.fps;
       e["cycles_per_packet"] = f.cycles_per_packet;
-      for (int i = 0; i < 4; ++i)
-        e["usage"][units::kTable4UnitNames[i]] = f.usage[i];
-      for (int i = 0; i < 3; ++i)
-        e["cache_hit"][units::cache_unit_name(units::CacheUnit(i))] = f.hit[i];
-      e["bandwidth_mb_s"]["dynrtc"] = f.bw_dynrtc;
-      e["bandwidth_mb_s"]["shading"] = f.bw_shading;
+      add_figures(e, f.figures, true);
       e["shading_bytes_per_pixel"] = f.shading_bytes_per_pixel;
       e["bit_identical_to_functional_model"] = f.checked;
     }
@@ -507,8 +497,9 @@ std::string sequence_table(const SequenceResult& r) {
     if (r.cycle) {
       std::snprintf(buf, sizeof buf,
                     "%11" PRIu64 " %6.1f %4.0f %4.0f %4.0f %4.0f %4.0f %2.0f %2.0f", f.cycles,
-                    f.fps, f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.hit[0], f.hit[1],
-                    f.hit[2]);
+                    f.fps, f.figures.usage(0), f.figures.usage(1), f.figures.usage(2),
+                    f.figures.usage(3), f.figures.cache_hit(0), f.figures.cache_hit(1),
+                    f.figures.cache_hit(2));
       s += buf;
     }
     // The host's top-level (re)build on this machine: not on the model's clock (D46).
@@ -564,9 +555,10 @@ std::string sequence_csv(const SequenceResult& r) {
                     ",%" PRIu64 ",%d,%" PRIu64 ",%" PRIu64 ",%" PRIu64
                     ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
                     f.upload_cycles, f.hidden ? 1 : 0, f.stall_cycles, f.start_cycle, f.cycles,
-                    f.fps, f.usage[0], f.usage[1], f.usage[2], f.usage[3], f.hit[0], f.hit[1],
-                    f.hit[2], f.bw_dynrtc, f.cycles_per_packet, f.bw_shading,
-                    f.shading_bytes_per_pixel);
+                    f.fps, f.figures.usage(0), f.figures.usage(1), f.figures.usage(2),
+                    f.figures.usage(3), f.figures.cache_hit(0), f.figures.cache_hit(1),
+                    f.figures.cache_hit(2), f.figures.bw_dynrtc(), f.cycles_per_packet,
+                    f.figures.bw_rgs(), f.shading_bytes_per_pixel);
       s += buf;
     }
     std::snprintf(buf, sizeof buf, ",%" PRIu64 ",%016" PRIx64 "\n", f.rays, f.digest);

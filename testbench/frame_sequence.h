@@ -18,6 +18,7 @@
 
 #include "testbench/image_io.h"
 #include "testbench/render_cmd.h"
+#include "units/figures.h"
 
 namespace saarcor {
 
@@ -58,10 +59,7 @@ struct SequenceFrame {
   std::uint64_t cycles = 0;       // rendering
   double fps = 0.0;               // rendering alone, at the modelled clock
   std::uint64_t rays = 0;
-  double usage[4] = {};     // traversal, list, transformation, intersection (%)
-  double hit[3] = {};       // traversal, list, transformation cache (%)
-  double bw_dynrtc = 0.0;   // MB/s
-  double bw_shading = 0.0;  // MB/s: the RGS's shading reads and frame-buffer writes
+  units::CycleFigures figures;  // the frame's Table 4 figures (units/figures.h)
   double shading_bytes_per_pixel = 0.0;
   double cycles_per_packet = 0.0;
   std::uint64_t digest = 0;  // FNV-1a of the hit records and the image

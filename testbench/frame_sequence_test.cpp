@@ -222,16 +222,15 @@ TEST(FrameSequence, AWriteIntoTheFrameInFlightIsRefused) {
   // The root node of the top-level copy the registers name: what every packet reads first.
   const memif::WordLocation root = board.locate(memif::ItemType::kNode, board.registers().top_root);
   u.runs.push_back({root.bank, root.offset, {0xFFFFFFFFu}});
-  const std::string e = error_of(
-      [&] { units::run_cycle(board, resolve_cycle_params(s.cycle), units::CycleRunOptions{}, u); });
+  const std::string e =
+      error_of([&] { run_cycle(board, resolve_cycle_params(s.cycle), CycleRunOptions{}, u); });
   EXPECT_NE(e.find("overlaps kd-nodes"), std::string::npos) << e;
   EXPECT_NE(e.find("which the frame in flight reads"), std::string::npos) << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   // The other copy's root is free to write, and the word arrives.
   const memif::WordLocation other = board.locate(memif::ItemType::kNode, p.built.top_node_capacity);
   u.runs = {{other.bank, other.offset, {0x12345678u}}};
-  const units::CycleFrame f =
-      units::run_cycle(board, resolve_cycle_params(s.cycle), units::CycleRunOptions{}, u);
+  const CycleFrame f = run_cycle(board, resolve_cycle_params(s.cycle), CycleRunOptions{}, u);
   EXPECT_EQ(board.word(other.bank, other.offset), 0x12345678u);
   EXPECT_EQ(f.upload_bytes, 4u);
   EXPECT_GT(f.upload_cycles, 0u);

@@ -187,7 +187,7 @@ class StressRunner {
     s.cycle.host_threads = c.host_threads;
     const PreparedScene& prep = prepared(c, s);
     const units::FunctionalParams shading = functional_params(s);
-    units::CycleFrame cy;
+    CycleFrame cy;
     try {
       cy = run_cycle_render(prep.built.image, shading, s.cycle);
     } catch (const std::runtime_error& e) {
@@ -225,7 +225,7 @@ class StressRunner {
     return slot->second;
   }
 
-  static void expect_same_frame(const units::CycleFrame& cy, const units::FunctionalFrame& fn) {
+  static void expect_same_frame(const CycleFrame& cy, const units::FunctionalFrame& fn) {
     ASSERT_EQ(cy.frame.pixels.size(), fn.pixels.size());
     int bad = 0;
     for (std::size_t i = 0; i < fn.pixels.size(); ++i)

@@ -281,8 +281,8 @@ FrameResult render_cycle_frame(const ModelSpec& model, const PreparedScene& prep
   FrameResult r;
   r.model = model.name;
   const auto t0 = Clock::now();
-  const units::CycleFrame c = run_cycle_render(prep.built.image, functional_params(settings),
-                                               settings.cycle, settings.heartbeat, settings.trace);
+  const CycleFrame c = run_cycle_render(prep.built.image, functional_params(settings),
+                                        settings.cycle, settings.heartbeat, settings.trace);
   r.seconds = seconds_since(t0);
   r.hits.width = c.frame.width;
   r.hits.height = c.frame.height;

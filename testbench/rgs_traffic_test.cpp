@@ -12,8 +12,8 @@
 
 #include "host/image_builder.h"
 #include "host/scene.h"
+#include "testbench/chip.h"
 #include "testbench/dynrtc_testing.h"
-#include "units/dynrtp.h"
 #include "units/functional_model.h"
 
 namespace saarcor::units {
@@ -56,10 +56,10 @@ TEST(RgsTraffic, HitSinkFrameReadsNoShadingDataAndWritesEveryPixel) {
   o.shading.shade = false;
   const CycleFrame c = run_cycle(b.image, prototype_params(), o);
   EXPECT_EQ(c.shading_bytes, 0u);
-  EXPECT_EQ(c.figures.bw_shading, 0.0);
+  EXPECT_EQ(c.figures.bw_shading(), 0.0);
   EXPECT_EQ(c.frame_bytes, 3u * 32 * 24);
-  EXPECT_GT(c.figures.bw_frame, 0.0);
-  EXPECT_DOUBLE_EQ(c.figures.bw_total, c.figures.bw_dynrtc + c.figures.bw_frame);
+  EXPECT_GT(c.figures.bw_frame(), 0.0);
+  EXPECT_DOUBLE_EQ(c.figures.bw_total(), c.figures.bw_dynrtc() + c.figures.bw_frame());
 }
 
 // Bilinear filtering reads four texels per textured hit, nearest one: the same hits, 12 more

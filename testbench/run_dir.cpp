@@ -7,12 +7,21 @@
 #include <map>
 #include <stdexcept>
 
+#include "units/figures.h"
+
 namespace saarcor {
 namespace {
 
 bool shell_safe(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
          std::string_view("_@%+=:,./-").find(c) != std::string_view::npos;
+}
+
+// A Table 4 figure's help by its dotted name (units/figures.h kFigures).
+std::string figure_help(const std::string& name) {
+  for (const units::FigureInfo& f : units::kFigures)
+    if (name == f.name) return f.help;
+  throw std::logic_error("no Table 4 figure named " + name);
 }
 
 std::string format_value(double v) {
@@ -145,14 +154,12 @@ void append_cycle_stats(std::vector<StatLine>& lines, const nlohmann::json& c) {
       {"frame.cycles_per_packet", num(c["cycles_per_packet"]), "cycles per packet (cycles)"});
   lines.push_back({"frame.simd_efficiency", num(c["simd_efficiency"]),
                    "active rays per packet step / packet width"});
-  for (const auto& [unit, v] : c["usage"].items())
-    lines.push_back({"frame.usage." + unit, num(v), "% of cycles the " + unit + " unit issued"});
-  for (const auto& [unit, v] : c["cache_hit"].items())
-    lines.push_back({"frame.cache_hit." + unit, num(v),
-                     "% of the " + unit + " cache's packet requests that hit (merges count)"});
-  for (const auto& [kind, v] : c["bandwidth_mb_s"].items())
-    lines.push_back(
-        {"frame.bandwidth_mb_s." + kind, num(v), kind + " memory bandwidth (MB/s, MB = 2^20 B)"});
+  // The Table 4 figures as the report holds them, each with its help (units/figures.h).
+  for (const char* group : {"usage", "cache_hit", "bandwidth_mb_s"})
+    for (const auto& [key, v] : c[group].items()) {
+      const std::string name = std::string(group) + "." + key;
+      lines.push_back({"frame." + name, num(v), figure_help(name)});
+    }
   for (const auto& [counter, v] : c["per_ray"].items()) {
     const auto it = counter_descriptions().find(counter);
     lines.push_back({"frame.per_ray." + counter, num(v),

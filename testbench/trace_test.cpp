@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "testbench/chip.h"
 #include "testbench/dynrtc_testing.h"
 #include "testbench/render_cmd.h"
 #include "testbench/testing.h"
-#include "units/dynrtp.h"
 #include "units/functional_model.h"
 #include "units/request_trace.h"
 #include "units/run_trace.h"
@@ -71,7 +71,7 @@ std::string compare_traces(const std::vector<TraceLine>& functional,
 
 struct Traced {
   std::string trace, konata;
-  units::CycleFrame frame;
+  CycleFrame frame;
 };
 
 Traced run_traced_cycle(const memif::MemoryImage& image, const std::vector<std::string>& set,
@@ -80,14 +80,14 @@ Traced run_traced_cycle(const memif::MemoryImage& image, const std::vector<std::
   units::CycleParams p = units::prototype_params();
   for (const std::string& kv : set)
     units::apply_cycle_setting(p, kv);
-  units::CycleRunOptions o;
+  CycleRunOptions o;
   o.shading = shading;
   o.programs = mode;
   std::ostringstream trace, log;
   o.trace.trace = &trace;
   if (konata) o.trace.konata = &log;
   Traced t;
-  t.frame = units::run_cycle(image, p, o);
+  t.frame = run_cycle(image, p, o);
   t.trace = trace.str();
   t.konata = log.str();
   return t;
@@ -202,9 +202,9 @@ TEST(RequestTrace, TracingMovesNoFigure) {
   const host::BuiltImage built = units::testing::build("builtin:dynamic", kW, kH);
   const units::FunctionalParams shading;
   for (const units::ProgramMode mode : {units::ProgramMode::kAhead, units::ProgramMode::kPerStep}) {
-    units::CycleRunOptions plain;
+    CycleRunOptions plain;
     plain.programs = mode;
-    const units::CycleFrame a = units::run_cycle(built.image, units::prototype_params(), plain);
+    const CycleFrame a = run_cycle(built.image, units::prototype_params(), plain);
     const Traced b = run_traced_cycle(built.image, {}, shading, mode, true);
     EXPECT_EQ(a.cycles, b.frame.cycles);
     EXPECT_EQ(a.issue_cycles, b.frame.issue_cycles);

@@ -18,7 +18,7 @@ namespace saarcor::units {
 // Item caches of the DynRTC by the unit that reads them.
 enum class CacheUnit { kTraversal = 0, kList = 1, kTransformation = 2 };
 inline constexpr int kCacheUnits = 3;
-inline const char* cache_unit_name(CacheUnit c) {
+constexpr const char* cache_unit_name(CacheUnit c) {
   constexpr const char* kNames[] = {"traversal", "list", "transformation"};
   return kNames[static_cast<int>(c)];
 }
@@ -93,7 +93,7 @@ void check_cycle_params(const CycleParams& params);
 // The resolved configuration: every parameter with its current value.
 std::vector<CycleParamInfo> describe(const CycleParams& params);
 // The memory interface the parameters describe (pipelines, caches, controller, routing, host
-// bus): what the cycle model's chip instantiates (units/dynrtp.cpp).
+// bus): what the cycle model's chip instantiates (testbench/chip.cpp).
 memif::MemorySystemConfig memory_system_config(const CycleParams& params);
 
 }  // namespace saarcor::units

@@ -24,7 +24,7 @@
 
 namespace saarcor::units {
 
-inline constexpr int kUnitCount = 5;  // UnitId::kRgs .. kIntersection
+// A unit's slot in the arrays indexed by unit (kMaxUnits slots: Figure 2's units and added ones).
 inline int unit_index(UnitId u) {
   return static_cast<int>(u);
 }
@@ -98,8 +98,7 @@ class CycleUnit : public hw::Module {
 
   // Inputs in priority order (the first non-empty path is served, D25).
   void add_input(ThreadPath* path) {
-    if (input_count_ == kUnitCount)
-      throw std::logic_error(name() + ": more input paths than units");
+    if (input_count_ == kMaxUnits) throw std::logic_error(name() + ": more input paths than units");
     consumes(*path);
     input_[input_count_++] = path;
   }
@@ -153,7 +152,7 @@ class CycleUnit : public hw::Module {
   int accept(ThreadPath* from);  // one thread from `from` (null while fetching); one request out
 
   ThreadTable& threads_;
-  std::array<ThreadPath*, kUnitCount> outputs_{};
+  std::array<ThreadPath*, kMaxUnits> outputs_{};
   int inside_ = 0;
   bool has_extra_ = false;
   UnitObserver* observer_ = nullptr;
@@ -175,7 +174,7 @@ class CycleUnit : public hw::Module {
   memif::Cache* cache_;
   hw::Channel<memif::CacheRequest>* cache_requests_ = nullptr;
   hw::Channel<memif::CacheResponse>* cache_responses_ = nullptr;
-  std::array<ThreadPath*, kUnitCount> input_{};  // in priority order (inline: scanned every cycle)
+  std::array<ThreadPath*, kMaxUnits> input_{};  // in priority order (inline: scanned every cycle)
   int input_count_ = 0;
   // Fetch stage: the thread whose cache requests are being sent.
   bool fetching_ = false;

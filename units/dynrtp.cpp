@@ -1,43 +1,18 @@
 // The DynRTP assembled for the cycle model (paper section 3.1, Figure 2 paths a-g; DESIGN.md
-// sections 5 and 6; docs/cycle-model.md): units, paths, memory interface, the frame loop and its
-// figures, over the thread table of units/recorded_threads.h.
+// sections 5 and 6; docs/cycle-model.md): Figure 2's units with their input priorities, the paths
+// between every two units, and the memory system's parameters. testbench/chip.cpp instantiates
+// the chip from it and clocks it.
 #include "units/dynrtp.h"
 
-#include <algorithm>
-#include <chrono>
-#include <condition_variable>
-#include <deque>
-#include <exception>
-#include <memory>
-#include <mutex>
-#include <new>
-#include <optional>
-#include <sstream>
 #include <stdexcept>
-#include <thread>
+#include <string>
 
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
 #include "units/dynrtc_units.h"
-#include "units/recorded_threads.h"
-#include "units/request_trace.h"
 
 namespace saarcor::units {
 namespace {
-
-template <class F, int kLanes>
-void collect(FunctionalFrame& frame, RecordedThreads<F, kLanes>& threads) {
-  frame.format = F::kFormat;
-  frame.width = threads.sink().width;
-  frame.height = threads.sink().height;
-  frame.params = threads.params();
-  collect_frame(frame, threads.units(), threads.sink());
-}
-
-constexpr memif::ItemType kCacheItem[kCacheUnits] = {memif::ItemType::kNode, memif::ItemType::kList,
-                                                     memif::ItemType::kRow};
-constexpr UnitId kTable4Unit[kTable4Units] = {UnitId::kTraversal, UnitId::kList,
-                                              UnitId::kTransformation, UnitId::kIntersection};
 
 // The paths of Figure 2 by (from, to); the other hand-overs of the thread program (a unit's own
 // loop, list -> traversal when a leaf's list ends, ...) get descriptive names.
@@ -59,405 +34,6 @@ std::string path_name(UnitId from, UnitId to) {
   return std::string(unit_name(from)) + "_to_" + unit_name(to);
 }
 
-// Input priorities (D25): in-flight work before new rays; a unit's own loop first. Only the
-// hand-overs the thread program can make are listed (a path nobody reads would hold its thread
-// until the watchdog names it).
-std::vector<UnitId> input_order(UnitId u) {
-  switch (u) {
-    case UnitId::kTraversal:  // loop (next node, pop), f, end of a leaf's list, shadow rays, b
-      return {UnitId::kTraversal, UnitId::kIntersection, UnitId::kList, UnitId::kRgs,
-              UnitId::kTransformation};
-    case UnitId::kList:  // loop (mailbox skip), after an intersection, c
-      return {UnitId::kList, UnitId::kIntersection, UnitId::kTraversal};
-    case UnitId::kTransformation:  // d before a (D25)
-      return {UnitId::kList, UnitId::kRgs};
-    case UnitId::kIntersection:  // e
-      return {UnitId::kTransformation};
-    default:  // the RGS: g, the end of a list or an intersection, shadow-ray generation
-      return {UnitId::kTraversal, UnitId::kList, UnitId::kIntersection, UnitId::kTransformation,
-              UnitId::kRgs};
-  }
-}
-
-// The frame buffer: one word per pixel from word 0 of the back bank (FrameRegisters::frame_bank).
-void check_frame_buffer(const memif::MemoryImage& image) {
-  const auto& r = image.registers();
-  if (r.frame_bank != memif::kFrameBank0 && r.frame_bank != memif::kFrameBank1)
-    throw std::runtime_error("cycle model: frame_bank " + std::to_string(r.frame_bank) +
-                             " is not a frame-buffer bank (0 or 1)");
-  const std::uint64_t words = std::uint64_t{r.width} * r.height;
-  if (words > image.bank_words())
-    throw std::runtime_error("cycle model: a " + std::to_string(r.width) + "x" +
-                             std::to_string(r.height) + " frame needs " + std::to_string(words) +
-                             " frame-buffer words, a bank holds " +
-                             std::to_string(image.bank_words()) + " (raise --bank-mb)");
-}
-
-// The frame's image as the hardware left it: the words the RGS wrote into the back bank.
-void read_frame_buffer(const memif::MemoryImage& image, int bank, CycleFrame& out) {
-  const std::vector<std::uint32_t>& fb = image.bank(bank);
-  auto& rgb = out.frame.rgb;
-  rgb.resize(out.frame.pixels.size() * 3u);
-  for (std::size_t i = 0; i < out.frame.pixels.size(); ++i)
-    for (std::size_t k = 0; k < 3; ++k)
-      rgb[3 * i + k] = static_cast<std::uint8_t>((fb[i] >> (8 * k)) & 255u);
-  out.frame_bank = bank;
-}
-
-double mb_per_s(std::uint64_t bytes, std::uint64_t cycles, double clock_mhz) {
-  if (cycles == 0) return 0.0;
-  return static_cast<double>(bytes) * clock_mhz * 1e6 / static_cast<double>(cycles) / 1048576.0;
-}
-
-double percent(std::uint64_t a, std::uint64_t b) {
-  return b == 0 ? 0.0 : 100.0 * static_cast<double>(a) / static_cast<double>(b);
-}
-
-// One DynRTP: its units and the paths a-g between them, over its pipeline's caches in the shared
-// memory system; its threads are ids [pipeline x threads, (pipeline + 1) x threads) of the table.
-class DynRtp {
- public:
-  DynRtp(hw::Kernel& k, memif::MemorySystem& mi, const CycleParams& p, ThreadTable& threads,
-         RayGenerationController& rgc, int pipeline) {
-    const std::string pre = "dynrtp" + std::to_string(pipeline) + ".";
-    const RgsPorts ports{&mi.shading_port(pipeline), &mi.frame_port(pipeline),
-                         mi.shading_client(pipeline), mi.frame_client(pipeline)};
-    rgs_ = &k.make<RaySource>(pre + "rgs", threads, p.rgs_depth, rgc, pipeline,
-                              static_cast<ThreadToken>(pipeline * p.threads), p.threads, ports);
-    units_[unit_index(UnitId::kRgs)] = rgs_;
-    units_[unit_index(UnitId::kTraversal)] =
-        &k.make<TraversalUnit>(pre + "traversal", threads, p.traversal_depth(),
-                               mi.cache(pipeline, memif::ItemType::kNode));
-    units_[unit_index(UnitId::kList)] = &k.make<ListUnit>(
-        pre + "list", threads, p.list_depth(), mi.cache(pipeline, memif::ItemType::kList));
-    units_[unit_index(UnitId::kTransformation)] =
-        &k.make<TransformationUnit>(pre + "transformation", threads, p.transformation_depth(),
-                                    mi.cache(pipeline, memif::ItemType::kRow));
-    units_[unit_index(UnitId::kIntersection)] =
-        &k.make<IntersectionUnit>(pre + "intersection", threads, p.intersection_depth());
-    // Thread-id queues hold every thread of the pipeline: a full path can never hold a unit
-    // (deadlock freedom by construction); the priorities of D25 decide only the order.
-    const int capacity = p.threads + 1;
-    for (int from = 0; from < kUnitCount; ++from)
-      for (int to = 0; to < kUnitCount; ++to) {
-        const auto f = static_cast<UnitId>(from), t = static_cast<UnitId>(to);
-        paths_[from][to] = &k.make_channel<ThreadToken>(pre + path_name(f, t), capacity, 1);
-        units_[from]->set_output(t, paths_[from][to]);
-      }
-    for (int to = 0; to < kUnitCount; ++to)
-      for (UnitId from : input_order(static_cast<UnitId>(to)))
-        units_[to]->add_input(paths_[unit_index(from)][to]);
-  }
-
-  RaySource& rgs() { return *rgs_; }
-  const RaySource& rgs() const { return *rgs_; }
-  CycleUnit& unit(UnitId u) { return *units_[unit_index(u)]; }
-  void observe(UnitObserver* o) {
-    for (CycleUnit* u : units_)
-      u->set_observer(o);
-  }
-
- private:
-  RaySource* rgs_ = nullptr;
-  std::array<CycleUnit*, kUnitCount> units_{};
-  std::array<std::array<ThreadPath*, kUnitCount>, kUnitCount> paths_{};
-};
-
-// The chip of Figure 2: the RGC, `pipelines` DynRTPs and the memory interface they share.
-class Chip {
- public:
-  Chip(hw::Kernel& k, memif::MemoryImage& image, const CycleParams& p, ThreadTable& threads)
-      : mi_(k, image, memory_system_config(p)), rgc_(threads.packets(), p.pipelines) {
-    for (int i = 0; i < p.pipelines; ++i)
-      pipes_.push_back(std::make_unique<DynRtp>(k, mi_, p, threads, rgc_, i));
-  }
-
-  // Every packet handed out, every thread free again and the last pixels written into the frame
-  // buffer (checked between cycles).
-  bool finished() const {
-    if (!rgc_.all_handed_out()) return false;
-    for (const auto& d : pipes_)
-      if (!d->rgs().idle()) return false;
-    return mi_.frame_writes_stored();
-  }
-  std::uint64_t packets_retired() const {
-    std::uint64_t n = 0;
-    for (const auto& d : pipes_)
-      n += d->rgs().packets_retired();
-    return n;
-  }
-  int pipelines() const { return static_cast<int>(pipes_.size()); }
-  DynRtp& pipeline(int i) { return *pipes_[static_cast<std::size_t>(i)]; }
-  void observe(UnitObserver* o) {
-    for (auto& d : pipes_)
-      d->observe(o);
-  }
-  memif::MemorySystem& memory() { return mi_; }
-
- private:
-  memif::MemorySystem mi_;
-  RayGenerationController rgc_;
-  std::vector<std::unique_ptr<DynRtp>> pipes_;
-};
-
-// Cumulative counts the figures are computed from.
-struct Snapshot {
-  std::uint64_t cycle = 0;
-  std::array<std::uint64_t, kTable4Units> issued{};
-  std::array<std::uint64_t, kCacheUnits> requests{}, hits{}, bytes{};
-  std::uint64_t shading_bytes = 0, frame_bytes = 0;
-  int pipelines = 1;  // usage is per unit: issue cycles over cycles x pipelines
-};
-
-Snapshot snapshot(hw::Kernel& k, Chip& chip) {
-  Snapshot s;
-  s.cycle = k.now();
-  s.pipelines = chip.pipelines();
-  for (int p = 0; p < chip.pipelines(); ++p) {
-    DynRtp& d = chip.pipeline(p);
-    for (int i = 0; i < kTable4Units; ++i)
-      s.issued[static_cast<std::size_t>(i)] += d.unit(kTable4Unit[i]).issue_cycles();
-    for (int c = 0; c < kCacheUnits; ++c) {
-      const memif::Cache& cache = chip.memory().cache(p, kCacheItem[c]);
-      s.requests[static_cast<std::size_t>(c)] += cache.requests_count();
-      s.hits[static_cast<std::size_t>(c)] += cache.hits() + cache.merges();
-      s.bytes[static_cast<std::size_t>(c)] +=
-          k.stats().get_counter(cache.name() + ".mem_bytes").value;
-    }
-    const std::string pre = "dynrtp" + std::to_string(p) + ".";
-    s.shading_bytes += k.stats().get_counter(pre + "shading.mem_bytes").value;
-    s.frame_bytes += k.stats().get_counter(pre + "frame.mem_bytes").value;
-  }
-  return s;
-}
-
-CycleFigures figures(const Snapshot& a, const Snapshot& b, double clock_mhz) {
-  CycleFigures f;
-  f.cycle = b.cycle;
-  const std::uint64_t n = b.cycle - a.cycle;
-  for (std::size_t i = 0; i < kTable4Units; ++i)
-    f.usage[i] = percent(b.issued[i] - a.issued[i], n * static_cast<std::uint64_t>(b.pipelines));
-  std::uint64_t dyn = 0;
-  for (std::size_t c = 0; c < kCacheUnits; ++c) {
-    const std::uint64_t req = b.requests[c] - a.requests[c];
-    f.cache_hit[c] = req == 0 ? 100.0 : percent(b.hits[c] - a.hits[c], req);
-    dyn += b.bytes[c] - a.bytes[c];
-  }
-  f.bw_dynrtc = mb_per_s(dyn, n, clock_mhz);
-  f.bw_shading = mb_per_s(b.shading_bytes - a.shading_bytes, n, clock_mhz);
-  f.bw_frame = mb_per_s(b.frame_bytes - a.frame_bytes, n, clock_mhz);
-  f.bw_total = f.bw_dynrtc + f.bw_shading + f.bw_frame;
-  return f;
-}
-
-// With several DynRTPs each thread also names its pipeline (thread t is pipeline t / threads').
-template <class F, int kLanes>
-std::string thread_report(RecordedThreads<F, kLanes>& threads, const CycleParams& p) {
-  std::ostringstream s;
-  s << "threads (id: unit, phase, item, rays):";
-  for (int t = 0; t < threads.size(); ++t) {
-    const Request r = threads.request(static_cast<std::uint32_t>(t));
-    if (r.unit == UnitId::kNone) continue;
-    s << "\n  thread " << t;
-    if (p.pipelines > 1) s << " (dynrtp" << t / p.threads << ")";
-    s << ": " << unit_name(r.unit) << ", " << phase_name(r.phase);
-    if (r.item != memif::kNone) s << ", item " << r.item;
-    s << ", mask 0x" << std::hex << threads.mask(static_cast<std::uint32_t>(t)) << std::dec;
-  }
-  return s.str();
-}
-
-// Runs the kernel until `done` (by default: the chip has retired every packet), sampling the
-// figures every opt.interval cycles into out.series and reporting progress.
-template <class F, int kLanes>
-void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, const CycleParams& p,
-              const CycleRunOptions& opt, CycleFrame& out, std::function<bool()> done = {}) {
-  if (!done) done = [&] { return chip.finished(); };
-  const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
-  Snapshot last = snapshot(k, chip);
-  while (!done()) {
-    std::uint64_t budget = chunk;
-    if (opt.max_cycles != 0) {
-      if (k.now() >= opt.max_cycles)
-        throw std::runtime_error("cycle model: the frame did not finish within " +
-                                 std::to_string(opt.max_cycles) + " cycles");
-      budget = std::min(budget, opt.max_cycles - k.now());
-    }
-    const hw::RunResult r = k.run(done, budget);
-    if (r.status == hw::RunResult::Status::kWatchdog)
-      throw std::runtime_error("cycle model: watchdog at cycle " + std::to_string(r.cycles) +
-                               ": no progress for " + std::to_string(p.watchdog) + " cycles\n" +
-                               thread_report(threads, p) + "\n" + r.report);
-    if (opt.interval != 0) {
-      const Snapshot now = snapshot(k, chip);
-      if (now.cycle > last.cycle) out.series.push_back(figures(last, now, p.clock_mhz));
-      last = now;
-    }
-    if (opt.progress)
-      opt.progress(k.now(), static_cast<int>(chip.packets_retired()), threads.packets());
-  }
-}
-
-// Queues the host's upload (refused here when it writes what the frame reads) and runs the frame
-// until it or the upload is done, whichever comes first. Returns true when the upload is not.
-template <class F, int kLanes>
-bool start_upload(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads,
-                  const CycleParams& p, const CycleRunOptions& opt, const memif::HostUpload& upload,
-                  CycleFrame& out) {
-  memif::HostBus& host = chip.memory().host();
-  host.upload(upload);
-  out.upload_bytes = upload.bytes();
-  simulate(k, chip, threads, p, opt, out, [&] { return chip.finished() || host.stored(); });
-  if (!host.stored()) return true;
-  out.upload_cycles = k.now();
-  return false;
-}
-
-// The frame is done and its upload is not: the bus goes on alone until its last word is stored
-// (the next frame cannot start before). A slow bus may wait longer than the watchdog's span for
-// its next burst's credit, so the watchdog allows that wait.
-void finish_upload(hw::Kernel& k, Chip& chip, const CycleParams& p, CycleFrame& out) {
-  const memif::HostBus& host = chip.memory().host();
-  const double burst_cycles =
-      4.0 * p.hostbus_burst_words * p.clock_mhz * 1e6 / (p.hostbus_mb_s * 1048576.0);
-  k.config().watchdog_cycles =
-      std::max<std::uint64_t>(p.watchdog, static_cast<std::uint64_t>(2.0 * burst_cycles) + 16);
-  const hw::RunResult r = k.run([&] { return host.stored(); });
-  if (r.status != hw::RunResult::Status::kDone)
-    throw std::runtime_error("cycle model: the host upload stopped at cycle " +
-                             std::to_string(r.cycles) + "\n" + r.report);
-  out.upload_cycles = k.now();
-}
-
-// Per pipeline and in total: packets, unit issue and stall cycles, requests, cache counts.
-void collect_units(const hw::Kernel& k, Chip& chip, const Snapshot& end, CycleFrame& out) {
-  std::uint64_t served = 0;
-  out.per_pipeline.resize(static_cast<std::size_t>(chip.pipelines()));
-  for (int pi = 0; pi < chip.pipelines(); ++pi) {
-    DynRtp& d = chip.pipeline(pi);
-    CycleFrame::PipelineCount& pc = out.per_pipeline[static_cast<std::size_t>(pi)];
-    pc.packets = d.rgs().packets_admitted();
-    served += d.rgs().requests_served();
-    for (int i = 0; i < kTable4Units; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      CycleUnit& u = d.unit(kTable4Unit[i]);
-      pc.issue_cycles[ui] = u.issue_cycles();
-      out.issue_cycles[ui] += u.issue_cycles();
-      out.stall_cycles[ui] += k.stats().get_counter(u.name() + ".stall_cycles").value;
-      out.requests[ui] += u.requests_served();
-    }
-    for (int c = 0; c < kCacheUnits; ++c) {
-      const memif::Cache& cache = chip.memory().cache(pi, kCacheItem[c]);
-      auto& cc = out.caches[static_cast<std::size_t>(c)];
-      cc.requests += cache.requests_count();
-      cc.hits += cache.hits();
-      cc.misses += cache.misses();
-      cc.merges += cache.merges();
-    }
-  }
-  for (std::uint64_t r : out.requests)
-    served += r;
-  out.frame.units.requests = served;
-  out.frame.units.packets = out.packets;
-  for (int c = 0; c < kCacheUnits; ++c)
-    out.caches[static_cast<std::size_t>(c)].mem_bytes = end.bytes[static_cast<std::size_t>(c)];
-}
-
-// The frame's rays, rates and SIMD efficiency at the modelled clock.
-void frame_rates(const CycleParams& p, CycleFrame& out) {
-  for (int kd = 0; kd < kRayKinds; ++kd) {
-    out.rays += out.frame.rays_issued[static_cast<std::size_t>(kd)];
-    out.per_ray_sum += out.frame.by_kind[static_cast<std::size_t>(kd)];
-  }
-  const double seconds = static_cast<double>(out.cycles) / (p.clock_mhz * 1e6);
-  out.fps = seconds > 0 ? 1.0 / seconds : 0.0;
-  out.rays_per_s = seconds > 0 ? static_cast<double>(out.rays) / seconds : 0.0;
-  const std::uint64_t steps = out.frame.units.traversal_steps;
-  out.simd_efficiency = steps == 0 ? 0.0
-                                   : static_cast<double>(out.per_ray_sum.traversal_steps) /
-                                         static_cast<double>(steps) / p.packet;
-}
-
-// The parameters, the options and the image's frame buffer, before anything is built.
-void check_run(const memif::MemoryImage& image, const CycleParams& p, const CycleRunOptions& opt) {
-  check_cycle_params(p);
-  check_frame_buffer(image);
-  if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
-    throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
-                             std::to_string(opt.ahead_packets) + ")");
-}
-
-// The frame as the RGS left it: the image read back from the bank it wrote, and its traffic.
-void collect_rgs(const memif::MemoryImage& image, int bank, const Snapshot& end, CycleFrame& out) {
-  read_frame_buffer(image, bank, out);
-  out.shading_bytes = end.shading_bytes;
-  out.frame_bytes = end.frame_bytes;
-  const double pixels = static_cast<double>(out.frame.width) * out.frame.height;
-  out.shading_bytes_per_pixel =
-      pixels > 0 ? static_cast<double>(end.shading_bytes + end.frame_bytes) / pixels : 0.0;
-}
-
-template <class F, int kLanes>
-CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
-                            const CycleRunOptions& opt, const memif::HostUpload* upload) {
-  const auto t0 = std::chrono::steady_clock::now();
-  check_run(image_in, p, opt);
-  // The chip's memory. Without an upload, a copy: the RGS writes its frame-buffer bank and the
-  // caller's image stays unchanged (several runs may share it, as a sweep's points do). With one,
-  // the caller's image (run_cycle's mutable overload): the upload's words and the frame's pixels
-  // stay in it for the next frame.
-  std::optional<memif::MemoryImage> copy;
-  if (upload == nullptr) copy.emplace(image_in);
-  memif::MemoryImage& image = copy ? *copy : const_cast<memif::MemoryImage&>(image_in);
-  // The bank this frame is written into (an upload brings the next frame's registers).
-  const int frame_bank = static_cast<int>(image.registers().frame_bank);
-  RecordedThreads<F, kLanes> threads(image, functional_params(p, opt.shading),
-                                     p.pipelines * p.threads, opt.programs, opt.ahead_packets,
-                                     opt.trace);
-  hw::KernelConfig kc;
-  kc.watchdog_cycles = p.watchdog;
-  kc.shuffle_seed = opt.shuffle_seed;
-  kc.idle_skip = opt.idle_skip;
-  hw::Kernel k(kc);
-  Chip chip(k, image, p, threads);
-  if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
-  std::unique_ptr<RunTracer> tracer;
-  if (opt.trace.any()) {
-    tracer = std::make_unique<RunTracer>(opt.trace, threads, p.threads);
-    chip.observe(tracer.get());
-  }
-
-  CycleFrame out;
-  out.params = p;
-  out.packets = static_cast<std::uint64_t>(threads.packets());
-  const Snapshot start = snapshot(k, chip);
-  const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
-  simulate(k, chip, threads, p, opt, out);
-  if (opt.vcd != nullptr) k.finish_trace();
-  if (tracer) tracer->finish();
-  const Snapshot end = snapshot(k, chip);
-  out.cycles = k.now();
-  if (uploading) finish_upload(k, chip, p, out);
-
-  threads.finish();
-  collect(out.frame, threads);
-  collect_rgs(image, frame_bank, end, out);
-  out.figures = figures(start, end, p.clock_mhz);
-  collect_units(k, chip, end, out);
-  frame_rates(p, out);
-  out.packets_retired = chip.packets_retired();
-  out.skipped_cycles = k.skipped_cycles();
-  out.host_threads = opt.programs == ProgramMode::kAhead ? 2 : 1;
-  out.programs = opt.programs;
-  out.module_evaluations = k.module_evaluations();
-  out.stats_json = k.stats().json();
-  out.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.frame.seconds = out.host_seconds;
-  out.sim_cycles_per_s =
-      out.host_seconds > 0 ? static_cast<double>(out.cycles) / out.host_seconds : 0.0;
-  return out;
-}
-
 }  // namespace
 
 FunctionalParams functional_params(const CycleParams& p, FunctionalParams shading) {
@@ -470,6 +46,85 @@ FunctionalParams functional_params(const CycleParams& p, FunctionalParams shadin
   shading.clip_faces_per_step = p.clip_faces_per_step;
   shading.shared_origin = p.shared_origin;
   return shading;
+}
+
+namespace {
+
+// Figure 2's units, each over its pipeline's cache (the RGS over its memory ports).
+CycleUnit& make_rgs(const UnitContext& c) {
+  const int pipe = c.pipeline;
+  const RgsPorts ports{&c.memory.shading_port(pipe), &c.memory.frame_port(pipe),
+                       c.memory.shading_client(pipe), c.memory.frame_client(pipe)};
+  return c.kernel.make<RaySource>(c.name, c.threads, c.params.rgs_depth, c.rgc, pipe,
+                                  static_cast<ThreadToken>(pipe * c.params.threads),
+                                  c.params.threads, ports);
+}
+CycleUnit& make_traversal(const UnitContext& c) {
+  return c.kernel.make<TraversalUnit>(c.name, c.threads, c.params.traversal_depth(),
+                                      c.memory.cache(c.pipeline, memif::ItemType::kNode));
+}
+CycleUnit& make_list(const UnitContext& c) {
+  return c.kernel.make<ListUnit>(c.name, c.threads, c.params.list_depth(),
+                                 c.memory.cache(c.pipeline, memif::ItemType::kList));
+}
+CycleUnit& make_transformation(const UnitContext& c) {
+  return c.kernel.make<TransformationUnit>(c.name, c.threads, c.params.transformation_depth(),
+                                           c.memory.cache(c.pipeline, memif::ItemType::kRow));
+}
+CycleUnit& make_intersection(const UnitContext& c) {
+  return c.kernel.make<IntersectionUnit>(c.name, c.threads, c.params.intersection_depth());
+}
+
+}  // namespace
+
+// Input priorities (D25): in-flight work before new rays; a unit's own loop first. Only the
+// hand-overs the thread program can make are listed.
+std::vector<UnitSpec> dynrtc_units() {
+  using U = UnitId;
+  return {
+      // The RGS: g, the end of a list or an intersection, shadow-ray generation.
+      {U::kRgs, {U::kTraversal, U::kList, U::kIntersection, U::kTransformation, U::kRgs}, make_rgs},
+      // Traversal: loop (next node, pop), f, end of a leaf's list, shadow rays, b.
+      {U::kTraversal,
+       {U::kTraversal, U::kIntersection, U::kList, U::kRgs, U::kTransformation},
+       make_traversal},
+      // List: loop (mailbox skip), after an intersection, c.
+      {U::kList, {U::kList, U::kIntersection, U::kTraversal}, make_list},
+      // Transformation: d before a (D25).
+      {U::kTransformation, {U::kList, U::kRgs}, make_transformation},
+      // Intersection: e.
+      {U::kIntersection, {U::kTransformation}, make_intersection},
+  };
+}
+
+// The units in the order given, then the paths between every two (by unit id), then each unit's
+// inputs in its priority order. Thread-id queues hold every thread of the pipeline: a full path can
+// never hold a unit (deadlock freedom by construction); the priorities decide only the order.
+DynRtp::DynRtp(hw::Kernel& k, memif::MemorySystem& mi, const CycleParams& p, ThreadTable& threads,
+               RayGenerationController& rgc, int pipeline, const std::vector<UnitSpec>& units) {
+  const std::string pre = "dynrtp" + std::to_string(pipeline) + ".";
+  std::array<const UnitSpec*, kMaxUnits> spec{};
+  for (const UnitSpec& s : units) {
+    const auto i = static_cast<std::size_t>(unit_index(s.id));
+    if (s.id == UnitId::kNone || i >= spec.size() || spec[i] != nullptr)
+      throw std::logic_error("DynRTP: unit id " + std::to_string(i) + " is kNone or given twice");
+    spec[i] = &s;
+    units_[i] = &s.make({k, mi, p, threads, rgc, pipeline, pre + unit_name(s.id)});
+  }
+  rgs_ = dynamic_cast<RaySource*>(units_[static_cast<std::size_t>(unit_index(UnitId::kRgs))]);
+  if (rgs_ == nullptr) throw std::logic_error("DynRTP: no ray source (UnitId::kRgs)");
+  const int capacity = p.threads + 1;
+  for (std::size_t from = 0; from < spec.size(); ++from)
+    for (std::size_t to = 0; to < spec.size(); ++to) {
+      if (spec[from] == nullptr || spec[to] == nullptr) continue;
+      const UnitId f = spec[from]->id, t = spec[to]->id;
+      paths_[from][to] = &k.make_channel<ThreadToken>(pre + path_name(f, t), capacity, 1);
+      units_[from]->set_output(t, paths_[from][to]);
+    }
+  for (std::size_t to = 0; to < spec.size(); ++to)
+    if (spec[to] != nullptr)
+      for (UnitId from : spec[to]->inputs)
+        units_[to]->add_input(paths_[static_cast<std::size_t>(unit_index(from))][to]);
 }
 
 // The CycleParams as the memory system's parameters (every memif knob of the table).
@@ -512,40 +167,6 @@ const char* program_mode_name(ProgramMode m) {
       return "ahead";
   }
   return "?";
-}
-
-namespace {
-
-CycleFrame run_cycle_image(const memif::MemoryImage& image, const CycleParams& params,
-                           const CycleRunOptions& options, const memif::HostUpload* upload) {
-  // The prototype's P = 4 gets thread programs with 4-lane packet arrays (ThreadProgram's
-  // kLanes); wider packets the full 64.
-  if (image.format() == ff::kFp24) {
-    if (params.packet <= 4)
-      return run_cycle_format<ff::Float<7, 16>, 4>(image, params, options, upload);
-    return run_cycle_format<ff::Float<7, 16>, kMaxPacket>(image, params, options, upload);
-  }
-  // The widest format with fp24's exponent, for the width study (docs/cycle-model.md, "Datapath
-  // width"): 31-bit values, a matrix row in four words instead of three.
-  if (image.format() == ff::Format{7, 23}) {
-    if (params.packet <= 4)
-      return run_cycle_format<ff::Float<7, 23>, 4>(image, params, options, upload);
-    return run_cycle_format<ff::Float<7, 23>, kMaxPacket>(image, params, options, upload);
-  }
-  throw std::runtime_error("cycle model: the image is in " + ff::format_name(image.format()) +
-                           "; the cycle model is built for fp24 (e7m16) and e7m23");
-}
-
-}  // namespace
-
-CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
-                     const CycleRunOptions& options) {
-  return run_cycle_image(image, params, options, nullptr);
-}
-
-CycleFrame run_cycle(memif::MemoryImage& image, const CycleParams& params,
-                     const CycleRunOptions& options, const memif::HostUpload& upload) {
-  return run_cycle_image(image, params, options, &upload);
 }
 
 }  // namespace saarcor::units

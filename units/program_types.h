@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "fixedfloat/float.h"
@@ -80,7 +81,9 @@ inline const char* ray_kind_name(RayKind k) {
   return kNames[static_cast<int>(k)];
 }
 
-// The hardware units of one DynRTP a thread may ask for.
+// The hardware units of one DynRTP a thread may ask for: the five of Figure 2, then kNone (no unit:
+// the thread is done). A unit added to the model takes an id after kNone from add_unit() below
+// (README "adding a unit").
 enum class UnitId : std::uint8_t {
   kRgs,
   kTransformation,
@@ -89,14 +92,11 @@ enum class UnitId : std::uint8_t {
   kIntersection,
   kNone,
 };
-inline constexpr int kUnitNames = 6;  // UnitId values, kNone included
-inline const char* unit_name(UnitId u) {
-  constexpr const char* kNames[] = {"rgs",  "transformation", "traversal",
-                                    "list", "intersection",   "none"};
-  return kNames[static_cast<int>(u)];
-}
+// Unit ids: Figure 2's five, kNone and the added units (the slots of a DynRTP's unit arrays).
+inline constexpr int kMaxUnits = 8;
 
-// The states of the thread program. Each names the unit that serves it.
+// The states of the thread program. Each names the unit that serves it. A unit added to the model
+// serves phases numbered after kDone (add_unit()).
 enum class Phase : std::uint8_t {
   kGenerate,           // transformation (path a): R' through the RGS's T into world rays
   kClipTop,            // traversal: one face of the scene box (6 steps, D29)
@@ -111,13 +111,36 @@ enum class Phase : std::uint8_t {
   kShadeShadow,        // RGS: shadow-ray results of one light
   kDone,
 };
-inline constexpr int kPhaseNames = 12;  // Phase values, kDone included
+inline constexpr int kMaxPhases = 32;  // Phase values: the thread program's, kDone, the added ones
+
+// A unit added to the DynRTP beyond Figure 2's five: its id and the phases it serves, numbered
+// from `first_phase` in the order add_unit() was given their names.
+struct AddedUnit {
+  UnitId id = UnitId::kNone;
+  Phase first_phase = Phase::kDone;
+  Phase phase(int k) const { return static_cast<Phase>(static_cast<int>(first_phase) + k); }
+};
+// Registers an added unit under `name` with the names of the phases it serves; from then on
+// unit_name, phase_name and phase_unit know them. Throws std::logic_error when a name is taken or
+// the ids (kMaxUnits) or phases (kMaxPhases) are used up. Register before any run starts (a
+// test's or a tool's start); the lookups below may then be called from any thread.
+AddedUnit add_unit(const std::string& name, const std::vector<std::string>& phases);
+// The added units' names and phases ("?" and kNone for a value nobody registered).
+const char* added_unit_name(UnitId u);
+const char* added_phase_name(Phase p);
+UnitId added_phase_unit(Phase p);
+
+inline const char* unit_name(UnitId u) {
+  constexpr const char* kNames[] = {"rgs",  "transformation", "traversal",
+                                    "list", "intersection",   "none"};
+  return u <= UnitId::kNone ? kNames[static_cast<int>(u)] : added_unit_name(u);
+}
 inline const char* phase_name(Phase p) {
   constexpr const char* kNames[] = {
       "generate",         "clip_top",    "traverse",           "list",
       "transform_object", "clip_bottom", "transform_triangle", "intersect",
       "shade_surface",    "shade_light", "shade_shadow",       "done"};
-  return kNames[static_cast<int>(p)];
+  return p <= Phase::kDone ? kNames[static_cast<int>(p)] : added_phase_name(p);
 }
 inline UnitId phase_unit(Phase p) {
   switch (p) {
@@ -140,7 +163,7 @@ inline UnitId phase_unit(Phase p) {
     case Phase::kDone:
       return UnitId::kNone;
   }
-  return UnitId::kNone;
+  return added_phase_unit(p);
 }
 
 // What the thread asks of a unit next: enough for a cycle model to fetch the item through the

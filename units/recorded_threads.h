@@ -1,6 +1,7 @@
 // The thread table of the cycle model: one thread program per simulated thread, or programs
 // recorded per packet and replayed (docs/cycle-model.md "Programs ahead of the simulation"):
-// the record/replay machinery, apart from the DynRTP's assembly (units/dynrtp.cpp).
+// the record/replay machinery, apart from the DynRTP's assembly (units/dynrtp.cpp) and the chip
+// that clocks it (testbench/chip.cpp).
 #pragma once
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "units/dynrtp.h"
 #include "units/functional_model.h"
 #include "units/request_trace.h"
+#include "units/run_trace.h"
 #include "units/thread_program.h"
 
 namespace saarcor::units {

@@ -63,8 +63,8 @@ std::uint64_t number(const std::string& text, const std::string& field, int base
 
 template <class E>
 E name_of(const std::string& text, const std::string& field, int count, const char* (*name)(E)) {
-  for (int i = 0; i < count; ++i)
-    if (field == name(static_cast<E>(i))) return static_cast<E>(i);
+  for (int i = 0; i < count; ++i)  // ("?": an id no added unit took)
+    if (field != "?" && field == name(static_cast<E>(i))) return static_cast<E>(i);
   bad(text, "unknown name '" + field + "'");
 }
 
@@ -83,8 +83,8 @@ TraceLine parse_trace_line(const std::string& text) {
   l.thread = f[2] == "-" ? -1 : static_cast<int>(number(text, f[2]));
   l.packet = static_cast<int>(number(text, f[3]));
   l.seq = static_cast<std::uint32_t>(number(text, f[4]));
-  l.unit = name_of<UnitId>(text, f[5], kUnitNames, unit_name);
-  l.phase = name_of<Phase>(text, f[6], kPhaseNames, phase_name);
+  l.unit = name_of<UnitId>(text, f[5], kMaxUnits, unit_name);
+  l.phase = name_of<Phase>(text, f[6], kMaxPhases, phase_name);
   l.item = f[7] == "-" ? memif::kNone : static_cast<std::uint32_t>(number(text, f[7]));
   l.steps = static_cast<int>(number(text, f[8]));
   l.mask = number(text, f[9], 16);

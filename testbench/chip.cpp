@@ -1,0 +1,366 @@
+// The chip of Figure 2 instantiated and clocked (DESIGN.md section 2: testbench/ "instantiates the
+// chip and clocks it"; docs/cycle-model.md): the RGC, the DynRTPs of units/dynrtp.h and the
+// memory system they share, the frame loop, the figures it samples (units/figures.h), and the
+// frame with the host's upload beside it.
+#include "testbench/chip.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "hw/kernel.h"
+#include "memif/memory_system.h"
+#include "units/dynrtc_units.h"
+#include "units/dynrtp.h"
+#include "units/recorded_threads.h"
+
+namespace saarcor {
+// The chip is built from units/ only (this file's one using-directive).
+using namespace units;
+namespace {
+
+template <class F, int kLanes>
+void collect(FunctionalFrame& frame, RecordedThreads<F, kLanes>& threads) {
+  frame.format = F::kFormat;
+  frame.width = threads.sink().width;
+  frame.height = threads.sink().height;
+  frame.params = threads.params();
+  collect_frame(frame, threads.units(), threads.sink());
+}
+
+constexpr memif::ItemType kCacheItem[kCacheUnits] = {memif::ItemType::kNode, memif::ItemType::kList,
+                                                     memif::ItemType::kRow};
+constexpr UnitId kTable4Unit[kTable4Units] = {UnitId::kTraversal, UnitId::kList,
+                                              UnitId::kTransformation, UnitId::kIntersection};
+
+// The frame buffer: one word per pixel from word 0 of the back bank (FrameRegisters::frame_bank).
+void check_frame_buffer(const memif::MemoryImage& image) {
+  const auto& r = image.registers();
+  if (r.frame_bank != memif::kFrameBank0 && r.frame_bank != memif::kFrameBank1)
+    throw std::runtime_error("cycle model: frame_bank " + std::to_string(r.frame_bank) +
+                             " is not a frame-buffer bank (0 or 1)");
+  const std::uint64_t words = std::uint64_t{r.width} * r.height;
+  if (words > image.bank_words())
+    throw std::runtime_error("cycle model: a " + std::to_string(r.width) + "x" +
+                             std::to_string(r.height) + " frame needs " + std::to_string(words) +
+                             " frame-buffer words, a bank holds " +
+                             std::to_string(image.bank_words()) + " (raise --bank-mb)");
+}
+
+// The frame's image as the hardware left it: the words the RGS wrote into the back bank.
+void read_frame_buffer(const memif::MemoryImage& image, int bank, CycleFrame& out) {
+  const std::vector<std::uint32_t>& fb = image.bank(bank);
+  auto& rgb = out.frame.rgb;
+  rgb.resize(out.frame.pixels.size() * 3u);
+  for (std::size_t i = 0; i < out.frame.pixels.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k)
+      rgb[3 * i + k] = static_cast<std::uint8_t>((fb[i] >> (8 * k)) & 255u);
+  out.frame_bank = bank;
+}
+
+// The chip of Figure 2: the RGC, `pipelines` DynRTPs and the memory interface they share.
+class Chip {
+ public:
+  Chip(hw::Kernel& k, memif::MemoryImage& image, const CycleParams& p, ThreadTable& threads)
+      : mi_(k, image, memory_system_config(p)), rgc_(threads.packets(), p.pipelines) {
+    for (int i = 0; i < p.pipelines; ++i)
+      pipes_.push_back(std::make_unique<DynRtp>(k, mi_, p, threads, rgc_, i));
+  }
+
+  // Every packet handed out, every thread free again and the last pixels written into the frame
+  // buffer (checked between cycles).
+  bool finished() const {
+    if (!rgc_.all_handed_out()) return false;
+    for (const auto& d : pipes_)
+      if (!d->rgs().idle()) return false;
+    return mi_.frame_writes_stored();
+  }
+  std::uint64_t packets_retired() const {
+    std::uint64_t n = 0;
+    for (const auto& d : pipes_)
+      n += d->rgs().packets_retired();
+    return n;
+  }
+  int pipelines() const { return static_cast<int>(pipes_.size()); }
+  DynRtp& pipeline(int i) { return *pipes_[static_cast<std::size_t>(i)]; }
+  void observe(UnitObserver* o) {
+    for (auto& d : pipes_)
+      d->observe(o);
+  }
+  memif::MemorySystem& memory() { return mi_; }
+
+ private:
+  memif::MemorySystem mi_;
+  RayGenerationController rgc_;
+  std::vector<std::unique_ptr<DynRtp>> pipes_;
+};
+
+// The counts the figures are computed from (units/figures.h), summed over the DynRTPs.
+FigureCounts snapshot(hw::Kernel& k, Chip& chip) {
+  FigureCounts s;
+  s.cycle = k.now();
+  s.pipelines = chip.pipelines();
+  for (int p = 0; p < chip.pipelines(); ++p) {
+    DynRtp& d = chip.pipeline(p);
+    for (int i = 0; i < kTable4Units; ++i)
+      s.issued[static_cast<std::size_t>(i)] += d.unit(kTable4Unit[i]).issue_cycles();
+    for (int c = 0; c < kCacheUnits; ++c) {
+      const memif::Cache& cache = chip.memory().cache(p, kCacheItem[c]);
+      s.requests[static_cast<std::size_t>(c)] += cache.requests_count();
+      s.hits[static_cast<std::size_t>(c)] += cache.hits() + cache.merges();
+      s.bytes[static_cast<std::size_t>(c)] +=
+          k.stats().get_counter(cache.name() + ".mem_bytes").value;
+    }
+    const std::string pre = "dynrtp" + std::to_string(p) + ".";
+    s.shading_bytes += k.stats().get_counter(pre + "shading.mem_bytes").value;
+    s.frame_bytes += k.stats().get_counter(pre + "frame.mem_bytes").value;
+  }
+  return s;
+}
+
+// With several DynRTPs each thread also names its pipeline (thread t is pipeline t / threads').
+template <class F, int kLanes>
+std::string thread_report(RecordedThreads<F, kLanes>& threads, const CycleParams& p) {
+  std::ostringstream s;
+  s << "threads (id: unit, phase, item, rays):";
+  for (int t = 0; t < threads.size(); ++t) {
+    const Request r = threads.request(static_cast<std::uint32_t>(t));
+    if (r.unit == UnitId::kNone) continue;
+    s << "\n  thread " << t;
+    if (p.pipelines > 1) s << " (dynrtp" << t / p.threads << ")";
+    s << ": " << unit_name(r.unit) << ", " << phase_name(r.phase);
+    if (r.item != memif::kNone) s << ", item " << r.item;
+    s << ", mask 0x" << std::hex << threads.mask(static_cast<std::uint32_t>(t)) << std::dec;
+  }
+  return s.str();
+}
+
+// Runs the kernel until `done` (by default: the chip has retired every packet), sampling the
+// figures every opt.interval cycles into out.series and reporting progress.
+template <class F, int kLanes>
+void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, const CycleParams& p,
+              const CycleRunOptions& opt, CycleFrame& out, std::function<bool()> done = {}) {
+  if (!done) done = [&] { return chip.finished(); };
+  const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
+  FigureCounts last = snapshot(k, chip);
+  while (!done()) {
+    std::uint64_t budget = chunk;
+    if (opt.max_cycles != 0) {
+      if (k.now() >= opt.max_cycles)
+        throw std::runtime_error("cycle model: the frame did not finish within " +
+                                 std::to_string(opt.max_cycles) + " cycles");
+      budget = std::min(budget, opt.max_cycles - k.now());
+    }
+    const hw::RunResult r = k.run(done, budget);
+    if (r.status == hw::RunResult::Status::kWatchdog)
+      throw std::runtime_error("cycle model: watchdog at cycle " + std::to_string(r.cycles) +
+                               ": no progress for " + std::to_string(p.watchdog) + " cycles\n" +
+                               thread_report(threads, p) + "\n" + r.report);
+    if (opt.interval != 0) {
+      const FigureCounts now = snapshot(k, chip);
+      if (now.cycle > last.cycle) out.series.push_back(compute_figures(last, now, p.clock_mhz));
+      last = now;
+    }
+    if (opt.progress)
+      opt.progress(k.now(), static_cast<int>(chip.packets_retired()), threads.packets());
+  }
+}
+
+// Queues the host's upload (refused here when it writes what the frame reads) and runs the frame
+// until it or the upload is done, whichever comes first. Returns true when the upload is not.
+template <class F, int kLanes>
+bool start_upload(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads,
+                  const CycleParams& p, const CycleRunOptions& opt, const memif::HostUpload& upload,
+                  CycleFrame& out) {
+  memif::HostBus& host = chip.memory().host();
+  host.upload(upload);
+  out.upload_bytes = upload.bytes();
+  simulate(k, chip, threads, p, opt, out, [&] { return chip.finished() || host.stored(); });
+  if (!host.stored()) return true;
+  out.upload_cycles = k.now();
+  return false;
+}
+
+// The frame is done and its upload is not: the bus goes on alone until its last word is stored
+// (the next frame cannot start before). A slow bus may wait longer than the watchdog's span for
+// its next burst's credit, so the watchdog allows that wait.
+void finish_upload(hw::Kernel& k, Chip& chip, const CycleParams& p, CycleFrame& out) {
+  const memif::HostBus& host = chip.memory().host();
+  const double burst_cycles =
+      4.0 * p.hostbus_burst_words * p.clock_mhz * 1e6 / (p.hostbus_mb_s * 1048576.0);
+  k.config().watchdog_cycles =
+      std::max<std::uint64_t>(p.watchdog, static_cast<std::uint64_t>(2.0 * burst_cycles) + 16);
+  const hw::RunResult r = k.run([&] { return host.stored(); });
+  if (r.status != hw::RunResult::Status::kDone)
+    throw std::runtime_error("cycle model: the host upload stopped at cycle " +
+                             std::to_string(r.cycles) + "\n" + r.report);
+  out.upload_cycles = k.now();
+}
+
+// Per pipeline and in total: packets, unit issue and stall cycles, requests, cache counts.
+void collect_units(const hw::Kernel& k, Chip& chip, const FigureCounts& end, CycleFrame& out) {
+  std::uint64_t served = 0;
+  out.per_pipeline.resize(static_cast<std::size_t>(chip.pipelines()));
+  for (int pi = 0; pi < chip.pipelines(); ++pi) {
+    DynRtp& d = chip.pipeline(pi);
+    CycleFrame::PipelineCount& pc = out.per_pipeline[static_cast<std::size_t>(pi)];
+    pc.packets = d.rgs().packets_admitted();
+    served += d.rgs().requests_served();
+    for (int i = 0; i < kTable4Units; ++i) {
+      const auto ui = static_cast<std::size_t>(i);
+      CycleUnit& u = d.unit(kTable4Unit[i]);
+      pc.issue_cycles[ui] = u.issue_cycles();
+      out.issue_cycles[ui] += u.issue_cycles();
+      out.stall_cycles[ui] += k.stats().get_counter(u.name() + ".stall_cycles").value;
+      out.requests[ui] += u.requests_served();
+    }
+    for (int c = 0; c < kCacheUnits; ++c) {
+      const memif::Cache& cache = chip.memory().cache(pi, kCacheItem[c]);
+      auto& cc = out.caches[static_cast<std::size_t>(c)];
+      cc.requests += cache.requests_count();
+      cc.hits += cache.hits();
+      cc.misses += cache.misses();
+      cc.merges += cache.merges();
+    }
+  }
+  for (std::uint64_t r : out.requests)
+    served += r;
+  out.frame.units.requests = served;
+  out.frame.units.packets = out.packets;
+  for (int c = 0; c < kCacheUnits; ++c)
+    out.caches[static_cast<std::size_t>(c)].mem_bytes = end.bytes[static_cast<std::size_t>(c)];
+}
+
+// The frame's rays, rates and SIMD efficiency at the modelled clock.
+void frame_rates(const CycleParams& p, CycleFrame& out) {
+  for (int kd = 0; kd < kRayKinds; ++kd) {
+    out.rays += out.frame.rays_issued[static_cast<std::size_t>(kd)];
+    out.per_ray_sum += out.frame.by_kind[static_cast<std::size_t>(kd)];
+  }
+  const double seconds = static_cast<double>(out.cycles) / (p.clock_mhz * 1e6);
+  out.fps = seconds > 0 ? 1.0 / seconds : 0.0;
+  out.rays_per_s = seconds > 0 ? static_cast<double>(out.rays) / seconds : 0.0;
+  const std::uint64_t steps = out.frame.units.traversal_steps;
+  out.simd_efficiency = steps == 0 ? 0.0
+                                   : static_cast<double>(out.per_ray_sum.traversal_steps) /
+                                         static_cast<double>(steps) / p.packet;
+}
+
+// The parameters, the options and the image's frame buffer, before anything is built.
+void check_run(const memif::MemoryImage& image, const CycleParams& p, const CycleRunOptions& opt) {
+  check_cycle_params(p);
+  check_frame_buffer(image);
+  if (opt.programs == ProgramMode::kAhead && opt.ahead_packets < 1)
+    throw std::runtime_error("cycle model: ahead_packets must be >= 1 (got " +
+                             std::to_string(opt.ahead_packets) + ")");
+}
+
+// The frame as the RGS left it: the image read back from the bank it wrote, and its traffic.
+void collect_rgs(const memif::MemoryImage& image, int bank, const FigureCounts& end,
+                 CycleFrame& out) {
+  read_frame_buffer(image, bank, out);
+  out.shading_bytes = end.shading_bytes;
+  out.frame_bytes = end.frame_bytes;
+  const double pixels = static_cast<double>(out.frame.width) * out.frame.height;
+  out.shading_bytes_per_pixel =
+      pixels > 0 ? static_cast<double>(end.shading_bytes + end.frame_bytes) / pixels : 0.0;
+}
+
+template <class F, int kLanes>
+CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
+                            const CycleRunOptions& opt, const memif::HostUpload* upload) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_run(image_in, p, opt);
+  // The chip's memory. Without an upload, a copy: the RGS writes its frame-buffer bank and the
+  // caller's image stays unchanged (several runs may share it, as a sweep's points do). With one,
+  // the caller's image (run_cycle's mutable overload): the upload's words and the frame's pixels
+  // stay in it for the next frame.
+  std::optional<memif::MemoryImage> copy;
+  if (upload == nullptr) copy.emplace(image_in);
+  memif::MemoryImage& image = copy ? *copy : const_cast<memif::MemoryImage&>(image_in);
+  // The bank this frame is written into (an upload brings the next frame's registers).
+  const int frame_bank = static_cast<int>(image.registers().frame_bank);
+  RecordedThreads<F, kLanes> threads(image, functional_params(p, opt.shading),
+                                     p.pipelines * p.threads, opt.programs, opt.ahead_packets,
+                                     opt.trace);
+  hw::KernelConfig kc;
+  kc.watchdog_cycles = p.watchdog;
+  kc.shuffle_seed = opt.shuffle_seed;
+  kc.idle_skip = opt.idle_skip;
+  hw::Kernel k(kc);
+  Chip chip(k, image, p, threads);
+  if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
+  std::unique_ptr<RunTracer> tracer;
+  if (opt.trace.any()) {
+    tracer = std::make_unique<RunTracer>(opt.trace, threads, p.threads);
+    chip.observe(tracer.get());
+  }
+
+  CycleFrame out;
+  out.params = p;
+  out.packets = static_cast<std::uint64_t>(threads.packets());
+  const FigureCounts start = snapshot(k, chip);
+  const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
+  simulate(k, chip, threads, p, opt, out);
+  if (opt.vcd != nullptr) k.finish_trace();
+  if (tracer) tracer->finish();
+  const FigureCounts end = snapshot(k, chip);
+  out.cycles = k.now();
+  if (uploading) finish_upload(k, chip, p, out);
+
+  threads.finish();
+  collect(out.frame, threads);
+  collect_rgs(image, frame_bank, end, out);
+  out.figures = compute_figures(start, end, p.clock_mhz);
+  collect_units(k, chip, end, out);
+  frame_rates(p, out);
+  out.packets_retired = chip.packets_retired();
+  out.skipped_cycles = k.skipped_cycles();
+  out.host_threads = opt.programs == ProgramMode::kAhead ? 2 : 1;
+  out.programs = opt.programs;
+  out.module_evaluations = k.module_evaluations();
+  out.stats_json = k.stats().json();
+  out.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.frame.seconds = out.host_seconds;
+  out.sim_cycles_per_s =
+      out.host_seconds > 0 ? static_cast<double>(out.cycles) / out.host_seconds : 0.0;
+  return out;
+}
+
+CycleFrame run_cycle_image(const memif::MemoryImage& image, const CycleParams& params,
+                           const CycleRunOptions& options, const memif::HostUpload* upload) {
+  // The prototype's P = 4 gets thread programs with 4-lane packet arrays (ThreadProgram's
+  // kLanes); wider packets the full 64.
+  if (image.format() == ff::kFp24) {
+    if (params.packet <= 4)
+      return run_cycle_format<ff::Float<7, 16>, 4>(image, params, options, upload);
+    return run_cycle_format<ff::Float<7, 16>, kMaxPacket>(image, params, options, upload);
+  }
+  // The widest format with fp24's exponent, for the width study (docs/cycle-model.md, "Datapath
+  // width"): 31-bit values, a matrix row in four words instead of three.
+  if (image.format() == ff::Format{7, 23}) {
+    if (params.packet <= 4)
+      return run_cycle_format<ff::Float<7, 23>, 4>(image, params, options, upload);
+    return run_cycle_format<ff::Float<7, 23>, kMaxPacket>(image, params, options, upload);
+  }
+  throw std::runtime_error("cycle model: the image is in " + ff::format_name(image.format()) +
+                           "; the cycle model is built for fp24 (e7m16) and e7m23");
+}
+
+}  // namespace
+
+CycleFrame run_cycle(const memif::MemoryImage& image, const CycleParams& params,
+                     const CycleRunOptions& options) {
+  return run_cycle_image(image, params, options, nullptr);
+}
+
+CycleFrame run_cycle(memif::MemoryImage& image, const CycleParams& params,
+                     const CycleRunOptions& options, const memif::HostUpload& upload) {
+  return run_cycle_image(image, params, options, &upload);
+}
+
+}  // namespace saarcor
