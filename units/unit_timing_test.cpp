@@ -452,7 +452,8 @@ TEST(UnitTimingRaySource, AdmitsOnePacketPerGrantedCycleAndReadmitsARetiredThrea
   const Request first = generate(kP + 1);  // what a primary packet asks the transformation for
   ScriptedThreads threads(k, {{}, {}}, {first}, packets);
   RayGenerationController rgc(packets, 1);
-  const int rgs_depth = 1;  // units/dynrtp.cpp
+  // Any depth (the chip takes the rgs.depth key): the re-admission below adds it.
+  const int rgs_depth = 1;
   auto& rgs = k.make<RaySource>("t.rgs", threads, rgs_depth, rgc, 0, 0, threads_count);
   RgsNeighbours n(k, rgs);
   Source& src = n.src;
