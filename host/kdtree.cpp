@@ -299,6 +299,14 @@ class Builder {
     const double c = al * (nl == 0 ? 0.0 : kt + ki * nl) + ar * (nr == 0 ? 0.0 : kt + ki * nr);
     return (nl == 0 || nr == 0 ? p_.empty_bonus : 1.0) * inv_area * c;
   }
+  // A plane's cost from the children's half areas and item counts: the SAH's K_T + K_I * (aL nL +
+  // aR nR) / area, or with leaf steps leaf_step_cost; the bonus where a side is empty.
+  double plane_cost(double kt, double al, double ar, std::uint32_t nl, std::uint32_t nr,
+                    double inv_area) const {
+    if (p_.leaf_step) return leaf_step_cost(kt, al, ar, nl, nr, inv_area);
+    const double bonus = nl == 0 || nr == 0 ? p_.empty_bonus : 1.0;
+    return bonus * (kt + p_.intersection_cost * inv_area * (al * nl + ar * nr));
+  }
   void start(std::size_t items);
   void add_item(std::uint32_t id, const float lo[3], const float hi[3]);
   // Grid neighbours of a grid value.
@@ -700,7 +708,6 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
   const double inv_area = 1.0 / area;
   const double kt = node_kt(area);
   const double ki = p_.intersection_cost;
-  const double bonus = p_.empty_bonus;
   // Fewer bins for smaller nodes: the per-node cost is proportional to the bins, the per-item
   // cost is not; the top of the tree, which decides the most, gets the most. On each axis a bin
   // spans at least 4 grid steps (finer candidates would collapse onto the same grid values).
@@ -836,8 +843,7 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
     auto cost_at = [&](double x, std::uint32_t nl, std::uint32_t nr) {
       const double al = (x - lo) * sum + prod;
       const double ar = (hi - x) * sum + prod;
-      if (p_.leaf_step) return leaf_step_cost(kt, al, ar, nl, nr, inv_area);
-      return (nl == 0 || nr == 0 ? bonus : 1.0) * (kt + ki * inv_area * (al * nl + ar * nr));
+      return plane_cost(kt, al, ar, nl, nr, inv_area);
     };
     if (sw.best_j[k] >= 0) {
       // Both children hold items and their half areas add up to d * sum + 2 * prod on every
@@ -1038,14 +1044,14 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
           // One side may be empty: both planar placements with the bonus, exactly.
           const std::uint32_t nl1 = nl + np;
           const std::uint32_t nr2 = nr + np;
-          const double c1 = p_.leaf_step
-                                ? leaf_step_cost(kt, al, ar, nl1, nr, inv_area)
-                                : (nl1 == 0 || nr == 0 ? bonus : 1.0) *
-                                      (kt + ki * (al * inv_area * nl1 + ar * inv_area * nr));
-          const double c2 = p_.leaf_step
-                                ? leaf_step_cost(kt, al, ar, nl, nr2, inv_area)
-                                : (nl == 0 || nr2 == 0 ? bonus : 1.0) *
-                                      (kt + ki * (al * inv_area * nl + ar * inv_area * nr2));
+          // (The plain SAH's products in this order, as the sweep has always rounded them.)
+          auto exact = [&](std::uint32_t l, std::uint32_t r) {
+            if (p_.leaf_step) return leaf_step_cost(kt, al, ar, l, r, inv_area);
+            return (l == 0 || r == 0 ? bonus : 1.0) *
+                   (kt + ki * (al * inv_area * l + ar * inv_area * r));
+          };
+          const double c1 = exact(nl1, nr);
+          const double c2 = exact(nl, nr2);
           if (c1 < best.cost || c2 < best.cost) {
             best = c1 <= c2 ? Split{c1, k, pos, true} : Split{c2, k, pos, false};
             best_m = (best.cost - kt0) / scale;
@@ -1088,10 +1094,7 @@ void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::si
     const double al = (static_cast<double>(x) - lo) * sum + prod;
     const double ar = (static_cast<double>(hi) - x) * sum + prod;
     // The interior side is empty where every item lies in the face.
-    const double cost = p_.leaf_step
-                            ? leaf_step_cost(kt, al, ar, nl, nr, inv_area)
-                            : (nl == 0 || nr == 0 ? p_.empty_bonus : 1.0) *
-                                  (kt + p_.intersection_cost * inv_area * (al * nl + ar * nr));
+    const double cost = plane_cost(kt, al, ar, nl, nr, inv_area);
     if (cost < best.cost) best = Split{cost, k, ordered(x), true, true};
   };
   // Near the low face: left = items with lo < x, right = items with hi > x.
