@@ -533,17 +533,23 @@ inline bool no_nan(std::uint32_t a, std::uint32_t b) {
 }
 template <int E, int M>
 inline bool lt(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  return no_nan<E, M>(a, b) & (order_key<E, M>(a, m.subnormals) < order_key<E, M>(b, m.subnormals));
+  // Both conditions are evaluated and combined with a bitwise AND, as the comparator's two
+  // signals are: no branch on the operands.
+  const bool ordered = no_nan<E, M>(a, b);
+  const bool less = order_key<E, M>(a, m.subnormals) < order_key<E, M>(b, m.subnormals);
+  return ordered & less;
 }
 template <int E, int M>
 inline bool le(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  return no_nan<E, M>(a, b) &
-         (order_key<E, M>(a, m.subnormals) <= order_key<E, M>(b, m.subnormals));
+  const bool ordered = no_nan<E, M>(a, b);
+  const bool less_equal = order_key<E, M>(a, m.subnormals) <= order_key<E, M>(b, m.subnormals);
+  return ordered & less_equal;
 }
 template <int E, int M>
 inline bool eq(std::uint32_t a, std::uint32_t b, const Mode& m) {
-  return no_nan<E, M>(a, b) &
-         (order_key<E, M>(a, m.subnormals) == order_key<E, M>(b, m.subnormals));
+  const bool ordered = no_nan<E, M>(a, b);
+  const bool equal = order_key<E, M>(a, m.subnormals) == order_key<E, M>(b, m.subnormals);
+  return ordered & equal;
 }
 
 // The value a comparator/mux passes on: in flush mode a subnormal operand leaves as signed zero.
