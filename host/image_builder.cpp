@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/tree_objective.h"
+
 namespace saarcor::host {
 
 namespace {
@@ -724,6 +726,10 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
     throw std::runtime_error("top-level item cost factor " +
                              std::to_string(params.top_item_cost_factor) +
                              " must be positive and finite");
+  if (params.tree_objective != static_cast<int>(KdObjective::kSahSum) &&
+      params.tree_objective != static_cast<int>(KdObjective::kBusiestUnit))
+    throw std::runtime_error("kd-tree objective " + std::to_string(params.tree_objective) +
+                             " must be 0 (SAH sum) or 1 (busiest unit)");
   if (params.top_level_buffers != 1 && params.top_level_buffers != 2)
     throw std::runtime_error("top-level copies " + std::to_string(params.top_level_buffers) +
                              " must be 1 or 2 (double-buffered)");
@@ -795,9 +801,9 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
       // Top + bottom must fit the traversal stack (both levels share it).
       KdBuildParams kd = b.params.kd;
       kd.max_depth = bottom_level_depth(params, n - info.dropped, scene.instances.size());
-      info.tree = build_kdtree(std::span<const glm::vec3>(obj.positions),
-                               std::span<const glm::uvec3>(obj.triangles),
-                               std::span<const std::uint8_t>(skip), kd);
+      info.tree = build_kdtree_for_units(
+          std::span<const glm::vec3>(obj.positions), std::span<const glm::uvec3>(obj.triangles),
+          std::span<const std::uint8_t>(skip), kd, static_cast<KdObjective>(params.tree_objective));
     }
     const double secs = seconds_since(t0);
     b.stats.bottom_build_seconds += secs;

@@ -35,6 +35,10 @@ struct ImageParams {
   // visit: a transformation like a triangle test's, a 6-cycle box clip, the bottom tree's descent
   // and its own triangle tests, about 16 triangle tests' worth (docs/kdtree.md, "Top level").
   float top_item_cost_factor = 16.0f;
+  // The bottom-level trees' objective (host/tree_objective.h, `kd.objective`): 0 = the plain SAH
+  // sum at kd.traversal_cost, 1 = the K_T ladder's tree with the lowest busiest-unit load. The
+  // top level keeps the plain sum (docs/kdtree.md "Busiest unit").
+  int tree_objective = 0;
   // Traversal stack entries per packet in the hardware (the prototype's 64, shared by both
   // levels): the top level's depth limit plus every bottom tree's must fit it, so the builder
   // caps the bottom trees' depth at stack_entries minus the top's (docs/kdtree.md).

@@ -100,6 +100,13 @@ struct KdTreeStats {
   double build_seconds = 0.0;  // every build of the node bound's search included
   // The node bound's cost per node (in SAH cost units at the root), 0 when the first build fit.
   double node_cost = 0.0;
+  // The busiest-unit objective's record (host/tree_objective.h; 0 where the tree did not go
+  // through it): the K_T the tree was built with and its SAH-expected unit cycles per packet.
+  double chosen_traversal_cost = 0.0;
+  double expected_traversal_cycles = 0.0;
+  double expected_list_cycles = 0.0;
+  double expected_transformation_cycles = 0.0;
+  double expected_intersection_cycles = 0.0;
 };
 
 struct KdTree {

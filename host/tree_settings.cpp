@@ -68,6 +68,12 @@ const std::vector<Binding>& bindings() {
         0, 1},
        true,
        SAARCOR_TREE_FIELD(kd.face_slabs, bool)},
+      {{"kd.objective", 0, "enum",
+        "bottom trees: 0 = plain SAH sum at kd.traversal_cost, 1 = the K_T (x 2^(i/2), i = -4..4) "
+        "whose tree has the lowest SAH-expected load in its busiest unit",
+        0, 1},
+       true,
+       SAARCOR_TREE_FIELD(tree_objective, int)},
       {{"kd.stack", 0, "entries",
         "traversal stack entries the trees are built for (both levels share them)", 2, 4096},
        true,

@@ -147,6 +147,7 @@ inline RandomConfig random_config(std::uint64_t seed, const std::vector<StressSc
     maybe("kd.max_depth", pick({-1, 12, 20}));  // shallower: leaves of thousands
     maybe("kd.face_slabs", in(0, 1));
     maybe("kd.traversal_cost", pick({5, 30, 100}));
+    maybe("kd.objective", in(0, 1));
   }
   c.shadows = rng() % 10 < 3;
   c.depth = c.scene.vary_image && rng() % 4 == 0 ? in(1, 3) : 0;

@@ -15,6 +15,7 @@
 #include "host/image_builder.h"
 #include "host/kdtree.h"
 #include "host/scene.h"
+#include "host/tree_objective.h"
 #include "host/tree_settings.h"
 
 namespace saarcor {
@@ -38,7 +39,12 @@ json tree_json(const KdTreeStats& s) {
               {"expected_traversal_steps", s.expected_traversal_steps},
               {"expected_leaf_visits", s.expected_leaf_visits},
               {"expected_item_tests", s.expected_item_tests},
-              {"build_seconds", s.build_seconds}};
+              {"build_seconds", s.build_seconds},
+              {"traversal_cost", s.chosen_traversal_cost},
+              {"expected_unit_cycles", json{{"traversal", s.expected_traversal_cycles},
+                                            {"list", s.expected_list_cycles},
+                                            {"transformation", s.expected_transformation_cycles},
+                                            {"intersection", s.expected_intersection_cycles}}}};
 }
 
 struct Trees {
@@ -67,7 +73,9 @@ Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& pa
     for (std::size_t k = 0; k < obj.triangles.size(); ++k)
       live += obj.degenerate[k] ? 0 : 1;
     kd.max_depth = host::bottom_level_depth(params, live, scene.instances.size());
-    const host::KdTree tree = host::build_kdtree(obj.positions, obj.triangles, obj.degenerate, kd);
+    const host::KdTree tree =
+        host::build_kdtree_for_units(obj.positions, obj.triangles, obj.degenerate, kd,
+                                     static_cast<host::KdObjective>(params.tree_objective));
     t.bottom.emplace_back(static_cast<std::uint32_t>(o), tree.stats);
   }
   std::vector<host::Aabb> boxes;
@@ -246,11 +254,16 @@ int run_scene(const SceneOptions& options) {
     const json& o = objs[i];
     std::printf(
         "  object %-10u %llu triangles, %.2f nodes per triangle, depth %u, per ray %.2f steps / "
-        "%.2f leaves / %.2f tests\n",
+        "%.2f leaves / %.2f tests; K_T %.3g, cycles per packet trav/list/xfrm/int "
+        "%.1f/%.1f/%.1f/%.1f\n",
         o["object"].get<unsigned>(), o["triangles"].get<unsigned long long>(),
         o["nodes_per_triangle"].get<double>(), o["depth"].get<unsigned>(),
         o["expected_traversal_steps"].get<double>(), o["expected_leaf_visits"].get<double>(),
-        o["expected_item_tests"].get<double>());
+        o["expected_item_tests"].get<double>(), o["traversal_cost"].get<double>(),
+        o["expected_unit_cycles"]["traversal"].get<double>(),
+        o["expected_unit_cycles"]["list"].get<double>(),
+        o["expected_unit_cycles"]["transformation"].get<double>(),
+        o["expected_unit_cycles"]["intersection"].get<double>());
   }
   if (objs.size() > kShown)
     std::printf("  (%zu smaller trees: --json lists every tree)\n", objs.size() - kShown);
