@@ -235,6 +235,78 @@ constexpr double kFaceSlabSlack = 1.5;
 // a grid step) down to single grid steps at the depth limit.
 constexpr double kMinAreaShare = 1.0 / (1 << 20);
 
+bool is_empty_leaf(const KdTreeNode& nd) {
+  return nd.leaf && nd.count == 0;
+}
+
+// The chain link at an inner node whose children are `l` and `r` (KdTreeStats): 1 where one child
+// is an empty leaf and the other an inner node with an empty-leaf child, 2 where that inner node
+// also cuts on the same axis with its empty child on the same side (mergeable), else 0.
+int chain_link(const std::vector<KdTreeNode>& nodes, const KdTreeNode& nd, std::uint32_t l,
+               std::uint32_t r) {
+  for (int empty_side = 0; empty_side < 2; ++empty_side) {
+    if (!is_empty_leaf(nodes[empty_side == 0 ? l : r])) continue;
+    const KdTreeNode& other = nodes[empty_side == 0 ? r : l];
+    if (other.leaf) continue;
+    const bool same_side = is_empty_leaf(nodes[other.child + empty_side]);
+    if (!same_side && !is_empty_leaf(nodes[other.child + 1 - empty_side])) continue;
+    return same_side && other.axis == nd.axis ? 2 : 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+// KdBuildParams::kChainsMerged: rewrites the node array with every mergeable chain link replaced
+// by one cut. An empty cut at s1 whose non-empty child cuts the same axis at s2 with its empty
+// side towards s1 leaves the slab between the node's face and s2 empty, so the node cuts at s2
+// instead (strictly inside its box, on the split grid: the child's plane), its children the
+// first empty leaf and the child's non-empty child; repeated while the new child is such a cut.
+// The array is written in the builder's order (a node's two children allocated together when it
+// is reached, then its left subtree, then its right one), so a tree without mergeable links comes
+// out unchanged; leaf lists are not moved.
+void kd_merge_empty_chains(KdTree& tree) {
+  if (tree.nodes.empty()) return;
+  const std::vector<KdTreeNode>& in = tree.nodes;
+  std::vector<KdTreeNode> out;
+  out.reserve(in.size());
+  out.push_back(in[0]);
+  struct Pending {
+    std::uint32_t old_node;
+    std::uint32_t new_node;
+  };
+  std::vector<Pending> stack{{0, 0}};
+  while (!stack.empty()) {
+    const Pending pd = stack.back();
+    stack.pop_back();
+    KdTreeNode nd = in[pd.old_node];
+    if (nd.leaf) {
+      out[pd.new_node] = nd;
+      continue;
+    }
+    std::uint32_t l = nd.child;
+    std::uint32_t r = nd.child + 1;
+    while (chain_link(in, nd, l, r) == 2) {
+      if (is_empty_leaf(in[l]) && !in[r].leaf && is_empty_leaf(in[in[r].child])) {
+        nd.split = in[r].split;
+        r = in[r].child + 1;
+      } else {
+        nd.split = in[l].split;
+        l = in[l].child;
+      }
+    }
+    nd.child = static_cast<std::uint32_t>(out.size());
+    out[pd.new_node] = nd;
+    out.emplace_back();
+    out.emplace_back();
+    stack.push_back({r, nd.child + 1});
+    stack.push_back({l, nd.child});
+  }
+  tree.nodes = std::move(out);
+}
+
+namespace {
+
 struct Split {
   double cost = std::numeric_limits<double>::infinity();
   int axis = -1;
@@ -327,17 +399,26 @@ class Builder {
     return (it.planar >> k) & 1u ? it.key[k] : grid_succ(it.key[k]);
   }
   void run();
-  void bin_node(std::uint32_t node, int depth, const Box& box, std::size_t b, std::uint32_t n);
-  BinnedSplit find_binned_split(const Box& box, const BinItem* items, std::uint32_t n) const;
-  void exact_subtree(std::uint32_t node, int depth, const Box& box, std::size_t b, std::uint32_t n);
+  // `no_empty`: the node is the non-empty child of an empty cut and KdBuildParams::empty_chains
+  // forbids chains, so no plane with an empty side is considered for it.
+  void bin_node(std::uint32_t node, int depth, const Box& box, std::size_t b, std::uint32_t n,
+                bool no_empty);
+  BinnedSplit find_binned_split(const Box& box, const BinItem* items, std::uint32_t n,
+                                bool no_empty) const;
+  void exact_subtree(std::uint32_t node, int depth, const Box& box, std::size_t b, std::uint32_t n,
+                     bool no_empty);
   void build_node(std::uint32_t node, int depth, const Box& box, const std::size_t b[3],
-                  const std::size_t e[3], std::uint32_t n);
+                  const std::size_t e[3], std::uint32_t n, bool no_empty);
+  // The non-empty child of a cut with `nl`, `nr` items on its sides may not be cut off empty.
+  bool forbid_empty_below(std::uint32_t nl, std::uint32_t nr) const {
+    return p_.empty_chains == KdBuildParams::kChainsForbidden && (nl == 0 || nr == 0);
+  }
   void make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0);
   void emit_leaf(std::uint32_t node, std::vector<std::uint32_t>& ids);
-  Split find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
-                   std::uint32_t n) const;
+  Split find_split(const Box& box, const std::size_t b[3], const std::size_t e[3], std::uint32_t n,
+                   bool no_empty) const;
   void face_slabs(const Box& box, int k, double sum, double prod, std::size_t b, std::size_t e,
-                  std::uint32_t n, double kt, double inv_area, Split& best) const;
+                  std::uint32_t n, double kt, double inv_area, bool no_empty, Split& best) const;
   int clip_split(std::uint32_t id, const Box& box, int axis, float split, float llo[3],
                  float lhi[3], float rlo[3], float rhi[3]) const;
   void add_clipped(std::uint32_t id, const float lo[3], const float hi[3], std::vector<Key>* out);
@@ -391,6 +472,10 @@ const KdBuildParams& Builder::checked(const KdBuildParams& p) {
   if (!(p.max_nodes_per_item >= 0.0f && p.max_nodes_per_item <= 1e6f) || p.node_floor < 0)
     throw std::runtime_error(
         "kd-tree: node bound needs 0 <= nodes per item <= 1e6 (0: no bound) and a floor >= 0");
+  if (p.empty_chains < KdBuildParams::kChainsAllowed ||
+      p.empty_chains > KdBuildParams::kChainsForbidden)
+    throw std::runtime_error("kd-tree: empty-chain rule " + std::to_string(p.empty_chains) +
+                             " outside 0..2");
   if (p.bins < 2 || p.bins > kMaxBins)
     throw std::runtime_error("kd-tree: bins " + std::to_string(p.bins) + " outside 2.." +
                              std::to_string(kMaxBins));
@@ -512,13 +597,14 @@ void Builder::run() {
   p_.max_depth = kd_max_depth(p_, item_count_);
   root_half_area_ = half_area(root_);
   min_half_area_ = root_half_area_ * kMinAreaShare;
-  bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n));
+  bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n), false);
+  if (p_.empty_chains == KdBuildParams::kChainsMerged) kd_merge_empty_chains(tree_);
 }
 
 // The exact stage for a subtree: events from the items' bounds (already on the grid), with
 // local ids 0..n-1 so that the per-item side bytes stay in cache, sorted once.
 void Builder::exact_subtree(std::uint32_t node, int depth, const Box& box, std::size_t b,
-                            std::uint32_t n) {
+                            std::uint32_t n, bool no_empty) {
   gid_.resize(n);
   if (side_.size() < n) side_.resize(n);
   const BinItem* items = items_.data() + b;
@@ -549,7 +635,7 @@ void Builder::exact_subtree(std::uint32_t node, int depth, const Box& box, std::
   }
   for (std::uint32_t i = 0; i < n; ++i)
     gid_[i] = items[i].id;
-  build_node(node, depth, box, eb, ee, n);
+  build_node(node, depth, box, eb, ee, n, no_empty);
 }
 
 // The bins' counts, per bin the three axes side by side (and a zero lane): the sweep below
@@ -699,8 +785,8 @@ void sweep_bins(const BinHist& hist_lo, const BinHist& hist_hi, int nb_max, std:
 // lies within a quarter bin of the even position, which is used for the areas; only the
 // winner's s_j is searched. The two empty-space planes at the items' lowest and highest bounds
 // are evaluated besides.
-BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
-                                       std::uint32_t n) const {
+BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items, std::uint32_t n,
+                                       bool no_empty) const {
   BinnedSplit best;
   const std::array<double, 3> d = extents(box);
   const double area = half_area(d);
@@ -859,7 +945,7 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
     // Empty-space planes at the items' bounds (all items on one side, planars with them):
     // the lowest lower bound, and the grid value above the highest key (the highest upper
     // bound, or one grid step beyond it when that is a planar item's).
-    if (tlo[k] > box.lo[k] && tlo[k] < box.hi[k]) {
+    if (!no_empty && tlo[k] > box.lo[k] && tlo[k] < box.hi[k]) {
       const double c = cost_at(tlo[k], 0, n);
       if (c < best.cost) {
         best = BinnedSplit{c, k, tlo[k], false, 0, n};
@@ -867,7 +953,7 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
       }
     }
     const float thi = grid_succ(tkey[k]);
-    if (thi < box.hi[k] && thi > box.lo[k]) {
+    if (!no_empty && thi < box.hi[k] && thi > box.lo[k]) {
       const double c = cost_at(thi, n, 0);
       if (c < best.cost) {
         best = BinnedSplit{c, k, thi, true, n, 0};
@@ -891,14 +977,14 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items,
 }
 
 void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_t b,
-                       std::uint32_t n) {
+                       std::uint32_t n, bool no_empty) {
   if (n == 0) {  // the empty side of an empty-space plane: a leaf under every rule
     leaf_scratch_.clear();
     emit_leaf(node, leaf_scratch_);
     return;
   }
   if (n <= static_cast<std::uint32_t>(p_.binned_above)) {
-    exact_subtree(node, depth, box, b, n);
+    exact_subtree(node, depth, box, b, n, no_empty);
     return;
   }
   if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth ||
@@ -909,10 +995,10 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
     emit_leaf(node, leaf_scratch_);
     return;
   }
-  const BinnedSplit best = find_binned_split(box, items_.data() + b, n);
+  const BinnedSplit best = find_binned_split(box, items_.data() + b, n, no_empty);
   if (best.axis < 0 || !(best.cost < static_cast<double>(p_.intersection_cost) * n)) {
     // The bins found nothing worth it: the exact sweep decides (leaf or a plane between bins).
-    exact_subtree(node, depth, box, b, n);
+    exact_subtree(node, depth, box, b, n, no_empty);
     return;
   }
   const int k = best.axis;
@@ -983,14 +1069,15 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
   const std::uint32_t child = make_inner(node, k, split);
   const std::size_t top = rb + nr;
   items_.top_ = top;
-  bin_node(child, depth + 1, lbox, lb, nl);
+  const bool no_empty_below = forbid_empty_below(nl, nr);
+  bin_node(child, depth + 1, lbox, lb, nl, no_empty_below);
   items_.top_ = top;
-  bin_node(child + 1, depth + 1, rbox, rb, nr);
+  bin_node(child + 1, depth + 1, rbox, rb, nr, no_empty_below);
   items_.top_ = entry_top;
 }
 
 Split Builder::find_split(const Box& box, const std::size_t b[3], const std::size_t e[3],
-                          std::uint32_t n) const {
+                          std::uint32_t n, bool no_empty) const {
   Split best;
   const std::array<double, 3> d = extents(box);
   const double area = half_area(d);
@@ -1050,8 +1137,10 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
             return (l == 0 || r == 0 ? bonus : 1.0) *
                    (kt + ki * (al * inv_area * l + ar * inv_area * r));
           };
-          const double c1 = exact(nl1, nr);
-          const double c2 = exact(nl, nr2);
+          // Under no_empty a placement that leaves a side empty is no candidate.
+          const double inf = std::numeric_limits<double>::infinity();
+          const double c1 = no_empty && (nl1 == 0 || nr == 0) ? inf : exact(nl1, nr);
+          const double c2 = no_empty && (nl == 0 || nr2 == 0) ? inf : exact(nl, nr2);
           if (c1 < best.cost || c2 < best.cost) {
             best = c1 <= c2 ? Split{c1, k, pos, true} : Split{c2, k, pos, false};
             best_m = (best.cost - kt0) / scale;
@@ -1065,7 +1154,7 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
       pending = 0;
       np = 0;
     }
-    if (p_.face_slabs) face_slabs(box, k, sum, prod, b[k], e[k], n, kt, inv_area, face);
+    if (p_.face_slabs) face_slabs(box, k, sum, prod, b[k], e[k], n, kt, inv_area, no_empty, face);
   }
   // A face slab wins when it is cheaper, and also when no other plane beats the leaf but the slab
   // lies within the slack (build_node applies the slack to it).
@@ -1083,7 +1172,7 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
 // rounded plane distances (about 2^-15 of the distance, fp24) cannot skip the slab.
 // sum, prod: the sum and product of the box's two other extents (the sweep's per-axis constants).
 void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::size_t b,
-                         std::size_t e, std::uint32_t n, double kt, double inv_area,
+                         std::size_t e, std::uint32_t n, double kt, double inv_area, bool no_empty,
                          Split& best) const {
   const double width = (static_cast<double>(root_.hi[k]) - root_.lo[k]) * kFaceSlabShare;
   const float lo = box.lo[k];
@@ -1094,6 +1183,7 @@ void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::si
     const double al = (static_cast<double>(x) - lo) * sum + prod;
     const double ar = (static_cast<double>(hi) - x) * sum + prod;
     // The interior side is empty where every item lies in the face.
+    if (no_empty && (nl == 0 || nr == 0)) return;
     const double cost = plane_cost(kt, al, ar, nl, nr, inv_area);
     if (cost < best.cost) best = Split{cost, k, ordered(x), true, true};
   };
@@ -1346,13 +1436,13 @@ std::size_t split_events(const Key* ev, std::size_t n, const std::uint8_t* side,
 }
 
 void Builder::build_node(std::uint32_t node, int depth, const Box& box, const std::size_t b[3],
-                         const std::size_t e[3], std::uint32_t n) {
+                         const std::size_t e[3], std::uint32_t n, bool no_empty) {
   if (n <= static_cast<std::uint32_t>(p_.leaf_size) || depth >= p_.max_depth ||
       half_area(box) < min_half_area_) {
     make_leaf(node, b[0], e[0]);
     return;
   }
-  const Split best = find_split(box, b, e, n);
+  const Split best = find_split(box, b, e, n, no_empty);
   const double leaf_cost = static_cast<double>(p_.intersection_cost) * n;
   if (best.axis < 0 || !(best.cost < leaf_cost * (best.face_slab ? kFaceSlabSlack : 1.0))) {
     make_leaf(node, b[0], e[0]);
@@ -1491,10 +1581,11 @@ void Builder::build_node(std::uint32_t node, int depth, const Box& box, const st
   std::size_t saved_top[3];
   for (int j = 0; j < 3; ++j)
     saved_top[j] = ev_[j].top_;
-  build_node(child, depth + 1, lbox, lb, le, n_left);
+  const bool no_empty_below = forbid_empty_below(n_left, n_right);
+  build_node(child, depth + 1, lbox, lb, le, n_left, no_empty_below);
   for (int j = 0; j < 3; ++j)
     ev_[j].top_ = saved_top[j];
-  build_node(child + 1, depth + 1, rbox, rb, re, n_right);
+  build_node(child + 1, depth + 1, rbox, rb, re, n_right, no_empty_below);
   for (int j = 0; j < 3; ++j)
     ev_[j].top_ = lb[j];
 }
@@ -1546,6 +1637,9 @@ KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params
       continue;
     }
     steps += pr;
+    const int link = chain_link(tree.nodes, nd, nd.child, nd.child + 1);
+    st.empty_chain_links += link != 0;
+    st.mergeable_chain_links += link == 2;
     Box l = it.box;
     Box r = it.box;
     l.hi[nd.axis] = nd.split;

@@ -1097,6 +1097,10 @@ TEST(KdTree, BadInputIsRefusedWithOneClearLine) {
   expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, "kd-tree: bins 1 outside 2..256");
   p.bins = 257;
   expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); }, "kd-tree: bins 257 outside 2..256");
+  p.bins = 128;
+  p.empty_chains = 3;
+  expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); },
+               "kd-tree: empty-chain rule 3 outside 0..2");
   p = {};
   p.binned_above = -1;
   expect_error([&] { build_kdtree(m.pos, m.tris, {}, p); },
@@ -1255,6 +1259,164 @@ TEST(KdTree, LeafStepsChargeEveryNonEmptyChild) {
   check_triangle_tree(stepped, t, p);
   check_rays(stepped, t, 2000 / kScale, 31);
   check_points(stepped, t, 200 / kScale, 32);
+}
+
+// ---- chains of empty cuts (docs/kdtree.md "Chains of empty cuts") ----------------------
+
+// The non-empty leaves of a tree with their boxes and lists (empty leaves left out), in order.
+std::vector<std::pair<std::vector<double>, std::vector<std::uint32_t>>> full_leaves(
+    const KdTree& tree, const KdBuildParams& params) {
+  std::vector<std::pair<std::vector<double>, std::vector<std::uint32_t>>> out;
+  for (const Leaf& lf : walk(tree, params)) {
+    const KdTreeNode& nd = tree.nodes[lf.node];
+    if (nd.count == 0) continue;
+    std::vector<double> box;
+    for (int k = 0; k < 3; ++k) {
+      box.push_back(lf.box.lo[k]);
+      box.push_back(lf.box.hi[k]);
+    }
+    out.emplace_back(box, std::vector<std::uint32_t>(tree.items.begin() + nd.first,
+                                                     tree.items.begin() + nd.first + nd.count));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+KdTreeNode inner(int axis, float split, std::uint32_t child) {
+  KdTreeNode n;
+  n.axis = static_cast<std::uint8_t>(axis);
+  n.split = split;
+  n.child = child;
+  return n;
+}
+KdTreeNode leaf(std::uint32_t first, std::uint32_t count) {
+  KdTreeNode n;
+  n.leaf = true;
+  n.first = first;
+  n.count = count;
+  return n;
+}
+
+// A hand-built tree over [0, 16]^3 (children adjacent, in the builder's order):
+//   0: x = 2,  left empty  | 2        link, mergeable (2 cuts x, empty side below)
+//   2: x = 5,  left empty  | 4        link, mergeable
+//   4: x = 7,  left empty  | 6        link across axes
+//   6: y = 4,  left empty  | 8        link across axes and sides
+//   8: z = 12, 9           | empty    link, mergeable (9 cuts z, empty side above)
+//   9: z = 9,  11          | empty    no link (11 has no empty child)
+//  11: x = 10, leaf {0}    | leaf {1, 2}
+// Merged: x = 7 (empty below) -> y = 4 (empty below) -> z = 9 (empty above) -> x = 10.
+TEST(KdTree, ChainLinksAreCountedAndSameAxisLinksMerge) {
+  KdTree t;
+  t.bounds.lo = glm::vec3(0.0f);
+  t.bounds.hi = glm::vec3(16.0f);
+  t.items = {0, 1, 2};
+  t.nodes.resize(15);
+  t.nodes[0] = inner(0, 2.0f, 1);
+  t.nodes[1] = leaf(0, 0);
+  t.nodes[2] = inner(0, 5.0f, 3);
+  t.nodes[3] = leaf(0, 0);
+  t.nodes[4] = inner(0, 7.0f, 5);
+  t.nodes[5] = leaf(0, 0);
+  t.nodes[6] = inner(1, 4.0f, 7);
+  t.nodes[7] = leaf(0, 0);
+  t.nodes[8] = inner(2, 12.0f, 9);
+  t.nodes[9] = inner(2, 9.0f, 11);
+  t.nodes[10] = leaf(0, 0);
+  t.nodes[11] = inner(0, 10.0f, 13);
+  t.nodes[12] = leaf(0, 0);
+  t.nodes[13] = leaf(0, 1);
+  t.nodes[14] = leaf(1, 2);
+  const KdTreeStats before = compute_kdtree_stats(t);
+  EXPECT_EQ(before.nodes, 15u);
+  EXPECT_EQ(before.empty_leaves, 6u);
+  EXPECT_EQ(before.empty_chain_links, 5u);      // nodes 0, 2, 4, 6 and 8
+  EXPECT_EQ(before.mergeable_chain_links, 3u);  // nodes 0, 2 and 8
+  const auto leaves_before = full_leaves(t, {});
+
+  KdTree m = t;
+  kd_merge_empty_chains(m);
+  const KdTreeStats after = compute_kdtree_stats(m);
+  // One inner node and one empty leaf fewer per mergeable link.
+  EXPECT_EQ(after.nodes, before.nodes - 2 * before.mergeable_chain_links);
+  EXPECT_EQ(after.empty_leaves, before.empty_leaves - before.mergeable_chain_links);
+  EXPECT_EQ(after.mergeable_chain_links, 0u);
+  EXPECT_EQ(after.empty_chain_links, 2u);  // x = 7 -> y = 4 -> z = 9, across axes
+  EXPECT_EQ(full_leaves(m, {}), leaves_before);
+  EXPECT_LT(after.expected_traversal_steps, before.expected_traversal_steps);
+  EXPECT_DOUBLE_EQ(after.expected_item_tests, before.expected_item_tests);
+  // The merged cuts are the inner planes.
+  EXPECT_EQ(m.nodes[0].axis, 0);
+  EXPECT_EQ(m.nodes[0].split, 7.0f);
+  ASSERT_FALSE(m.nodes[m.nodes[0].child + 1].leaf);
+  const KdTreeNode& y = m.nodes[m.nodes[0].child + 1];
+  EXPECT_EQ(y.axis, 1);
+  const KdTreeNode& z = m.nodes[y.child + 1];
+  EXPECT_EQ(z.axis, 2);
+  EXPECT_EQ(z.split, 9.0f);
+  // Merging again changes nothing: the array is written in the builder's order.
+  KdTree again = m;
+  kd_merge_empty_chains(again);
+  ASSERT_EQ(again.nodes.size(), m.nodes.size());
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    EXPECT_EQ(again.nodes[i].leaf, m.nodes[i].leaf);
+    EXPECT_EQ(again.nodes[i].split, m.nodes[i].split);
+    EXPECT_EQ(again.nodes[i].child, m.nodes[i].child);
+    EXPECT_EQ(again.nodes[i].count, m.nodes[i].count);
+  }
+}
+
+// The rules on built trees: merging leaves the non-empty leaves as they are and no mergeable link;
+// forbidding chains leaves no link at all; both keep every invariant and answer rays right.
+TEST(KdTree, EmptyChainRulesKeepTheInvariants) {
+  Mesh m = random_triangles(400 / kScale, 5, 20.0f, 1.0f);
+  append(m, sphere(12, 16, glm::vec3(30.0f, 0.0f, 0.0f), 2.0f));
+  append(m, terrain(20, 15, 3));
+  KdBuildParams allowed;
+  allowed.max_nodes_per_item = 0.0f;  // the rules alone, without the bound's rebuilds
+  allowed.empty_chains = KdBuildParams::kChainsAllowed;
+  KdBuildParams merged = allowed;
+  merged.empty_chains = KdBuildParams::kChainsMerged;
+  KdBuildParams forbidden = allowed;
+  forbidden.empty_chains = KdBuildParams::kChainsForbidden;
+  const KdTree a = build_kdtree(m.pos, m.tris, {}, allowed);
+  const KdTree b = build_kdtree(m.pos, m.tris, {}, merged);
+  const KdTree c = build_kdtree(m.pos, m.tris, {}, forbidden);
+  EXPECT_GT(a.stats.empty_chain_links, 0u);
+  EXPECT_EQ(b.stats.mergeable_chain_links, 0u);
+  EXPECT_EQ(b.nodes.size(), a.nodes.size() - 2 * a.stats.mergeable_chain_links);
+  EXPECT_EQ(b.stats.empty_chain_links, a.stats.empty_chain_links - a.stats.mergeable_chain_links);
+  EXPECT_EQ(full_leaves(b, merged), full_leaves(a, allowed));
+  EXPECT_EQ(c.stats.empty_chain_links, 0u);
+  // The rule itself: below an empty cut, no plane with an empty side.
+  for (const KdTreeNode& nd : c.nodes) {
+    if (nd.leaf) continue;
+    for (int s = 0; s < 2; ++s) {
+      const KdTreeNode& e = c.nodes[nd.child + s];
+      const KdTreeNode& o = c.nodes[nd.child + 1 - s];
+      if (!(e.leaf && e.count == 0) || o.leaf) continue;
+      EXPECT_FALSE(c.nodes[o.child].leaf && c.nodes[o.child].count == 0);
+      EXPECT_FALSE(c.nodes[o.child + 1].leaf && c.nodes[o.child + 1].count == 0);
+    }
+  }
+  for (const auto& [tree, params] : {std::pair{&b, merged}, std::pair{&c, forbidden}}) {
+    check_triangle_tree(*tree, m, params);
+    check_rays(*tree, m, 2000 / kScale, 41);
+    check_points(*tree, m, 200 / kScale, 42);
+  }
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<float> u(-50.0f, 50.0f);
+  std::uniform_real_distribution<float> s(0.0f, 3.0f);
+  std::vector<Aabb> boxes(300);
+  for (Aabb& bx : boxes) {
+    bx.lo = glm::vec3(u(rng), u(rng) * 0.1f, u(rng));
+    bx.hi = bx.lo + glm::vec3(s(rng), s(rng), s(rng));
+  }
+  for (const KdBuildParams& p : {merged, forbidden}) {
+    const KdTree top = build_kdtree(boxes, p);
+    check_box_tree(top, boxes);
+    EXPECT_EQ(top.stats.mergeable_chain_links, 0u);
+  }
 }
 
 }  // namespace

@@ -62,6 +62,12 @@ const std::vector<Binding>& bindings() {
         "node bound: a tree of this many nodes or fewer is never bound", 0, 1e9},
        true,
        SAARCOR_TREE_FIELD(kd.node_floor, int)},
+      {{"kd.empty_chains", 0, "rule",
+        "chains of empty cuts: 0 = allowed, 1 = same-axis links merged into one cut, 2 = the "
+        "non-empty child of an empty cut is not cut off empty again",
+        0, 2},
+       true,
+       SAARCOR_TREE_FIELD(kd.empty_chains, int)},
       {{"kd.face_slabs", 0, "bool",
         "thin slabs peeling items that lie in a node face (for hardware without a triangle "
         "mailbox)",

@@ -33,6 +33,8 @@ json tree_json(const KdTreeStats& s) {
   return json{{"nodes", s.nodes},
               {"leaves", s.leaves},
               {"empty_leaves", s.empty_leaves},
+              {"empty_chain_links", s.empty_chain_links},
+              {"mergeable_chain_links", s.mergeable_chain_links},
               {"depth", s.depth},
               {"items_per_leaf", s.items_per_leaf},
               {"sah_cost", s.sah_cost},
@@ -108,6 +110,8 @@ json bottom_json(const Trees& t, const host::Scene& scene) {
     sum.nodes += s.nodes;
     sum.leaves += s.leaves;
     sum.empty_leaves += s.empty_leaves;
+    sum.empty_chain_links += s.empty_chain_links;
+    sum.mergeable_chain_links += s.mergeable_chain_links;
     sum.depth = std::max(sum.depth, s.depth);
     sum.build_seconds += s.build_seconds;
     leaf_items += s.items_per_leaf * (s.leaves - s.empty_leaves);
@@ -125,6 +129,8 @@ json bottom_json(const Trees& t, const host::Scene& scene) {
               {"nodes", sum.nodes},
               {"leaves", sum.leaves},
               {"empty_leaves", sum.empty_leaves},
+              {"empty_chain_links", sum.empty_chain_links},
+              {"mergeable_chain_links", sum.mergeable_chain_links},
               {"max_depth", sum.depth},
               {"nodes_per_triangle", static_cast<double>(sum.nodes) /
                                          std::max<double>(1.0, static_cast<double>(triangles))},
@@ -230,19 +236,21 @@ int run_scene(const SceneOptions& options) {
   std::printf("load time           %.3f s\n", load_seconds);
   const auto tree_line = [](const char* name, const KdTreeStats& s) {
     std::printf(
-        "%-19s %u nodes, %u leaves (%u empty), depth %u, %.2f items/leaf, SAH %.2f, "
-        "per ray %.2f steps / %.2f leaves / %.2f tests, %.3f s\n",
-        name, s.nodes, s.leaves, s.empty_leaves, s.depth, s.items_per_leaf, s.sah_cost,
-        s.expected_traversal_steps, s.expected_leaf_visits, s.expected_item_tests, s.build_seconds);
+        "%-19s %u nodes, %u leaves (%u empty), %u chain links (%u mergeable), depth %u, %.2f "
+        "items/leaf, SAH %.2f, per ray %.2f steps / %.2f leaves / %.2f tests, %.3f s\n",
+        name, s.nodes, s.leaves, s.empty_leaves, s.empty_chain_links, s.mergeable_chain_links,
+        s.depth, s.items_per_leaf, s.sah_cost, s.expected_traversal_steps, s.expected_leaf_visits,
+        s.expected_item_tests, s.build_seconds);
   };
   tree_line("kd-tree top", trees.top);
   const json b = j["kdtree"]["bottom"];
   std::printf(
       "kd-tree bottom      %zu trees, %llu nodes (%.2f per triangle), %llu leaves (%llu empty), "
-      "max depth %u, %.2f items/leaf, %.3f s\n",
+      "%llu chain links (%llu mergeable), max depth %u, %.2f items/leaf, %.3f s\n",
       trees.bottom.size(), b["nodes"].get<unsigned long long>(),
       b["nodes_per_triangle"].get<double>(), b["leaves"].get<unsigned long long>(),
-      b["empty_leaves"].get<unsigned long long>(), b["max_depth"].get<unsigned>(),
+      b["empty_leaves"].get<unsigned long long>(), b["empty_chain_links"].get<unsigned long long>(),
+      b["mergeable_chain_links"].get<unsigned long long>(), b["max_depth"].get<unsigned>(),
       b["items_per_leaf"].get<double>(), b["build_seconds"].get<double>());
   // Every tree's expectations, largest first (all of them in --json).
   std::vector<json> objs(b["objects"].begin(), b["objects"].end());
@@ -253,11 +261,12 @@ int run_scene(const SceneOptions& options) {
   for (std::size_t i = 0; i < objs.size() && i < kShown; ++i) {
     const json& o = objs[i];
     std::printf(
-        "  object %-10u %llu triangles, %.2f nodes per triangle, depth %u, per ray %.2f steps / "
-        "%.2f leaves / %.2f tests; K_T %.3g, cycles per packet trav/list/xfrm/int "
-        "%.1f/%.1f/%.1f/%.1f\n",
+        "  object %-10u %llu triangles, %.2f nodes per triangle, %llu chain links (%llu "
+        "mergeable), depth %u, per ray %.2f steps / %.2f leaves / %.2f tests; K_T %.3g, cycles per "
+        "packet trav/list/xfrm/int %.1f/%.1f/%.1f/%.1f\n",
         o["object"].get<unsigned>(), o["triangles"].get<unsigned long long>(),
-        o["nodes_per_triangle"].get<double>(), o["depth"].get<unsigned>(),
+        o["nodes_per_triangle"].get<double>(), o["empty_chain_links"].get<unsigned long long>(),
+        o["mergeable_chain_links"].get<unsigned long long>(), o["depth"].get<unsigned>(),
         o["expected_traversal_steps"].get<double>(), o["expected_leaf_visits"].get<double>(),
         o["expected_item_tests"].get<double>(), o["traversal_cost"].get<double>(),
         o["expected_unit_cycles"]["traversal"].get<double>(),

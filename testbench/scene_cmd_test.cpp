@@ -121,7 +121,15 @@ TEST_F(SceneCmd, TreeKeysChangeTheTrees) {
             ja["objects"][0]["expected_item_tests"].get<double>());
   const CmdResult t = run("builtin:room");
   EXPECT_NE(t.out.find("806 triangles, "), std::string::npos) << t.out;
-  EXPECT_NE(t.out.find("nodes per triangle, depth "), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("nodes per triangle, 45 chain links (0 mergeable), depth "),
+            std::string::npos)
+      << t.out;
+  // The room's 45 chain links turn to another axis or side; forbidding chains leaves none.
+  EXPECT_EQ(ja["empty_chain_links"].get<int>(), 45);
+  EXPECT_EQ(ja["mergeable_chain_links"].get<int>(), 0);
+  const CmdResult c = run("builtin:room --json --set kd.empty_chains=2");
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(json::parse(c.out)["kdtree"]["bottom"]["empty_chain_links"].get<int>(), 0);
   expect_one_line_error("builtin:room --set threads=4", "unknown --set key 'threads'");
   expect_one_line_error("builtin:room --set kd.max_depth=-3", "bad --set kd.max_depth=-3");
 }
