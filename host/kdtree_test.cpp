@@ -903,17 +903,24 @@ TEST(KdTree, StatisticsAreConsistent) {
   EXPECT_NEAR(tests / lines, s.expected_item_tests, 0.05 * s.expected_item_tests);
 }
 
+// Node for node: every field of every node the same.
+void expect_same_nodes(const KdTree& a, const KdTree& b) {
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+    EXPECT_EQ(a.nodes[i].leaf, b.nodes[i].leaf) << i;
+    EXPECT_EQ(a.nodes[i].axis, b.nodes[i].axis) << i;
+    EXPECT_EQ(a.nodes[i].split, b.nodes[i].split) << i;
+    EXPECT_EQ(a.nodes[i].child, b.nodes[i].child) << i;
+    EXPECT_EQ(a.nodes[i].first, b.nodes[i].first) << i;
+    EXPECT_EQ(a.nodes[i].count, b.nodes[i].count) << i;
+  }
+}
+
 TEST(KdTree, Deterministic) {
   const Mesh m = random_triangles(900, 77, 4.0f, 1.0f);
   const KdTree a = build_kdtree(m.pos, m.tris, {});
   const KdTree b = build_kdtree(m.pos, m.tris, {});
-  ASSERT_EQ(a.nodes.size(), b.nodes.size());
-  for (std::size_t i = 0; i < a.nodes.size(); ++i) {
-    EXPECT_EQ(a.nodes[i].leaf, b.nodes[i].leaf);
-    EXPECT_EQ(a.nodes[i].split, b.nodes[i].split);
-    EXPECT_EQ(a.nodes[i].child, b.nodes[i].child);
-    EXPECT_EQ(a.nodes[i].first, b.nodes[i].first);
-  }
+  expect_same_nodes(a, b);
   EXPECT_EQ(a.items, b.items);
 }
 
@@ -1357,13 +1364,7 @@ TEST(KdTree, ChainLinksAreCountedAndSameAxisLinksMerge) {
   // Merging again changes nothing: the array is written in the builder's order.
   KdTree again = m;
   kd_merge_empty_chains(again);
-  ASSERT_EQ(again.nodes.size(), m.nodes.size());
-  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
-    EXPECT_EQ(again.nodes[i].leaf, m.nodes[i].leaf);
-    EXPECT_EQ(again.nodes[i].split, m.nodes[i].split);
-    EXPECT_EQ(again.nodes[i].child, m.nodes[i].child);
-    EXPECT_EQ(again.nodes[i].count, m.nodes[i].count);
-  }
+  expect_same_nodes(again, m);
 }
 
 // The rules on built trees: merging leaves the non-empty leaves as they are and no mergeable link;
