@@ -266,8 +266,13 @@ int chain_link(const std::vector<KdTreeNode>& nodes, const KdTreeNode& nd, std::
 // is reached, then its left subtree, then its right one), so a tree without mergeable links comes
 // out unchanged; leaf lists are not moved.
 void kd_merge_empty_chains(KdTree& tree) {
-  if (tree.nodes.empty()) return;
   const std::vector<KdTreeNode>& in = tree.nodes;
+  // Most trees have no mergeable link (the builder puts an empty cut at the items' outermost
+  // bound): one read-only pass over the array, no rewrite.
+  const auto mergeable = [&](const KdTreeNode& nd) {
+    return !nd.leaf && chain_link(in, nd, nd.child, nd.child + 1) == 2;
+  };
+  if (std::none_of(in.begin(), in.end(), mergeable)) return;
   std::vector<KdTreeNode> out;
   out.reserve(in.size());
   out.push_back(in[0]);
