@@ -245,11 +245,17 @@ bool is_empty_leaf(const KdTreeNode& nd) {
 int chain_link(const std::vector<KdTreeNode>& nodes, const KdTreeNode& nd, std::uint32_t l,
                std::uint32_t r) {
   for (int empty_side = 0; empty_side < 2; ++empty_side) {
-    if (!is_empty_leaf(nodes[empty_side == 0 ? l : r])) continue;
+    if (!is_empty_leaf(nodes[empty_side == 0 ? l : r])) {
+      continue;
+    }
     const KdTreeNode& other = nodes[empty_side == 0 ? r : l];
-    if (other.leaf) continue;
+    if (other.leaf) {
+      continue;
+    }
     const bool same_side = is_empty_leaf(nodes[other.child + empty_side]);
-    if (!same_side && !is_empty_leaf(nodes[other.child + 1 - empty_side])) continue;
+    if (!same_side && !is_empty_leaf(nodes[other.child + 1 - empty_side])) {
+      continue;
+    }
     return same_side && other.axis == nd.axis ? 2 : 1;
   }
   return 0;
@@ -272,7 +278,9 @@ void kd_merge_empty_chains(KdTree& tree) {
   const auto mergeable = [&](const KdTreeNode& nd) {
     return !nd.leaf && chain_link(in, nd, nd.child, nd.child + 1) == 2;
   };
-  if (std::none_of(in.begin(), in.end(), mergeable)) return;
+  if (std::none_of(in.begin(), in.end(), mergeable)) {
+    return;
+  }
   std::vector<KdTreeNode> out;
   out.reserve(in.size());
   out.push_back(in[0]);
@@ -478,9 +486,10 @@ const KdBuildParams& Builder::checked(const KdBuildParams& p) {
     throw std::runtime_error(
         "kd-tree: node bound needs 0 <= nodes per item <= 1e6 (0: no bound) and a floor >= 0");
   if (p.empty_chains < KdBuildParams::kChainsAllowed ||
-      p.empty_chains > KdBuildParams::kChainsForbidden)
+      p.empty_chains > KdBuildParams::kChainsForbidden) {
     throw std::runtime_error("kd-tree: empty-chain rule " + std::to_string(p.empty_chains) +
                              " outside 0..2");
+  }
   if (p.bins < 2 || p.bins > kMaxBins)
     throw std::runtime_error("kd-tree: bins " + std::to_string(p.bins) + " outside 2.." +
                              std::to_string(kMaxBins));
@@ -603,7 +612,9 @@ void Builder::run() {
   root_half_area_ = half_area(root_);
   min_half_area_ = root_half_area_ * kMinAreaShare;
   bin_node(0, 0, root_, 0, static_cast<std::uint32_t>(n), false);
-  if (p_.empty_chains == KdBuildParams::kChainsMerged) kd_merge_empty_chains(tree_);
+  if (p_.empty_chains == KdBuildParams::kChainsMerged) {
+    kd_merge_empty_chains(tree_);
+  }
 }
 
 // The exact stage for a subtree: events from the items' bounds (already on the grid), with
@@ -1159,7 +1170,9 @@ Split Builder::find_split(const Box& box, const std::size_t b[3], const std::siz
       pending = 0;
       np = 0;
     }
-    if (p_.face_slabs) face_slabs(box, k, sum, prod, b[k], e[k], n, kt, inv_area, no_empty, face);
+    if (p_.face_slabs) {
+      face_slabs(box, k, sum, prod, b[k], e[k], n, kt, inv_area, no_empty, face);
+    }
   }
   // A face slab wins when it is cheaper, and also when no other plane beats the leaf but the slab
   // lies within the slack (build_node applies the slack to it).
@@ -1188,7 +1201,9 @@ void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::si
     const double al = (static_cast<double>(x) - lo) * sum + prod;
     const double ar = (static_cast<double>(hi) - x) * sum + prod;
     // The interior side is empty where every item lies in the face.
-    if (no_empty && (nl == 0 || nr == 0)) return;
+    if (no_empty && (nl == 0 || nr == 0)) {
+      return;
+    }
     const double cost = plane_cost(kt, al, ar, nl, nr, inv_area);
     if (cost < best.cost) best = Split{cost, k, ordered(x), true, true};
   };

@@ -19,7 +19,9 @@ struct Walk {
 // takes them, split into the nodes the traversal unit steps into and the entries it hands on.
 Walk walk(const KdTree& tree) {
   Walk w;
-  if (tree.nodes.empty()) return w;
+  if (tree.nodes.empty()) {
+    return w;
+  }
   using Box = std::array<std::array<double, 3>, 2>;
   const auto half_area = [](const Box& b) {
     const double x = b[1][0] - b[0][0], y = b[1][1] - b[0][1], z = b[1][2] - b[0][2];
@@ -40,7 +42,9 @@ Walk walk(const KdTree& tree) {
     const KdTreeNode& nd = tree.nodes[n];
     const double pr = root_area > 0.0 ? half_area(box) / root_area : 1.0;
     if (nd.leaf) {
-      if (nd.count == 0) continue;  // flagged empty in its parent: never fetched
+      if (nd.count == 0) {  // flagged empty in its parent: never fetched
+        continue;
+      }
       w.steps += pr;
       w.tests += pr * nd.count;
       continue;
@@ -86,8 +90,9 @@ KdUnitLoads kd_unit_loads(const KdTree& tree) {
 
 std::vector<float> kd_objective_ladder(float traversal_cost) {
   std::vector<float> v;
-  for (int i = -4; i <= 4; ++i)
+  for (int i = -4; i <= 4; ++i) {
     v.push_back(static_cast<float>(traversal_cost * std::exp2(0.5 * i)));
+  }
   return v;
 }
 
@@ -123,10 +128,14 @@ KdTree build_kdtree_for_units(std::span<const glm::vec3> positions,
     p.traversal_cost = ladder[static_cast<std::size_t>(i)];
     KdTree t = build_kdtree(positions, tris, skip, p);
     const KdUnitLoads u = kd_unit_loads(t);
-    if (u.busiest() > best_loads.busiest()) break;
+    if (u.busiest() > best_loads.busiest()) {
+      break;
+    }
     const double s = sah(t);
     const bool better = u.busiest() < best_loads.busiest() || s < best_sah;
-    if (!better) continue;
+    if (!better) {
+      continue;
+    }
     best = std::move(t);
     best_loads = u;
     best_sah = s;
