@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "host/tree_objective.h"
 
 namespace {
 
@@ -132,6 +136,36 @@ TEST_F(SceneCmd, TreeKeysChangeTheTrees) {
   EXPECT_EQ(json::parse(c.out)["kdtree"]["bottom"]["empty_chain_links"].get<int>(), 0);
   expect_one_line_error("builtin:room --set threads=4", "unknown --set key 'threads'");
   expect_one_line_error("builtin:room --set kd.max_depth=-3", "bad --set kd.max_depth=-3");
+}
+
+// Each bottom tree records the K_T it was built with and its expected unit cycles per packet: the
+// configured K_T without the objective, a rung of the ladder with it (the room's tree leans to
+// the transformation unit, so the walk goes to cheaper steps). The top level keeps the plain SAH
+// and has no such record.
+TEST_F(SceneCmd, BottomTreesRecordTheObjectivesChoice) {
+  const CmdResult a = run("builtin:room --json");
+  const CmdResult b = run("builtin:room --json --set kd.objective=1");
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  const json ja = json::parse(a.out)["kdtree"];
+  const json jb = json::parse(b.out)["kdtree"];
+  EXPECT_FALSE(ja["top"].contains("traversal_cost"));
+  EXPECT_FALSE(ja["top"].contains("expected_unit_cycles"));
+  const json& oa = ja["bottom"]["objects"][0];
+  const json& ob = jb["bottom"]["objects"][0];
+  EXPECT_EQ(oa["traversal_cost"].get<double>(), 30.0);
+  const json& ua = oa["expected_unit_cycles"];
+  EXPECT_GT(ua["transformation"].get<double>(), ua["traversal"].get<double>());
+  // P + 1 transformation and P intersection cycles per list entry of a 4-ray packet.
+  EXPECT_NEAR(ua["transformation"].get<double>(), 5.0 * ua["list"].get<double>(), 1e-9);
+  EXPECT_NEAR(ua["intersection"].get<double>(), 4.0 * ua["list"].get<double>(), 1e-9);
+  const double kt = ob["traversal_cost"].get<double>();
+  EXPECT_LT(kt, 30.0);
+  const std::vector<float> ladder = saarcor::host::kd_objective_ladder(30.0f);
+  EXPECT_NE(std::find(ladder.begin(), ladder.end(), static_cast<float>(kt)), ladder.end()) << kt;
+  const json& ub = ob["expected_unit_cycles"];
+  EXPECT_LT(std::max(ub["traversal"].get<double>(), ub["transformation"].get<double>()),
+            ua["transformation"].get<double>());
 }
 
 TEST_F(SceneCmd, TextReportNamesEveryFigure) {
