@@ -730,6 +730,9 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
       params.tree_objective != static_cast<int>(KdObjective::kBusiestUnit))
     throw std::runtime_error("kd-tree objective " + std::to_string(params.tree_objective) +
                              " must be 0 (SAH sum) or 1 (busiest unit)");
+  if (!(params.tree_objective_ratio >= 1.0f && params.tree_objective_ratio <= 1e6f))
+    throw std::runtime_error("kd-tree objective ratio " +
+                             std::to_string(params.tree_objective_ratio) + " must be 1..1e6");
   if (params.top_level_buffers != 1 && params.top_level_buffers != 2)
     throw std::runtime_error("top-level copies " + std::to_string(params.top_level_buffers) +
                              " must be 1 or 2 (double-buffered)");
@@ -803,7 +806,8 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
       kd.max_depth = bottom_level_depth(params, n - info.dropped, scene.instances.size());
       info.tree = build_kdtree_for_units(
           std::span<const glm::vec3>(obj.positions), std::span<const glm::uvec3>(obj.triangles),
-          std::span<const std::uint8_t>(skip), kd, static_cast<KdObjective>(params.tree_objective));
+          std::span<const std::uint8_t>(skip), kd, static_cast<KdObjective>(params.tree_objective),
+          params.tree_objective_ratio);
     }
     const double secs = seconds_since(t0);
     b.stats.bottom_build_seconds += secs;

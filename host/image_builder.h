@@ -39,6 +39,9 @@ struct ImageParams {
   // sum at kd.traversal_cost, 1 = the K_T ladder's tree with the lowest busiest-unit load. The
   // top level keeps the plain sum (docs/kdtree.md "Busiest unit").
   int tree_objective = 0;
+  // With the objective, only a tree whose SAH-expected traversal and transformation loads differ
+  // by this factor or more is walked ("overloads one unit while others idle"); 1: every tree.
+  float tree_objective_ratio = 1.0f;
   // Traversal stack entries per packet in the hardware (the prototype's 64, shared by both
   // levels): the top level's depth limit plus every bottom tree's must fit it, so the builder
   // caps the bottom trees' depth at stack_entries minus the top's (docs/kdtree.md).

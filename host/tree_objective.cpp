@@ -98,7 +98,8 @@ std::vector<float> kd_objective_ladder(float traversal_cost) {
 
 KdTree build_kdtree_for_units(std::span<const glm::vec3> positions,
                               std::span<const glm::uvec3> tris, std::span<const std::uint8_t> skip,
-                              const KdBuildParams& params, KdObjective objective) {
+                              const KdBuildParams& params, KdObjective objective,
+                              double min_ratio) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto since = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -108,9 +109,15 @@ KdTree build_kdtree_for_units(std::span<const glm::vec3> positions,
     record(best, params, params.traversal_cost, since());
     return best;
   }
+  KdUnitLoads best_loads = kd_unit_loads(best);
+  const double lighter = std::min(best_loads.traversal, best_loads.transformation);
+  const double heavier = std::max(best_loads.traversal, best_loads.transformation);
+  if (heavier < min_ratio * lighter) {
+    record(best, params, params.traversal_cost, since());
+    return best;
+  }
   const std::vector<float> ladder = kd_objective_ladder(params.traversal_cost);
   const int middle = static_cast<int>(ladder.size()) / 2;
-  KdUnitLoads best_loads = kd_unit_loads(best);
   // The SAH cost at the configured costs breaks ties (the plain sum is the better tree when the
   // busiest unit does not care).
   const auto sah = [&](const KdTree& t) {

@@ -48,10 +48,14 @@ std::vector<float> kd_objective_ladder(float traversal_cost);
 // build_kdtree's tree. kBusiestUnit starts at the configured K_T and walks the ladder towards
 // the lighter unit (up while traversal is the busiest, down while transformation is) as long as
 // the busiest unit's load does not rise; ties go to the lower SAH cost at the configured costs.
-// Every rung is built with the node bound. Either way the stats' sah_cost is at the configured
-// costs, build_seconds counts every rung, and the chosen K_T and unit loads are recorded.
+// Every rung is built with the node bound. A tree whose plain loads of the two units the walk
+// trades (traversal and transformation) differ by less than `min_ratio` is not walked: the
+// objective is for trees that overload one unit while the other idles. Either way the stats'
+// sah_cost is at the configured costs, build_seconds counts every rung, and the chosen K_T and
+// unit loads are recorded.
 KdTree build_kdtree_for_units(std::span<const glm::vec3> positions,
                               std::span<const glm::uvec3> tris, std::span<const std::uint8_t> skip,
-                              const KdBuildParams& params, KdObjective objective);
+                              const KdBuildParams& params, KdObjective objective,
+                              double min_ratio = 1.0);
 
 }  // namespace saarcor::host

@@ -124,6 +124,29 @@ TEST(TreeObjective, TestHeavyTreeGetsCheaperSteps) {
   EXPECT_DOUBLE_EQ(t.stats.sah_cost, compute_kdtree_stats(t, p).sah_cost);
 }
 
+// The guard: a tree whose plain traversal and transformation loads differ by less than the ratio
+// keeps its plain tree; one whose loads differ by more is walked as without the guard.
+TEST(TreeObjective, RatioGuardWalksOnlyOverloadedTrees) {
+  const Mesh m = lattice(6);
+  KdBuildParams p;
+  p.traversal_cost = 2.0f;
+  const KdTree plain = build_kdtree(m.pos, m.tris, {}, p);
+  const KdUnitLoads pu = kd_unit_loads(plain);
+  const double ratio = pu.traversal / pu.transformation;
+  ASSERT_GT(ratio, 1.0);
+  const KdTree kept =
+      build_kdtree_for_units(m.pos, m.tris, {}, p, KdObjective::kBusiestUnit, ratio * 1.01);
+  EXPECT_TRUE(same_tree(kept, plain));
+  EXPECT_EQ(kept.stats.chosen_traversal_cost, 2.0);
+  EXPECT_DOUBLE_EQ(kept.stats.expected_traversal_cycles, pu.traversal);
+  const KdTree walked =
+      build_kdtree_for_units(m.pos, m.tris, {}, p, KdObjective::kBusiestUnit, ratio * 0.99);
+  const KdTree unguarded = build_kdtree_for_units(m.pos, m.tris, {}, p, KdObjective::kBusiestUnit);
+  EXPECT_FALSE(same_tree(walked, plain));
+  EXPECT_TRUE(same_tree(walked, unguarded));
+  EXPECT_EQ(walked.stats.chosen_traversal_cost, unguarded.stats.chosen_traversal_cost);
+}
+
 TEST(TreeObjective, LadderIsGeometricAroundTheConfiguredCost) {
   const std::vector<float> l = kd_objective_ladder(30.0f);
   ASSERT_EQ(l.size(), 9u);
@@ -140,6 +163,10 @@ TEST(TreeObjective, KeyIsATreeSetting) {
   EXPECT_EQ(p.tree_objective, 1);
   EXPECT_THROW(apply_tree_setting(p, "kd.objective=2"), std::runtime_error);
   EXPECT_THROW(apply_tree_setting(p, "kd.objective=0.5"), std::runtime_error);
+  EXPECT_EQ(p.tree_objective_ratio, 1.0f);
+  apply_tree_setting(p, "kd.objective_ratio=2");
+  EXPECT_EQ(p.tree_objective_ratio, 2.0f);
+  EXPECT_THROW(apply_tree_setting(p, "kd.objective_ratio=0.5"), std::runtime_error);
 }
 
 }  // namespace

@@ -80,6 +80,12 @@ const std::vector<Binding>& bindings() {
         0, 1},
        true,
        SAARCOR_TREE_FIELD(tree_objective, int)},
+      {{"kd.objective_ratio", 0, "factor",
+        "kd.objective=1 walks only the trees whose SAH-expected traversal and transformation "
+        "loads differ by at least this factor (1 = every tree); the others keep the plain tree",
+        1, 1e6},
+       false,
+       SAARCOR_TREE_FIELD(tree_objective_ratio, float)},
       {{"kd.stack", 0, "entries",
         "traversal stack entries the trees are built for (both levels share them)", 2, 4096},
        true,

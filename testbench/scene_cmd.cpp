@@ -81,9 +81,9 @@ Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& pa
     for (std::size_t k = 0; k < obj.triangles.size(); ++k)
       live += obj.degenerate[k] ? 0 : 1;
     kd.max_depth = host::bottom_level_depth(params, live, scene.instances.size());
-    const host::KdTree tree =
-        host::build_kdtree_for_units(obj.positions, obj.triangles, obj.degenerate, kd,
-                                     static_cast<host::KdObjective>(params.tree_objective));
+    const host::KdTree tree = host::build_kdtree_for_units(
+        obj.positions, obj.triangles, obj.degenerate, kd,
+        static_cast<host::KdObjective>(params.tree_objective), params.tree_objective_ratio);
     t.bottom.emplace_back(static_cast<std::uint32_t>(o), tree.stats);
   }
   std::vector<host::Aabb> boxes;
