@@ -1640,6 +1640,7 @@ KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params
   std::uint64_t listed = 0;
   double steps = 0.0;
   double leaf_visits = 0.0;
+  double fetched = 0.0;
   double tests = 0.0;
   while (!stack.empty()) {
     const Item it = stack.back();
@@ -1653,6 +1654,7 @@ KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params
       if (nd.count == 0) ++st.empty_leaves;
       listed += nd.count;
       leaf_visits += pr;
+      fetched += nd.count != 0 ? pr : 0.0;
       tests += pr * nd.count;
       continue;
     }
@@ -1671,6 +1673,7 @@ KdTreeStats compute_kdtree_stats(const KdTree& tree, const KdBuildParams& params
   st.items_per_leaf = full > 0 ? static_cast<double>(listed) / full : 0.0;
   st.expected_traversal_steps = steps;
   st.expected_leaf_visits = leaf_visits;
+  st.expected_fetched_leaves = fetched;
   st.expected_item_tests = tests;
   st.sah_cost = params.traversal_cost * steps + params.intersection_cost * tests;
   return st;

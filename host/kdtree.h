@@ -115,6 +115,9 @@ struct KdTreeStats {
   // SAH-expected per ray (surface-area probabilities relative to the root box).
   double expected_traversal_steps = 0.0;
   double expected_leaf_visits = 0.0;
+  // Of those, the non-empty leaves: with the inner nodes, the nodes the traversal unit fetches
+  // (an empty child is skipped in its parent, traversal.skip_empty).
+  double expected_fetched_leaves = 0.0;
   double expected_item_tests = 0.0;
   double build_seconds = 0.0;  // every build of the node bound's search included
   // The node bound's cost per node (in SAH cost units at the root), 0 when the first build fit.

@@ -2,73 +2,22 @@
 #include "host/tree_objective.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 
 namespace saarcor::host {
 namespace {
 
-struct Walk {
-  double steps = 0.0;  // inner nodes and non-empty leaves: the nodes the traversal unit fetches
-  double inner = 0.0;  // inner nodes only (the SAH's traversal steps)
-  double tests = 0.0;  // list entries, each a triangle test
-};
-
-// Surface-area probabilities of every node relative to the root box, as compute_kdtree_stats
-// takes them, split into the nodes the traversal unit steps into and the entries it hands on.
-Walk walk(const KdTree& tree) {
-  Walk w;
-  if (tree.nodes.empty()) {
-    return w;
-  }
-  using Box = std::array<std::array<double, 3>, 2>;
-  const auto half_area = [](const Box& b) {
-    const double x = b[1][0] - b[0][0], y = b[1][1] - b[0][1], z = b[1][2] - b[0][2];
-    return x * y + y * z + z * x;
-  };
-  Box root{};
-  if (!tree.bounds.empty()) {
-    for (int k = 0; k < 3; ++k) {
-      root[0][k] = tree.bounds.lo[k];
-      root[1][k] = tree.bounds.hi[k];
-    }
-  }
-  const double root_area = half_area(root);
-  std::vector<std::pair<std::uint32_t, Box>> stack{{0, root}};
-  while (!stack.empty()) {
-    const auto [n, box] = stack.back();
-    stack.pop_back();
-    const KdTreeNode& nd = tree.nodes[n];
-    const double pr = root_area > 0.0 ? half_area(box) / root_area : 1.0;
-    if (nd.leaf) {
-      if (nd.count == 0) {  // flagged empty in its parent: never fetched
-        continue;
-      }
-      w.steps += pr;
-      w.tests += pr * nd.count;
-      continue;
-    }
-    w.steps += pr;
-    w.inner += pr;
-    Box l = box;
-    Box r = box;
-    l[1][nd.axis] = nd.split;
-    r[0][nd.axis] = nd.split;
-    stack.push_back({nd.child + 1, r});
-    stack.push_back({nd.child, l});
-  }
-  return w;
-}
-
-KdUnitLoads loads_of(const Walk& w) {
-  return {kTraversalCyclesPerStep * w.steps, kListCyclesPerEntry * w.tests,
-          kTransformationCyclesPerTest * w.tests, kIntersectionCyclesPerTest * w.tests};
+// The SAH cost at the configured costs of a tree built at any K_T (the formula of
+// compute_kdtree_stats, on the expectations the builder already computed).
+double sah_at(const KdBuildParams& params, const KdTreeStats& s) {
+  return params.traversal_cost * s.expected_traversal_steps +
+         params.intersection_cost * s.expected_item_tests;
 }
 
 // The tree's stats at the configured costs, with the objective's record.
 void record(KdTree& tree, const KdBuildParams& params, float chosen, double seconds) {
-  tree.stats = compute_kdtree_stats(tree, params);
+  tree.stats.sah_cost = sah_at(params, tree.stats);
   tree.stats.build_seconds = seconds;
   const KdUnitLoads u = kd_unit_loads(tree);
   tree.stats.chosen_traversal_cost = chosen;
@@ -85,7 +34,12 @@ double KdUnitLoads::busiest() const {
 }
 
 KdUnitLoads kd_unit_loads(const KdTree& tree) {
-  return loads_of(walk(tree));
+  const KdTreeStats& s = tree.stats;
+  // The nodes the traversal unit fetches: inner nodes and non-empty leaves.
+  const double steps = s.expected_traversal_steps + s.expected_fetched_leaves;
+  const double tests = s.expected_item_tests;
+  return {kTraversalCyclesPerStep * steps, kListCyclesPerEntry * tests,
+          kTransformationCyclesPerTest * tests, kIntersectionCyclesPerTest * tests};
 }
 
 std::vector<float> kd_objective_ladder(float traversal_cost) {
@@ -120,11 +74,7 @@ KdTree build_kdtree_for_units(std::span<const glm::vec3> positions,
   const int middle = static_cast<int>(ladder.size()) / 2;
   // The SAH cost at the configured costs breaks ties (the plain sum is the better tree when the
   // busiest unit does not care).
-  const auto sah = [&](const KdTree& t) {
-    const Walk w = walk(t);
-    return params.traversal_cost * w.inner + params.intersection_cost * w.tests;
-  };
-  double best_sah = sah(best);
+  double best_sah = sah_at(params, best.stats);
   float chosen = params.traversal_cost;
   // Dearer steps trade traversal steps for triangle tests and cheaper ones the reverse, so the
   // walk goes towards the unit that is not the busiest and stops where the busiest load rises
@@ -138,7 +88,7 @@ KdTree build_kdtree_for_units(std::span<const glm::vec3> positions,
     if (u.busiest() > best_loads.busiest()) {
       break;
     }
-    const double s = sah(t);
+    const double s = sah_at(params, t.stats);
     const bool better = u.busiest() < best_loads.busiest() || s < best_sah;
     if (!better) {
       continue;

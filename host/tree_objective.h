@@ -38,6 +38,7 @@ struct KdUnitLoads {
   double busiest() const;
 };
 
+// From the expectations compute_kdtree_stats stored in tree.stats (a built tree's).
 KdUnitLoads kd_unit_loads(const KdTree& tree);
 
 // The K_T values a busiest-unit build may use: K_T * 2^(i/2) for i = -4..4 (K_T / 4 .. 4 K_T),
