@@ -1,6 +1,7 @@
 // The memory image (DESIGN.md section 4; memif/image_format.h): encode then decode, layout and
 // capacity accounting, overflow errors, texture and texcoord encoding, per-frame upload.
 #include "host/image_builder.h"
+#include "host/tree_settings.h"
 
 #include <gtest/gtest.h>
 
@@ -222,6 +223,24 @@ TEST(ImageBuilder, FrameRegisters) {
   EXPECT_EQ(r.epsilon, ff::from_double(1e-4 * glm::length(diag), ff::kFp24, {}));
   p.epsilon = 0.5;
   EXPECT_EQ(build_image(s, p).image.registers().epsilon, ff::from_double(0.5, ff::kFp24, {}));
+}
+
+TEST(ImageBuilder, TheCameraKeyChoosesTheRegistersCamera) {
+  Scene s = few_triangles();
+  for (const float z : {5.0f, 9.0f}) {
+    Camera c;
+    c.position = {0.5f, 0.5f, z};
+    c.forward = {0, 0, -1};
+    c.up = {0, 1, 0};
+    c.yfov = 0.8f;
+    s.cameras.push_back(c);
+  }
+  ImageParams p = small_params();
+  EXPECT_EQ(build_image(s, p).camera.position.z, 5.0f);  // -1: the first camera
+  apply_tree_setting(p, "image.camera=1");
+  const BuiltImage b = build_image(s, p);
+  EXPECT_EQ(b.camera.position.z, 9.0f);
+  EXPECT_EQ(b.image.registers().cam_p[2], ff::from_double(9.0, ff::kFp24, {}));
 }
 
 TEST(ImageBuilder, GridWithTwoInstances) {

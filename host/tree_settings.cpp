@@ -96,6 +96,12 @@ const std::vector<Binding>& bindings() {
         0, 1},
        true,
        SAARCOR_TREE_FIELD(bilinear, bool)},
+      {{"image.camera", 0, "index",
+        "the scene's camera the frame is rendered from: -1 = its first (a default view if it has "
+        "none), k = camera k of the scene's list (saarcor scene counts them)",
+        -1, 1e6},
+       true,
+       SAARCOR_TREE_FIELD(camera, int)},
   };
   return table;
 }

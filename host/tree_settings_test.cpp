@@ -53,6 +53,8 @@ TEST(TreeSettings, SetThenDescribeGivesTheValueBack) {
   apply_tree_setting(p, "kd.nodes_per_item=3.5");
   apply_tree_setting(p, "kd.node_floor=1000");
   apply_tree_setting(p, "kd.empty_chains=2");
+  apply_tree_setting(p, "image.camera=2");
+  EXPECT_EQ(p.camera, 2);
   EXPECT_EQ(p.kd.empty_chains, KdBuildParams::kChainsForbidden);
   EXPECT_TRUE(p.kd.leaf_step);
   EXPECT_EQ(p.kd.max_nodes_per_item, 3.5f);
@@ -78,6 +80,8 @@ TEST(TreeSettings, BadValuesAreOneLineErrors) {
   EXPECT_EQ(error_of(p, "kd.max_depth=-2"), "bad --set kd.max_depth=-2: expected -1..1000 levels");
   EXPECT_EQ(error_of(p, "kd.stack=1"), "bad --set kd.stack=1: expected 2..4096 entries");
   EXPECT_EQ(error_of(p, "kd.empty_chains=3"), "bad --set kd.empty_chains=3: expected 0..2 rule");
+  EXPECT_EQ(error_of(p, "image.camera=-2"),
+            "bad --set image.camera=-2: expected -1..1000000 index");
   EXPECT_EQ(error_of(p, "kd.traversal_cost=nan"), "bad --set kd.traversal_cost=nan: not a number");
   EXPECT_EQ(error_of(p, "kd.face_slabs"), "bad --set 'kd.face_slabs': expected KEY=VALUE");
   EXPECT_EQ(

@@ -323,6 +323,8 @@ TEST(SaarcorBinary, OneLineErrors) {
       saarcor("compare " + (d / "junk.exr").string() + " " + (d / "junk.exr").string()),
       "junk.exr: cannot read image");
   expect_one_line_error(saarcor("precision builtin:cube --mantissa 8..30"), "bad --mantissa");
+  expect_one_line_error(saarcor("render builtin:cube --res 8x8 --set image.camera=1"),
+                        "camera 1 does not exist (the scene has 1 cameras)");
 }
 
 }  // namespace
