@@ -199,6 +199,10 @@ int run_scene(const SceneOptions& options) {
   j["lights"] = scene.lights.size();
   j["light_defaulted"] = scene.light_defaulted;
   j["cameras"] = scene.cameras.size();
+  j["camera_names"] = json::array();
+  for (const host::Camera& c : scene.cameras) {
+    j["camera_names"].push_back(c.name);
+  }
   j["animation_seconds"] = scene.animation_seconds;
   j["dropped_triangles"] = scene.dropped_triangles();
   j["dropped_triangles_instanced"] = scene.instanced_dropped_triangles();
@@ -236,8 +240,16 @@ int run_scene(const SceneOptions& options) {
   std::printf("materials/textures  %zu / %zu\n", scene.materials.size(), scene.textures.size());
   std::printf("lights              %zu%s\n", scene.lights.size(),
               scene.light_defaulted ? " (default light)" : "");
+  // The cameras by index, the values --set image.camera takes (the first eight).
+  std::string views;
+  for (std::size_t c = 0; c < scene.cameras.size() && c < 8; ++c) {
+    views += (c == 0 ? ": " : ", ") + std::to_string(c) + " " + scene.cameras[c].name;
+  }
+  if (scene.cameras.size() > 8) {
+    views += ", ...";
+  }
   std::printf("cameras             %zu%s\n", scene.cameras.size(),
-              scene.cameras.empty() ? " (default framing)" : "");
+              scene.cameras.empty() ? " (default framing)" : views.c_str());
   std::printf("animation           %.3f s\n", scene.animation_seconds);
   std::printf("load time           %.3f s\n", load_seconds);
   const auto tree_line = [](const char* name, const KdTreeStats& s) {

@@ -179,6 +179,16 @@ TEST_F(SceneCmd, TextReportNamesEveryFigure) {
     EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
 }
 
+TEST_F(SceneCmd, CamerasAreListedByTheIndexImageCameraTakes) {
+  const CmdResult text = run("builtin:suncor");
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("cameras             3: 0 field, 1 above, 2 heads\n"), std::string::npos)
+      << text.out;
+  const CmdResult r = run("builtin:room --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out)["camera_names"], json::array({"door"}));
+}
+
 TEST_F(SceneCmd, TimeMovesTheAnimatedInstances) {
   const std::string box = kScenes + "/BoxAnimated/BoxAnimated.glb";
   const CmdResult r = run(box + " --time 1.875 --json");
