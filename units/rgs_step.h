@@ -253,16 +253,17 @@ class RgsStep {
     const memif::ShadingRecord rec = read_shading_record(t.image, record);
     read(t.image.registers().shading_record_base + memif::kShadingRecordWords * record,
          memif::kShadingRecordWords, 0);
-    s.mat = read_material(t.image, rec.material);
     if (rec.material != material_) {  // the packet's hits mostly share a material: read once
       material_ = rec.material;
+      material_record_ = read_material(t.image, rec.material);  // the register's decoded record
       // w0..w3; the refraction words only for a material w3 flags as refracting.
       const std::uint32_t a =
           t.image.registers().material_base + memif::kMaterialWords * rec.material;
       read(a, memif::kMaterialBaseWords, 1);
-      if (s.mat.refraction != 0)
+      if (material_record_.refraction != 0)
         read(a + memif::kMaterialBaseWords, memif::kMaterialWords - memif::kMaterialBaseWords, 2);
     }
+    s.mat = material_record_;
     s.base = base_colour(t.image, rec, s.mat, fix16(s.rec.u), fix16(s.rec.v),
                          [this](std::uint32_t a) { read(a, 1, 2); });
     const std::uint32_t shininess = s.mat.specular_rgb_shininess >> 24;
@@ -510,6 +511,7 @@ class RgsStep {
   std::vector<RgsAccess> mem_;             // the accesses of the request executing
   std::vector<std::uint32_t> pixels_;      // the primary packet's pixels (kNone: empty lane)
   std::uint32_t material_ = memif::kNone;  // the material read last in this shading pass
+  memif::MaterialRecord material_record_;  // its record, decoded once per read
   std::vector<Surface> surf_;
   std::uint32_t light_ = 0;
   Rgb8 light_rgb_{};
