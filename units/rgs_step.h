@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -101,13 +102,14 @@ class RgsStep {
       s.highlight = false;
       if (!s.hit) continue;
       const Vec3<F>& sd = t.lane(i).world.d;  // hit point - L
-      const F ns = shade_dot(t, s.n, sd);
-      const F ss = shade_dot(t, sd, sd);
+      const DotOperand ds = dot_operand(sd);  // decoded once for the light's two or three dots
+      const F ns = shade_dot(t, s.n, s.n_op, sd, ds);
+      const F ss = shade_dot(t, sd, ds, sd, ds);
       s.lit = is_neg_nonzero(ns);
       if (!s.lit) continue;
       s.cos = cosine(t, ns, s.nn, ss);
       if (s.spec) {
-        const F rl = shade_dot(t, s.r, sd);
+        const F rl = shade_dot(t, s.r, s.r_op, sd, ds);
         s.highlight = is_neg_nonzero(rl);
         if (s.highlight) s.cos_s = cosine(t, rl, s.rr, ss);
       }
@@ -139,6 +141,14 @@ class RgsStep {
   void begin_request() { mem_.clear(); }
 
  private:
+  // A vector as dot_step64 reads it: its components' exact values (meaningful when its range says
+  // normal or zero) and its exponent range. A hit's normal and reflected direction meet every
+  // light's shadow direction: decoded once, not per dot.
+  struct DotOperand {
+    V2d xy{};  // components 0 and 1
+    double z = 0.0;
+    ExponentRange range;
+  };
   // The RGS's per-lane surface context while it shades a packet's hits.
   struct Surface {
     bool hit = false;
@@ -150,6 +160,8 @@ class RgsStep {
     Vec3<F> n{};
     F nn{}, kk{}, rr{};
     Vec3<F> r{};  // reflected view direction (specular)
+    // n and r as the dot products read them, decoded once per hit for every light's dots.
+    DotOperand n_op{}, r_op{};
     bool spec = false;
     memif::MaterialRecord mat;
     Rgb8 base{}, spec_rgb{};
@@ -163,10 +175,85 @@ class RgsStep {
   static void count_transform(State& t, std::uint64_t steps) {
     PipelineUnits<F>::count(t.u.transformation_ops, 9 * steps, 9 * steps, 0, 0);
   }
+  static DotOperand dot_operand(const Vec3<F>& a) {
+    DotOperand o;
+    o.range.include(a[0]);
+    o.range.include(a[1]);
+    o.range.include(a[2]);
+    o.xy = decode_pair<F>(a[0].bits, a[1].bits);
+    o.z = decode_pair<F>(a[2].bits, a[2].bits)[0];
+    return o;
+  }
+  // dot_step64 on decoded operands: the same condition, the same ops on the same values.
+  static bool dot64(const DotOperand& a, const DotOperand& b, bool nearest, F& out) {
+    const int low = a.range.lo + b.range.lo - F::kManBits;
+    const int high = a.range.hi + b.range.hi + 2;
+    if (!(nearest & a.range.normal & b.range.normal & (low >= F::kFormat.emin()) &
+          (high + 2 <= F::kFormat.emax())))
+      return false;
+    const V2d p = a.xy * b.xy;
+    const double x = round_in_range<F>(p[0]);
+    const double y = round_in_range<F>(p[1]);
+    const double z = round_in_range<F>(a.z * b.z);
+    out = encoding_of<F>(round_in_range<F>(round_in_range<F>(x + y) + round_in_range<F>(z + 0.0)));
+    return true;
+  }
+
   // A direction step (ops counted by the caller) as three dot products: each of its rows is
   // dot_step's expression with the row as the first vector. With a matrix per lane (T_shadow, T_R)
-  // the rows' exponent ranges are cheaper than matrix_values for one step.
+  // the exponent ranges are cheaper than matrix_values for one step.
   static Vec3<F> direction_step(const State& t, const Mat34<F>& m, const Vec3<F>& v) {
+    Vec3<F> out;
+    direction_steps(t, m, v, m, v, out, out);
+    return out;
+  }
+  // dot_step64's condition for every row at once: the linear part's exponent range contains each
+  // row's, so where it holds, each row's holds too.
+  static bool direction_decides(const State& t, const Mat34<F>& m, const Vec3<F>& v) {
+    ExponentRange rm, rv;
+    for (int r = 0; r < 3; ++r) {
+      rm.include(m[r][0]);
+      rm.include(m[r][1]);
+      rm.include(m[r][2]);
+    }
+    rv.include(v[0]);
+    rv.include(v[1]);
+    rv.include(v[2]);
+    const int low = rm.lo + rv.lo - F::kManBits;
+    const int high = rm.hi + rv.hi + 2;
+    return t.nearest & rm.normal & rv.normal & (low >= F::kFormat.emin()) &
+           (high + 2 <= F::kFormat.emax());
+  }
+  // Two lanes' direction steps (a matrix each): where direction_decides holds, both lanes' rows go
+  // through dot_step64's ops together (one lane per half of a vector register: each lane's ops
+  // and values are its own, so its results are dot_step64's); otherwise the lane row by row. The
+  // two lanes may be the same (one step); out_a and out_b may then be the same vector.
+  static void direction_steps(const State& t, const Mat34<F>& ma, const Vec3<F>& va,
+                              const Mat34<F>& mb, const Vec3<F>& vb, Vec3<F>& out_a,
+                              Vec3<F>& out_b) {
+    const bool da = direction_decides(t, ma, va);
+    const bool same = &ma == &mb && &va == &vb;
+    const bool db = same ? da : direction_decides(t, mb, vb);
+    if (da | db) {
+      const V2d x[3] = {decode_pair<F>(va[0].bits, vb[0].bits),
+                        decode_pair<F>(va[1].bits, vb[1].bits),
+                        decode_pair<F>(va[2].bits, vb[2].bits)};
+      V2u e[3];
+      for (int r = 0; r < 3; ++r) {
+        const V2d a = round_in_range2<F>(decode_pair<F>(ma[r][0].bits, mb[r][0].bits) * x[0]);
+        const V2d b = round_in_range2<F>(decode_pair<F>(ma[r][1].bits, mb[r][1].bits) * x[1]);
+        const V2d c = round_in_range2<F>(decode_pair<F>(ma[r][2].bits, mb[r][2].bits) * x[2]);
+        e[r] = encode_pair<F>(
+            round_in_range2<F>(round_in_range2<F>(a + b) + round_in_range2<F>(c + 0.0)));
+      }
+      if (db) out_b = lane_of<F>(e, 1);
+      if (da) out_a = lane_of<F>(e, 0);
+    }
+    if (!da) out_a = direction_rows(t, ma, va);
+    if (!db && !same) out_b = direction_rows(t, mb, vb);
+  }
+  // The row-by-row direction step: dot_step64 per row where its condition holds, else dot_step.
+  static Vec3<F> direction_rows(const State& t, const Mat34<F>& m, const Vec3<F>& v) {
     ExponentRange rv;
     rv.include(v[0]);
     rv.include(v[1]);
@@ -185,10 +272,32 @@ class RgsStep {
     if (dot_step64<F>(a, b, t.nearest, r)) return r;
     return dot_step(t.u.raw, a, b);
   }
-  // -x / sqrt(a * b) on the RGS helper (1 mul, 1 sqrt, 1 div).
+  // The same with both vectors decoded already (dot_operand of a and of b).
+  static F shade_dot(State& t, const Vec3<F>& a, const DotOperand& da, const Vec3<F>& b,
+                     const DotOperand& db) {
+    PipelineUnits<F>::count(t.u.transformation_ops, 3, 3, 0, 0);
+    F r;
+    if (dot64(da, db, t.nearest, r)) return r;
+    return dot_step(t.u.raw, a, b);
+  }
+  // -x / sqrt(a * b) on the RGS helper (1 mul, 1 sqrt, 1 div). Normal operands in nearest-even:
+  // the three ops on binary64 values, each rounded to F's precision where round_to_format accepts
+  // it (what ff::fast's mul, sqrt and div compute and round: the product is exact, the root and
+  // the quotient double-rounded innocuously), without encoding the intermediates; anything else,
+  // or a result out of F's normal range, on the encodings.
   static F cosine(State& t, F x, F a, F b) {
     PipelineUnits<F>::count(t.u.rgs_ops, 0, 1, 1, 0);
     ++t.u.rgs_ops.sqrt;
+    using ff::fast::is_normal;
+    constexpr int E = F::kExpBits, M = F::kManBits;
+    if (t.nearest & is_normal<E, M>(x.bits) & is_normal<E, M>(a.bits) & is_normal<E, M>(b.bits)) {
+      bool ok = true;
+      const V2d ab = decode_pair<F>(a.bits, b.bits);
+      const double p = round_to_format<F>(ab[0] * ab[1], ok);
+      const double root = round_to_format<F>(std::sqrt(p), ok);
+      const double q = round_to_format<F>(-decode_pair<F>(x.bits, x.bits)[0] / root, ok);
+      if (ok) return encoding_of<F>(q);
+    }
     const auto& fp = t.u.raw;
     return fp.div(x.neg(), fp.sqrt(fp.mul(a, b)));
   }
@@ -247,34 +356,38 @@ class RgsStep {
     s.rec = l.hit;
     const memif::InstanceHeader h = t.image.instance_header(s.rec.instance);
     s.n = world_normal(t, h, s.rec);
-    s.nn = shade_dot(t, s.n, s.n);
+    s.n_op = dot_operand(s.n);
+    s.nn = shade_dot(t, s.n, s.n_op, s.n, s.n_op);
     t.u.shading_transformation_steps += 1;  // normal step; the dots count below
     const std::uint32_t record = h.shading_base + s.rec.triangle;
     const memif::ShadingRecord rec = read_shading_record(t.image, record);
     read(t.image.registers().shading_record_base + memif::kShadingRecordWords * record,
          memif::kShadingRecordWords, 0);
-    s.mat = read_material(t.image, rec.material);
     if (rec.material != material_) {  // the packet's hits mostly share a material: read once
       material_ = rec.material;
+      material_record_ = read_material(t.image, rec.material);  // the register's decoded record
       // w0..w3; the refraction words only for a material w3 flags as refracting.
       const std::uint32_t a =
           t.image.registers().material_base + memif::kMaterialWords * rec.material;
       read(a, memif::kMaterialBaseWords, 1);
-      if (s.mat.refraction != 0)
+      if (material_record_.refraction != 0)
         read(a + memif::kMaterialBaseWords, memif::kMaterialWords - memif::kMaterialBaseWords, 2);
     }
+    s.mat = material_record_;
     s.base = base_colour(t.image, rec, s.mat, fix16(s.rec.u), fix16(s.rec.v),
                          [this](std::uint32_t a) { read(a, 1, 2); });
     const std::uint32_t shininess = s.mat.specular_rgb_shininess >> 24;
     s.spec_rgb = unpack_rgb(s.mat.specular_rgb_shininess);
     s.spec = shininess >= 1 && (s.mat.specular_rgb_shininess & 0xFFFFFFu) != 0;
     const bool reflect = t.params.secondary && t.depth < max_depth_ && s.mat.reflectivity > 0;
-    if (s.spec || reflect) s.kk = twice_quotient(t, shade_dot(t, s.ray.d, s.n), s.nn);
+    if (s.spec || reflect)
+      s.kk = twice_quotient(t, shade_dot(t, s.ray.d, dot_operand(s.ray.d), s.n, s.n_op), s.nn);
     if (s.spec) {
       const Mat34<F> tr = reflect_matrix(s.ray, s.n);
       count_transform(t, 1);
       s.r = direction_step(t, tr, Vec3<F>{F::one(), s.kk.neg(), F::zero()});
-      s.rr = shade_dot(t, s.r, s.r);
+      s.r_op = dot_operand(s.r);
+      s.rr = shade_dot(t, s.r, s.r_op, s.r, s.r_op);
       t.u.shading_transformation_steps += 1;
     }
     for (int k = 0; k < 3; ++k)
@@ -339,9 +452,11 @@ class RgsStep {
     // Without shadow rays only the directions are needed: n direction steps, no origin step.
     t.u.shading_transformation_steps += static_cast<std::uint64_t>(t.p);
     count_transform(t, static_cast<std::uint64_t>(t.p));
-    for (int i = 0; i < t.p; ++i) {
-      const GenLane<F>& g = pk.lanes[static_cast<std::size_t>(i)];
-      t.lane(i).world.d = direction_step(t, g.t, g.rd);
+    for (int i = 0; i < t.p; i += 2) {  // two lanes at a time (P = 1: the lane with itself)
+      const int j = i + 1 < t.p ? i + 1 : i;
+      const GenLane<F>& ga = pk.lanes[static_cast<std::size_t>(i)];
+      const GenLane<F>& gb = pk.lanes[static_cast<std::size_t>(j)];
+      direction_steps(t, ga.t, ga.rd, gb.t, gb.rd, t.lane(i).world.d, t.lane(j).world.d);
     }
     shade_light(t);
   }
@@ -510,6 +625,7 @@ class RgsStep {
   std::vector<RgsAccess> mem_;             // the accesses of the request executing
   std::vector<std::uint32_t> pixels_;      // the primary packet's pixels (kNone: empty lane)
   std::uint32_t material_ = memif::kNone;  // the material read last in this shading pass
+  memif::MaterialRecord material_record_;  // its record, decoded once per read
   std::vector<Surface> surf_;
   std::uint32_t light_ = 0;
   Rgb8 light_rgb_{};

@@ -27,18 +27,32 @@ inline std::uint32_t mul8(std::uint32_t a, std::uint32_t b) {
 // Float to unsigned fixed point with `frac_bits` fraction bits, clamped to [0, 1]: a shifter on
 // the encoding in hardware, exact here (docs/shading.md: fix8, fix16). NaN gives 0.
 inline std::uint32_t to_unit_fixed(double x, int frac_bits) {
-  const double one = std::ldexp(1.0, frac_bits);
+  // 2^frac_bits as a shift (frac_bits <= 16): the same double as ldexp(1, frac_bits), without a
+  // libm call per texel coordinate and cosine.
+  const auto one = static_cast<double>(std::uint32_t{1} << frac_bits);
   if (!(x > 0.0)) return 0;
   if (x >= 1.0) return static_cast<std::uint32_t>(one);
   return static_cast<std::uint32_t>(std::floor(x * one + 0.5));
 }
+// The RGS's shifter on the encoding: a normal value is decoded inline; exponent field 0 (zero, or
+// a subnormal, which to_double reads as zero) gives 0 without the general decode, as it would
+// through it; infinities and NaN take the general decode.
+template <class F>
+inline std::uint32_t to_unit_fixed_of(F x, int frac_bits) {
+  constexpr std::uint32_t kExpMax = F::kFormat.exp_field_max();
+  const std::uint32_t e = (x.bits >> F::kManBits) & kExpMax;
+  if (e - 1u < kExpMax - 1u) [[likely]]
+    return to_unit_fixed(ff::fast::decode_normal<F::kExpBits, F::kManBits>(x.bits), frac_bits);
+  if (e == 0) return 0;
+  return to_unit_fixed(x.to_double(), frac_bits);
+}
 template <class F>
 inline std::uint32_t fix8(F x) {
-  return to_unit_fixed(x.to_double(), 8);
+  return to_unit_fixed_of(x, 8);
 }
 template <class F>
 inline std::uint32_t fix16(F x) {
-  return to_unit_fixed(x.to_double(), 16);
+  return to_unit_fixed_of(x, 16);
 }
 
 // The shading bank's records (docs/shading.md section 5).
