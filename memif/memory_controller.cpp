@@ -185,7 +185,7 @@ void MemoryController::start(int b, std::uint64_t when) {
   Bank& bank = banks_[static_cast<std::size_t>(b)];
   const Queued& q = bank.queue.front();  // leaves the queue last: read in place
   const MemRequest& r = q.req;
-  bank.free_at = when + r.words;
+  free_at_[static_cast<std::size_t>(b)] = when + r.words;
   *bank.words += r.words;
   *clients_[r.client].bytes += r.counted_bytes ? r.counted_bytes : 4u * r.words;
   // accept_requests checked the words are inside the bank.
@@ -222,17 +222,22 @@ void MemoryController::start(int b, std::uint64_t when) {
 
 int MemoryController::issue() {
   if (queued_ == 0) return 0;
+  // A path starts only a bank that has work and is free: the paths without one are not visited
+  // (their cycle would choose nothing and change nothing).
+  unsigned active = 0;  // the paths with a free queued bank, visited in path order
+  for (unsigned bits = queued_; bits != 0; bits &= bits - 1) {
+    const int b = std::countr_zero(bits);
+    if (free_at_[static_cast<std::size_t>(b)] <= now())
+      active |= path_bit_[static_cast<std::size_t>(b)];
+  }
   int started = 0;
-  unsigned active = 0;  // the paths with a queued bank, visited in path order
-  for (unsigned bits = queued_; bits != 0; bits &= bits - 1)
-    active |= path_bit_[static_cast<std::size_t>(std::countr_zero(bits))];
   for (; active != 0; active &= active - 1) {
     Path& path = paths_[static_cast<std::size_t>(std::countr_zero(active))];
     const unsigned waiting = path.banks & queued_;
     if (waiting == 0 || path.free_at > now()) continue;
     auto startable = [&](int b) {
       const Bank& bank = banks_[static_cast<std::size_t>(b)];
-      return (queued_ >> b & 1u) != 0 && bank.free_at <= now() &&
+      return (queued_ >> b & 1u) != 0 && free_at_[static_cast<std::size_t>(b)] <= now() &&
              static_cast<int>(bank.inflight.size()) < inflight_limit_;
     };
     auto older = [&](int b, int than) {
@@ -251,13 +256,12 @@ int MemoryController::issue() {
       // Stay on the open bank while it has work and the burst limit allows, waiting for it when
       // it becomes free no later than a switch would let another bank start: such a switch
       // would be needless. Otherwise switch to the free bank with the oldest request.
-      const Bank* open = path.open >= 0 ? &banks_[static_cast<std::size_t>(path.open)] : nullptr;
-      const bool open_wanted = open != nullptr && (queued_ >> path.open & 1u) != 0 &&
+      const bool open_wanted = path.open >= 0 && (queued_ >> path.open & 1u) != 0 &&
                                (path.burst < config_.max_burst || others_waiting == 0);
       if (open_wanted && startable(path.open)) {
         chosen = path.open;
-      } else if (open_wanted &&
-                 open->free_at <= now() + static_cast<std::uint64_t>(config_.switch_penalty)) {
+      } else if (open_wanted && free_at_[static_cast<std::size_t>(path.open)] <=
+                                    now() + static_cast<std::uint64_t>(config_.switch_penalty)) {
         chosen = -1;  // wait for the open bank
       } else {
         chosen = oldest_startable;
@@ -328,7 +332,7 @@ std::uint64_t MemoryController::next_wakeup(std::uint64_t now) const {
     const int b = std::countr_zero(bits);
     const Path& path =
         paths_[static_cast<std::size_t>(config_.bank_path[static_cast<std::size_t>(b)])];
-    const std::uint64_t ready = std::max(banks_[static_cast<std::size_t>(b)].free_at, path.free_at);
+    const std::uint64_t ready = std::max(free_at_[static_cast<std::size_t>(b)], path.free_at);
     if (ready > now) t = std::min(t, ready);
   }
   return t;
@@ -339,7 +343,7 @@ std::string MemoryController::dump_state() const {
   for (int b = 0; b < kNumBanks; ++b) {
     const Bank& bank = banks_[static_cast<std::size_t>(b)];
     os << "bank" << b << " queue " << bank.queue.size() << " in flight " << bank.inflight.size()
-       << " free at " << bank.free_at << (b + 1 < kNumBanks ? "; " : "");
+       << " free at " << free_at_[static_cast<std::size_t>(b)] << (b + 1 < kNumBanks ? "; " : "");
   }
   return os.str();
 }

@@ -109,8 +109,7 @@ class MemoryController : public hw::Module {
   // written where it waits.
   struct Bank {
     Fifo<Queued> queue;
-    Fifo<InFlight> inflight;    // reads, in start order (due cycles increase)
-    std::uint64_t free_at = 0;  // first cycle the bank can start another request
+    Fifo<InFlight> inflight;  // reads, in start order (due cycles increase)
     hw::Counter* reads = nullptr;
     hw::Counter* writes = nullptr;
     hw::Counter* words = nullptr;
@@ -147,6 +146,7 @@ class MemoryController : public hw::Module {
   // is its front request's arrival number and due_[b] its front read's due cycle.
   unsigned queued_ = 0, inflight_ = 0;
   std::array<std::uint64_t, kNumBanks> oldest_{}, due_{};
+  std::array<std::uint64_t, kNumBanks> free_at_{};  // first cycle a bank can start another request
   // The earliest due_ (kNever with nothing in flight): before it no read can leave, and the
   // retire stage is not entered (most cycles with reads in flight have none due).
   std::uint64_t next_due_ = hw::kNever;
