@@ -2,6 +2,7 @@
 #include "memif/cache.h"
 
 #include <algorithm>
+#include <bit>
 #include <sstream>
 #include <stdexcept>
 
@@ -33,14 +34,18 @@ std::string Cache::check(std::string name, const CacheConfig& config, int words)
 Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryImage& image,
              std::uint16_t client, CacheConfig config)
     : hw::Module(kernel, check(std::move(name), config, image.item_words(type))),
+      request0_(nullptr),
+      one_port_(config.ports == 1),
+      ways_(config.ways),
+      sets_(config.ways > 0 ? config.items / config.ways : 0),
+      words_(image.item_words(type)),
+      filled_(config.max_misses),
+      fills_(kernel, this->name() + ".fill", std::max(1, config.memory_capacity), 1),
       type_(type),
       image_(image),
       client_(client),
       config_(config),
-      words_(image.item_words(type)),
-      sets_(config.ways > 0 ? config.items / config.ways : 0),
-      mem_requests_(kernel, this->name() + ".mem_req", std::max(1, config.memory_capacity), 1),
-      fills_(kernel, this->name() + ".fill", std::max(1, config.memory_capacity), 1) {
+      mem_requests_(kernel, this->name() + ".mem_req", std::max(1, config.memory_capacity), 1) {
   for (int p = 0; p < config.ports; ++p) {
     const std::string suffix = config.ports == 1 ? "" : std::to_string(p);
     requests_.push_back(std::make_unique<hw::Channel<CacheRequest>>(
@@ -48,6 +53,7 @@ Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryIm
     responses_.push_back(std::make_unique<hw::Channel<CacheResponse>>(
         kernel, this->name() + ".resp" + suffix, config.hit_latency + 2, config.hit_latency - 1));
   }
+  request0_ = requests_[0].get();
   // Event scheduling: the cache depends only on its channels (it has no timers).
   sleep_when_idle();
   for (int p = 0; p < config.ports; ++p) {
@@ -58,7 +64,13 @@ Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryIm
   consumes(fills_);
   if ((sets_ & (sets_ - 1)) == 0) set_mask_ = static_cast<std::uint32_t>(sets_ - 1);
   lines_.resize(static_cast<std::size_t>(config.items));
+  if (ways_ > 1) lru_.resize(static_cast<std::size_t>(config.items));
   mshrs_.resize(static_cast<std::size_t>(config.max_misses));
+  for (Mshr& m : mshrs_)
+    m.targets = Fifo<Mshr::Target>(config.max_targets);
+  free_mshrs_.assign((mshrs_.size() + 63) / 64, 0);
+  for (std::size_t i = 0; i < mshrs_.size(); ++i)
+    free_mshrs_[i / 64] |= std::uint64_t{1} << (i % 64);
   hw::Stats& s = stats();
   const std::string& n = this->name();
   requests_stat_ = &s.counter(n + ".requests", "requests", "item requests accepted");
@@ -80,9 +92,10 @@ Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryIm
 
 void Cache::invalidate() {
   for (Line& l : lines_) {
-    if (l.mshr >= 0) mshrs_[static_cast<std::size_t>(l.mshr)].line = -1;
+    if (l.state >= 0) mshrs_[static_cast<std::size_t>(l.state)].line = -1;
     l = Line{};
   }
+  std::fill(lru_.begin(), lru_.end(), 0);
 }
 
 bool Cache::idle() const {
@@ -103,7 +116,7 @@ int Cache::evaluate() {
   int progress = fills_.can_pop() ? accept_fill() : 0;
   const int delivered = filled_.empty() ? 0 : deliver();
   progress += delivered;
-  if (requests_.size() != 1 || requests_[0]->can_pop()) progress += lookup(delivered == 0);
+  if (!one_port_ || request0_->can_pop()) progress += lookup(delivered == 0);
   return progress;
 }
 
@@ -111,30 +124,32 @@ int Cache::deliver() {
   if (filled_.empty()) return 0;
   const int id = filled_.front();
   Mshr& m = mshrs_[static_cast<std::size_t>(id)];
-  hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(m.targets.front().port)];
+  const Mshr::Target& t = m.targets.front();
+  hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(t.port)];
   if (!out.can_push()) {
     stall();
     return 0;
   }
   CacheResponse& r = out.push_slot();
   r.index = m.item;
-  r.label = m.targets.front().label;
+  r.label = t.label;
   r.words = m.words;
   r.count = words_;
   m.targets.pop_front();
   if (m.targets.empty()) {
     m.busy = false;
+    free_mshrs_[static_cast<std::size_t>(id) / 64] |= std::uint64_t{1} << (id % 64);
     filled_.pop_front();
   }
   return 1;
 }
 
 int Cache::lookup(bool port_free) {
-  const int ports = static_cast<int>(requests_.size());
-  int port = -1;
-  if (ports == 1) {  // the DynRTP's caches: one unit each
-    if (requests_[0]->can_pop()) port = 0;
-  } else {
+  int port = 0;
+  hw::Channel<CacheRequest>* in = request0_;
+  if (!one_port_) {
+    const int ports = static_cast<int>(requests_.size());
+    port = -1;
     for (int k = 0; k < ports; ++k) {
       const int p = (next_port_ + k) % ports;
       if (requests_[static_cast<std::size_t>(p)]->can_pop()) {
@@ -142,62 +157,62 @@ int Cache::lookup(bool port_free) {
         break;
       }
     }
+    if (port < 0) return 0;
+    in = requests_[static_cast<std::size_t>(port)].get();
+  } else if (!in->can_pop()) {
+    return 0;
   }
-  if (port < 0) return 0;
-  hw::Channel<CacheRequest>& in = *requests_[static_cast<std::size_t>(port)];
-  hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(port)];
-  const CacheRequest& req = in.peek();
+  const CacheRequest& req = in->peek();
+  const std::uint32_t index = req.index;
   auto accepted = [&] {
-    if (accept_log_) accept_log_->push_back(req.index);
+    if (accept_log_) accept_log_->push_back(index);
     ++*requests_stat_;
-    next_port_ = port + 1 == ports ? 0 : port + 1;
-    in.pop();  // last: `req` refers to the channel's slot
+    if (!one_port_) next_port_ = port + 1 == static_cast<int>(requests_.size()) ? 0 : port + 1;
+    in->drop();  // last: `req` refers to the channel's slot
   };
-  const std::size_t set = set_mask_ != 0 || sets_ == 1
-                              ? req.index & set_mask_
-                              : req.index % static_cast<std::uint32_t>(sets_);
-  const std::size_t first = set * static_cast<std::size_t>(config_.ways);
-  int way = -1;
-  for (int w = 0; w < config_.ways; ++w) {
-    const Line& l = lines_[first + static_cast<std::size_t>(w)];
-    if (l.item == req.index && (l.valid || l.mshr >= 0)) {
-      way = w;
-      break;
-    }
-  }
-  if (way >= 0) {
-    Line& l = lines_[first + static_cast<std::size_t>(way)];
-    if (l.valid) {  // hit
+  const std::size_t set =
+      set_mask_ != 0 || sets_ == 1 ? index & set_mask_ : index % static_cast<std::uint32_t>(sets_);
+  const std::size_t first = set * static_cast<std::size_t>(ways_);
+  std::size_t li = first;
+  const std::size_t end = first + static_cast<std::size_t>(ways_);
+  while (li < end && (lines_[li].item != index || lines_[li].state == kEmpty))
+    ++li;
+  if (li < end) {
+    Line& t = lines_[li];
+    if (t.state == kValid) {  // hit
+      hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(port)];
       if (!port_free || !out.can_push()) {
         stall();
         return 0;
       }
       CacheResponse& r = out.push_slot();
-      r.index = req.index;
+      r.index = index;
       r.label = req.label;
-      r.words = l.words;
+      r.words = t.words;
       r.count = words_;
-      l.lru = ++use_clock_;
+      if (ways_ > 1) lru_[li] = ++use_clock_;
       ++*hits_;
       accepted();
       return 1;
     }
-    Mshr& m = mshrs_[static_cast<std::size_t>(l.mshr)];  // merge into the pending fill
+    Mshr& m = mshrs_[static_cast<std::size_t>(t.state)];  // merge into the pending fill
     if (static_cast<int>(m.targets.size()) >= config_.max_targets) {
       stall();
       return 0;
     }
-    m.targets.push_back({req.label, port});
-    l.lru = ++use_clock_;
+    Mshr::Target& target = m.targets.push_slot();
+    target.label = req.label;
+    target.port = port;
+    if (ways_ > 1) lru_[li] = ++use_clock_;
     ++*merges_;
     accepted();
     return 1;
   }
-  // Miss: needs a free MSHR and room towards memory.
+  // Miss: needs a free MSHR (the lowest numbered) and room towards memory.
   int id = -1;
-  for (std::size_t i = 0; i < mshrs_.size(); ++i) {
-    if (!mshrs_[i].busy) {
-      id = static_cast<int>(i);
+  for (std::size_t w = 0; w < free_mshrs_.size(); ++w) {
+    if (free_mshrs_[w] != 0) {
+      id = static_cast<int>(w * 64) + std::countr_zero(free_mshrs_[w]);
       break;
     }
   }
@@ -205,38 +220,41 @@ int Cache::lookup(bool port_free) {
     stall();
     return 0;
   }
-  int victim = 0;
-  for (int w = 0; w < config_.ways; ++w) {
-    const Line& l = lines_[first + static_cast<std::size_t>(w)];
-    const Line& v = lines_[first + static_cast<std::size_t>(victim)];
-    const bool empty = !l.valid && l.mshr < 0;
-    if (empty) {
-      victim = w;
-      break;
+  // The victim: the first empty way, else the least recently used one (one way: that one).
+  std::size_t victim = first;
+  if (ways_ > 1) {
+    for (std::size_t w = first; w < end; ++w) {
+      if (lines_[w].state == kEmpty) {
+        victim = w;
+        break;
+      }
+      if (lru_[w] < lru_[victim]) victim = w;
     }
-    if (l.lru < v.lru) victim = w;
+    lru_[victim] = ++use_clock_;
   }
-  const std::size_t li = first + static_cast<std::size_t>(victim);
-  Line& l = lines_[li];
-  if (l.mshr >= 0) mshrs_[static_cast<std::size_t>(l.mshr)].line = -1;  // fill no longer kept
-  l.item = req.index;
-  l.valid = false;
-  l.mshr = id;
-  l.lru = ++use_clock_;
+  Line& l = lines_[victim];
+  if (l.state >= 0) mshrs_[static_cast<std::size_t>(l.state)].line = -1;  // fill no longer kept
+  l.item = index;
+  l.state = id;
   Mshr& m = mshrs_[static_cast<std::size_t>(id)];
   m.busy = true;
   m.filled = false;
-  m.item = req.index;
-  m.line = static_cast<int>(li);
-  m.targets.assign(1, {req.label, port});
-  const WordLocation loc = image_.locate(type_, req.index, 0);
-  MemRequest mr;
+  m.item = index;
+  m.line = static_cast<int>(victim);
+  m.targets.clear();
+  Mshr::Target& target = m.targets.push_slot();
+  target.label = req.label;
+  target.port = port;
+  free_mshrs_[static_cast<std::size_t>(id) / 64] &= ~(std::uint64_t{1} << (id % 64));
+  const WordLocation loc = image_.locate(type_, index, 0);
+  MemRequest& mr = mem_requests_.push_slot();  // the cache's own channel: written in place
   mr.client = client_;
   mr.tag = static_cast<std::uint32_t>(id);
   mr.bank = static_cast<std::uint8_t>(loc.bank);
-  mr.offset = loc.offset;
   mr.words = static_cast<std::uint8_t>(words_);
-  mem_requests_.push(mr);
+  mr.write = false;
+  mr.counted_bytes = 0;
+  mr.offset = loc.offset;
   ++*misses_;
   accepted();
   return 1;
@@ -244,7 +262,7 @@ int Cache::lookup(bool port_free) {
 
 int Cache::accept_fill() {
   if (!fills_.can_pop()) return 0;
-  const MemResponse f = fills_.pop();
+  const MemResponse& f = fills_.peek();
   if (f.tag >= mshrs_.size() || !mshrs_[f.tag].busy || mshrs_[f.tag].filled || f.count != words_) {
     throw std::logic_error("cache '" + name() + "': fill for MSHR " + std::to_string(f.tag) +
                            " that is not waiting for one");
@@ -253,12 +271,12 @@ int Cache::accept_fill() {
   m.filled = true;
   m.words = f.words;
   if (m.line >= 0) {
-    Line& l = lines_[static_cast<std::size_t>(m.line)];
-    l.valid = true;
-    l.mshr = -1;
-    l.words = f.words;
+    const auto line = static_cast<std::size_t>(m.line);
+    lines_[line].state = kValid;
+    lines_[line].words = f.words;
   }
   filled_.push_back(static_cast<int>(f.tag));
+  fills_.drop();  // last: `f` refers to the channel's slot
   return 1;
 }
 

@@ -30,12 +30,12 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "hw/kernel.h"
+#include "memif/fifo.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
@@ -98,11 +98,13 @@ class Cache : public hw::Module {
   bool idle() const;  // no miss outstanding, all four channels empty
 
  private:
-  struct Line {
+  // A line: the item it holds, its state and its words, in 32 aligned bytes, so a lookup and the
+  // hit's words read one host cache line (the LRU stamps, used only with ways > 1, sit apart).
+  static constexpr std::int32_t kValid = -1;  // data present
+  static constexpr std::int32_t kEmpty = -2;  // no item (reset, invalidated)
+  struct alignas(32) Line {
     std::uint32_t item = kNone;
-    bool valid = false;     // data present
-    int mshr = -1;          // fill pending in this MSHR
-    std::uint64_t lru = 0;  // last use, for LRU
+    std::int32_t state = kEmpty;  // kValid, kEmpty, or the MSHR whose fill is pending (>= 0)
     std::array<std::uint32_t, kMaxRequestWords> words{};
   };
   struct Mshr {
@@ -114,7 +116,7 @@ class Cache : public hw::Module {
       Label label;
       int port;
     };
-    std::deque<Target> targets;
+    Fifo<Target> targets;  // at most max_targets
     std::array<std::uint32_t, kMaxRequestWords> words{};
   };
 
@@ -123,24 +125,30 @@ class Cache : public hw::Module {
   int deliver();               // one waiting request of a filled miss, if any
   int lookup(bool port_free);  // the next request: hit, merge or miss
 
+  // What every evaluation reads first, together.
+  hw::Channel<CacheRequest>* request0_;  // port 0's request channel
+  bool one_port_;
+  int ways_;
+  int sets_;
+  std::uint32_t set_mask_ = 0;  // sets - 1 when sets is a power of two (else 0 and a modulo)
+  int words_;
+  Fifo<int> filled_;  // MSHRs with data, in fill order
+  hw::Channel<MemResponse> fills_;
+  std::vector<Line> lines_;
+  std::vector<std::uint64_t> lru_;  // per line, last use (kept only with ways > 1)
+  std::vector<Mshr> mshrs_;
+  std::vector<std::uint64_t> free_mshrs_;  // bit i: MSHR i is free
+  std::uint64_t use_clock_ = 0;
+  int next_port_ = 0;  // round-robin among request ports
+  hw::Counter *requests_stat_, *hits_, *misses_, *merges_;
+  std::vector<std::uint32_t>* accept_log_ = nullptr;
   ItemType type_;
   const MemoryImage& image_;
   std::uint16_t client_;
   CacheConfig config_;
-  int words_;
-  int sets_;
-  std::uint32_t set_mask_ = 0;  // sets - 1 when sets is a power of two (else 0 and a modulo)
   std::vector<std::unique_ptr<hw::Channel<CacheRequest>>> requests_;
   std::vector<std::unique_ptr<hw::Channel<CacheResponse>>> responses_;
   hw::Channel<MemRequest> mem_requests_;
-  hw::Channel<MemResponse> fills_;
-  std::vector<Line> lines_;
-  std::vector<Mshr> mshrs_;
-  std::deque<int> filled_;  // MSHRs with data, in fill order
-  std::uint64_t use_clock_ = 0;
-  int next_port_ = 0;  // round-robin among request ports
-  std::vector<std::uint32_t>* accept_log_ = nullptr;
-  hw::Counter *requests_stat_, *hits_, *misses_, *merges_;
 };
 
 }  // namespace saarcor::memif

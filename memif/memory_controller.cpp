@@ -45,10 +45,11 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
     const int p = config_.bank_path[static_cast<std::size_t>(b)];
     if (static_cast<int>(paths_.size()) <= p) paths_.resize(static_cast<std::size_t>(p) + 1);
     paths_[static_cast<std::size_t>(p)].banks |= 1u << b;
+    path_bit_[static_cast<std::size_t>(b)] = 1u << p;
     const std::string bn = n + ".bank" + std::to_string(b);
     Bank& bank = banks_[static_cast<std::size_t>(b)];
-    bank.queue = hw::Ring<Queued>(config_.queue_depth);
-    bank.inflight = hw::Ring<InFlight>(inflight_limit_);
+    bank.queue = Fifo<Queued>(config_.queue_depth);
+    bank.inflight = Fifo<InFlight>(inflight_limit_);
     bank.reads = &s.counter(bn + ".reads", "requests", "read requests started");
     bank.writes = &s.counter(bn + ".writes", "requests", "write requests started");
     bank.words = &s.counter(bn + ".busy_cycles", "cycles", "cycles transferring a word");
@@ -67,6 +68,7 @@ MemoryController::Port& MemoryController::add_port(const std::string& name, int 
                              " needs a response width >= 1");
   ports_.push_back(std::make_unique<Port>(kernel(), name, config_.port_capacity, response_width));
   consumes(ports_.back()->requests);
+  intake_.push_back(&ports_.back()->requests);
   produces(ports_.back()->responses);
   return *ports_.back();
 }
@@ -137,7 +139,7 @@ bool MemoryController::port_idle(const Port& port) const {
 
 int MemoryController::evaluate() {
   // Back to front, like pipeline stages: each stage reads what the later one left last cycle.
-  int progress = retire_responses();
+  int progress = next_due_ <= now() ? retire_responses() : 0;
   progress += issue();
   progress += accept_requests();
   return progress;
@@ -146,7 +148,6 @@ int MemoryController::evaluate() {
 // Completed reads leave towards their port, oldest due first; per port and cycle as many as its
 // response channel is wide (one but for the routing's port with a wider broadcast).
 int MemoryController::retire_responses() {
-  if (inflight_ == 0) return 0;
   int moved = 0;
   for (;;) {
     int best = -1;
@@ -160,8 +161,8 @@ int MemoryController::retire_responses() {
     }
     if (best < 0) break;
     Bank& bank = banks_[static_cast<std::size_t>(best)];
-    ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.push(
-        bank.inflight.front().resp);
+    ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.push_slot() =
+        bank.inflight.front().resp;
     bank.inflight.pop_front();
     if (bank.inflight.empty()) {
       inflight_ &= ~(1u << best);
@@ -171,55 +172,72 @@ int MemoryController::retire_responses() {
     }
     ++moved;
   }
-  for (unsigned bits = inflight_; bits != 0; bits &= bits - 1)
-    if (due_[static_cast<std::size_t>(std::countr_zero(bits))] <= now()) stall();  // port full
+  next_due_ = hw::kNever;
+  for (unsigned bits = inflight_; bits != 0; bits &= bits - 1) {
+    const std::uint64_t due = due_[static_cast<std::size_t>(std::countr_zero(bits))];
+    next_due_ = std::min(next_due_, due);
+    if (due <= now()) stall();  // port full
+  }
   return moved;
 }
 
 void MemoryController::start(int b, std::uint64_t when) {
   Bank& bank = banks_[static_cast<std::size_t>(b)];
-  const Queued q = bank.queue.front();
+  const Queued& q = bank.queue.front();  // leaves the queue last: read in place
+  const MemRequest& r = q.req;
+  free_at_[static_cast<std::size_t>(b)] = when + r.words;
+  *bank.words += r.words;
+  *clients_[r.client].bytes += r.counted_bytes ? r.counted_bytes : 4u * r.words;
+  // accept_requests checked the words are inside the bank.
+  std::uint32_t* const mem = image_.bank(b).data() + r.offset;
+  if (r.write) {
+    ++*bank.writes;
+    for (int i = 0; i < r.words; ++i)
+      mem[i] = r.data[static_cast<std::size_t>(i)];
+  } else {
+    ++*bank.reads;
+    const std::uint64_t due = when + r.words - 1 + static_cast<std::uint64_t>(config_.latency);
+    if (bank.inflight.empty()) {
+      inflight_ |= 1u << b;
+      due_[static_cast<std::size_t>(b)] = due;
+      next_due_ = std::min(next_due_, due);
+    }
+    // The read's words go into its return buffer entry as the bank delivers them; the entry's
+    // words beyond the request are zero, as the response promises.
+    InFlight& f = bank.inflight.push_slot();
+    f.due = due;
+    f.port = q.port;
+    f.resp.client = r.client;
+    f.resp.tag = r.tag;
+    f.resp.count = r.words;
+    for (int i = 0; i < kMaxRequestWords; ++i)
+      f.resp.words[static_cast<std::size_t>(i)] = i < r.words ? mem[i] : 0u;
+  }
   bank.queue.pop_front();
   if (bank.queue.empty())
     queued_ &= ~(1u << b);
   else
     oldest_[static_cast<std::size_t>(b)] = bank.queue.front().seq;
-  const MemRequest& r = q.req;
-  bank.free_at = when + r.words;
-  *bank.words += r.words;
-  *clients_.at(r.client).bytes += r.counted_bytes ? r.counted_bytes : 4u * r.words;
-  std::vector<std::uint32_t>& mem = image_.bank(b);
-  if (r.write) {
-    ++*bank.writes;
-    for (int i = 0; i < r.words; ++i)
-      mem[r.offset + static_cast<std::uint32_t>(i)] = r.data[static_cast<std::size_t>(i)];
-    return;
-  }
-  ++*bank.reads;
-  InFlight f;
-  f.due = when + r.words - 1 + static_cast<std::uint64_t>(config_.latency);
-  f.port = q.port;
-  f.resp.client = r.client;
-  f.resp.tag = r.tag;
-  f.resp.count = r.words;
-  for (int i = 0; i < r.words; ++i)
-    f.resp.words[static_cast<std::size_t>(i)] = mem[r.offset + static_cast<std::uint32_t>(i)];
-  if (bank.inflight.empty()) {
-    inflight_ |= 1u << b;
-    due_[static_cast<std::size_t>(b)] = f.due;
-  }
-  bank.inflight.push_back(f);
 }
 
 int MemoryController::issue() {
   if (queued_ == 0) return 0;
+  // A path starts only a bank that has work and is free: the paths without one are not visited
+  // (their cycle would choose nothing and change nothing).
+  unsigned active = 0;  // the paths with a free queued bank, visited in path order
+  for (unsigned bits = queued_; bits != 0; bits &= bits - 1) {
+    const int b = std::countr_zero(bits);
+    if (free_at_[static_cast<std::size_t>(b)] <= now())
+      active |= path_bit_[static_cast<std::size_t>(b)];
+  }
   int started = 0;
-  for (Path& path : paths_) {
+  for (; active != 0; active &= active - 1) {
+    Path& path = paths_[static_cast<std::size_t>(std::countr_zero(active))];
     const unsigned waiting = path.banks & queued_;
     if (waiting == 0 || path.free_at > now()) continue;
     auto startable = [&](int b) {
       const Bank& bank = banks_[static_cast<std::size_t>(b)];
-      return (queued_ >> b & 1u) != 0 && bank.free_at <= now() &&
+      return (queued_ >> b & 1u) != 0 && free_at_[static_cast<std::size_t>(b)] <= now() &&
              static_cast<int>(bank.inflight.size()) < inflight_limit_;
     };
     auto older = [&](int b, int than) {
@@ -238,13 +256,12 @@ int MemoryController::issue() {
       // Stay on the open bank while it has work and the burst limit allows, waiting for it when
       // it becomes free no later than a switch would let another bank start: such a switch
       // would be needless. Otherwise switch to the free bank with the oldest request.
-      const Bank* open = path.open >= 0 ? &banks_[static_cast<std::size_t>(path.open)] : nullptr;
-      const bool open_wanted = open != nullptr && (queued_ >> path.open & 1u) != 0 &&
+      const bool open_wanted = path.open >= 0 && (queued_ >> path.open & 1u) != 0 &&
                                (path.burst < config_.max_burst || others_waiting == 0);
       if (open_wanted && startable(path.open)) {
         chosen = path.open;
-      } else if (open_wanted &&
-                 open->free_at <= now() + static_cast<std::uint64_t>(config_.switch_penalty)) {
+      } else if (open_wanted && free_at_[static_cast<std::size_t>(path.open)] <=
+                                    now() + static_cast<std::uint64_t>(config_.switch_penalty)) {
         chosen = -1;  // wait for the open bank
       } else {
         chosen = oldest_startable;
@@ -272,8 +289,8 @@ int MemoryController::issue() {
 
 int MemoryController::accept_requests() {
   int accepted = 0;
-  for (std::size_t p = 0; p < ports_.size(); ++p) {
-    hw::Channel<MemRequest>& in = ports_[p]->requests;
+  for (std::size_t p = 0; p < intake_.size(); ++p) {
+    hw::Channel<MemRequest>& in = *intake_[p];
     if (!in.can_pop()) continue;
     const MemRequest& r = in.peek();
     if (r.bank >= kNumBanks || r.words < 1 || r.words > kMaxRequestWords ||
@@ -294,7 +311,11 @@ int MemoryController::accept_requests() {
       queued_ |= 1u << r.bank;
       oldest_[r.bank] = seq_;
     }
-    bank.queue.push_back({in.pop(), static_cast<int>(p), seq_++});
+    Queued& q = bank.queue.push_slot();  // the request is written into its queue entry
+    q.req = r;
+    q.port = static_cast<int>(p);
+    q.seq = seq_++;
+    in.drop();  // last: `r` refers to the channel's slot
     bank.max_queue->set_max(bank.queue.size());
     ++accepted;
   }
@@ -311,7 +332,7 @@ std::uint64_t MemoryController::next_wakeup(std::uint64_t now) const {
     const int b = std::countr_zero(bits);
     const Path& path =
         paths_[static_cast<std::size_t>(config_.bank_path[static_cast<std::size_t>(b)])];
-    const std::uint64_t ready = std::max(banks_[static_cast<std::size_t>(b)].free_at, path.free_at);
+    const std::uint64_t ready = std::max(free_at_[static_cast<std::size_t>(b)], path.free_at);
     if (ready > now) t = std::min(t, ready);
   }
   return t;
@@ -322,7 +343,7 @@ std::string MemoryController::dump_state() const {
   for (int b = 0; b < kNumBanks; ++b) {
     const Bank& bank = banks_[static_cast<std::size_t>(b)];
     os << "bank" << b << " queue " << bank.queue.size() << " in flight " << bank.inflight.size()
-       << " free at " << bank.free_at << (b + 1 < kNumBanks ? "; " : "");
+       << " free at " << free_at_[static_cast<std::size_t>(b)] << (b + 1 < kNumBanks ? "; " : "");
   }
   return os.str();
 }

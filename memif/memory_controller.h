@@ -32,7 +32,7 @@
 #include <vector>
 
 #include "hw/kernel.h"
-#include "hw/ring.h"
+#include "memif/fifo.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
@@ -105,11 +105,11 @@ class MemoryController : public hw::Module {
     MemResponse resp;
   };
   // A bank's queue holds at most queue_depth requests and its reads in flight at most
-  // inflight_limit_ (a bank starts no read beyond it), so both are fixed rings.
+  // inflight_limit_ (a bank starts no read beyond it), so both are fixed rings; an entry is
+  // written where it waits.
   struct Bank {
-    hw::Ring<Queued> queue;
-    hw::Ring<InFlight> inflight;  // reads, in start order (due cycles increase)
-    std::uint64_t free_at = 0;    // first cycle the bank can start another request
+    Fifo<Queued> queue;
+    Fifo<InFlight> inflight;  // reads, in start order (due cycles increase)
     hw::Counter* reads = nullptr;
     hw::Counter* writes = nullptr;
     hw::Counter* words = nullptr;
@@ -146,6 +146,14 @@ class MemoryController : public hw::Module {
   // is its front request's arrival number and due_[b] its front read's due cycle.
   unsigned queued_ = 0, inflight_ = 0;
   std::array<std::uint64_t, kNumBanks> oldest_{}, due_{};
+  std::array<std::uint64_t, kNumBanks> free_at_{};  // first cycle a bank can start another request
+  // The earliest due_ (kNever with nothing in flight): before it no read can leave, and the
+  // retire stage is not entered (most cycles with reads in flight have none due).
+  std::uint64_t next_due_ = hw::kNever;
+  // Per bank: bit p = its issue path p; the issue stage visits only the paths of queued banks.
+  std::array<unsigned, kNumBanks> path_bit_{};
+  // Per port: its request channel (the intake polls every port every cycle it runs).
+  std::vector<hw::Channel<MemRequest>*> intake_;
 };
 
 }  // namespace saarcor::memif
