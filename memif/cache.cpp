@@ -67,7 +67,7 @@ Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryIm
   if (ways_ > 1) lru_.resize(static_cast<std::size_t>(config.items));
   mshrs_.resize(static_cast<std::size_t>(config.max_misses));
   for (Mshr& m : mshrs_)
-    m.targets = Fifo<Mshr::Target>(config.max_targets);
+    m.targets = hw::Ring<Mshr::Target>(config.max_targets);
   free_mshrs_.assign((mshrs_.size() + 63) / 64, 0);
   for (std::size_t i = 0; i < mshrs_.size(); ++i)
     free_mshrs_[i / 64] |= std::uint64_t{1} << (i % 64);

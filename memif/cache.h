@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "hw/kernel.h"
-#include "memif/fifo.h"
+#include "hw/ring.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
@@ -116,7 +116,7 @@ class Cache : public hw::Module {
       Label label;
       int port;
     };
-    Fifo<Target> targets;  // at most max_targets
+    hw::Ring<Target> targets;  // at most max_targets
     std::array<std::uint32_t, kMaxRequestWords> words{};
   };
 
@@ -132,7 +132,7 @@ class Cache : public hw::Module {
   int sets_;
   std::uint32_t set_mask_ = 0;  // sets - 1 when sets is a power of two (else 0 and a modulo)
   int words_;
-  Fifo<int> filled_;  // MSHRs with data, in fill order
+  hw::Ring<int> filled_;  // MSHRs with data, in fill order
   hw::Channel<MemResponse> fills_;
   std::vector<Line> lines_;
   std::vector<std::uint64_t> lru_;  // per line, last use (kept only with ways > 1)

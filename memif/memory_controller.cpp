@@ -48,8 +48,8 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
     path_bit_[static_cast<std::size_t>(b)] = 1u << p;
     const std::string bn = n + ".bank" + std::to_string(b);
     Bank& bank = banks_[static_cast<std::size_t>(b)];
-    bank.queue = Fifo<Queued>(config_.queue_depth);
-    bank.inflight = Fifo<InFlight>(inflight_limit_);
+    bank.queue = hw::Ring<Queued>(config_.queue_depth);
+    bank.inflight = hw::Ring<InFlight>(inflight_limit_);
     bank.reads = &s.counter(bn + ".reads", "requests", "read requests started");
     bank.writes = &s.counter(bn + ".writes", "requests", "write requests started");
     bank.words = &s.counter(bn + ".busy_cycles", "cycles", "cycles transferring a word");

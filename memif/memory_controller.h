@@ -32,7 +32,7 @@
 #include <vector>
 
 #include "hw/kernel.h"
-#include "memif/fifo.h"
+#include "hw/ring.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
@@ -108,8 +108,8 @@ class MemoryController : public hw::Module {
   // inflight_limit_ (a bank starts no read beyond it), so both are fixed rings; an entry is
   // written where it waits.
   struct Bank {
-    Fifo<Queued> queue;
-    Fifo<InFlight> inflight;  // reads, in start order (due cycles increase)
+    hw::Ring<Queued> queue;
+    hw::Ring<InFlight> inflight;  // reads, in start order (due cycles increase)
     hw::Counter* reads = nullptr;
     hw::Counter* writes = nullptr;
     hw::Counter* words = nullptr;
