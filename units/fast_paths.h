@@ -248,34 +248,61 @@ template <class F>
 // (L = la + lb - M >= emin, B = ha + hb + 2 <= emax - 2, every operand normal or zero) makes each
 // op its binary64 result rounded once to F's precision, as in transform_step64. rb: b's exponent
 // range (a direction step's rows share it). false: not decided here, use dot_step.
+// A vector as dot_step64 reads it: its components' exact values (meaningful when its range says
+// normal or zero) and its exponent range. Decoded once, it serves every dot it takes part in (the
+// RGS's normal meets each light's shadow direction).
+struct DotOperand {
+  V2d xy{};  // components 0 and 1
+  double z = 0.0;
+  ExponentRange range;
+};
 template <class F>
-[[gnu::always_inline]] inline bool dot_step64(const Vec3<F>& a, const Vec3<F>& b,
-                                              const ExponentRange& rb, bool nearest, F& out) {
-  ExponentRange ra;
-  ra.include(a[0]);
-  ra.include(a[1]);
-  ra.include(a[2]);
-  const int low = ra.lo + rb.lo - F::kManBits;
-  const int high = ra.hi + rb.hi + 2;
-  if (!(nearest & ra.normal & rb.normal & (low >= F::kFormat.emin()) &
-        (high + 2 <= F::kFormat.emax())))
-    return false;
-  const V2d p = decode_pair<F>(a[0].bits, a[1].bits) * decode_pair<F>(b[0].bits, b[1].bits);
-  const V2d c = decode_pair<F>(a[2].bits, b[2].bits);
+[[gnu::always_inline]] inline DotOperand dot_operand(const Vec3<F>& a, const ExponentRange& range) {
+  DotOperand o;
+  o.xy = decode_pair<F>(a[0].bits, a[1].bits);
+  o.z = decode_pair<F>(a[2].bits, a[2].bits)[0];
+  o.range = range;
+  return o;
+}
+template <class F>
+[[gnu::always_inline]] inline DotOperand dot_operand(const Vec3<F>& a) {
+  ExponentRange r;
+  r.include(a[0]);
+  r.include(a[1]);
+  r.include(a[2]);
+  return dot_operand<F>(a, r);
+}
+// Whether dot_step64 decides a dot product of vectors within these exponent ranges: nearest-even,
+// normal entries, and every product and partial sum a normal value of F (or zero), so that each
+// rounding in binary64 is F's. A range that contains several vectors' ranges decides for each.
+template <class F>
+[[gnu::always_inline]] inline bool dot_step64_decides(const ExponentRange& a,
+                                                      const ExponentRange& b, bool nearest) {
+  const int low = a.lo + b.lo - F::kManBits;
+  const int high = a.hi + b.hi + 2;
+  return nearest & a.normal & b.normal & (low >= F::kFormat.emin()) &
+         (high + 2 <= F::kFormat.emax());
+}
+template <class F>
+[[gnu::always_inline]] inline bool dot_step64(const DotOperand& a, const DotOperand& b,
+                                              bool nearest, F& out) {
+  if (!dot_step64_decides<F>(a.range, b.range, nearest)) return false;
+  const V2d p = a.xy * b.xy;
   const double x = round_in_range<F>(p[0]);
   const double y = round_in_range<F>(p[1]);
-  const double z = round_in_range<F>(c[0] * c[1]);
+  const double z = round_in_range<F>(a.z * b.z);
   out = encoding_of<F>(round_in_range<F>(round_in_range<F>(x + y) + round_in_range<F>(z + 0.0)));
   return true;
 }
 template <class F>
+[[gnu::always_inline]] inline bool dot_step64(const Vec3<F>& a, const Vec3<F>& b,
+                                              const ExponentRange& rb, bool nearest, F& out) {
+  return dot_step64<F>(dot_operand<F>(a), dot_operand<F>(b, rb), nearest, out);
+}
+template <class F>
 [[gnu::always_inline]] inline bool dot_step64(const Vec3<F>& a, const Vec3<F>& b, bool nearest,
                                               F& out) {
-  ExponentRange rb;
-  rb.include(b[0]);
-  rb.include(b[1]);
-  rb.include(b[2]);
-  return dot_step64<F>(a, b, rb, nearest, out);
+  return dot_step64<F>(dot_operand<F>(a), dot_operand<F>(b), nearest, out);
 }
 
 struct TraversalLane64 {

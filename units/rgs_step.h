@@ -101,8 +101,8 @@ class RgsStep {
       s.lit = false;
       s.highlight = false;
       if (!s.hit) continue;
-      const Vec3<F>& sd = t.lane(i).world.d;  // hit point - L
-      const DotOperand ds = dot_operand(sd);  // decoded once for the light's two or three dots
+      const Vec3<F>& sd = t.lane(i).world.d;     // hit point - L
+      const DotOperand ds = dot_operand<F>(sd);  // decoded once for the light's two or three dots
       const F ns = shade_dot(t, s.n, s.n_op, sd, ds);
       const F ss = shade_dot(t, sd, ds, sd, ds);
       s.lit = is_neg_nonzero(ns);
@@ -141,14 +141,6 @@ class RgsStep {
   void begin_request() { mem_.clear(); }
 
  private:
-  // A vector as dot_step64 reads it: its components' exact values (meaningful when its range says
-  // normal or zero) and its exponent range. A hit's normal and reflected direction meet every
-  // light's shadow direction: decoded once, not per dot.
-  struct DotOperand {
-    V2d xy{};  // components 0 and 1
-    double z = 0.0;
-    ExponentRange range;
-  };
   // The RGS's per-lane surface context while it shades a packet's hits.
   struct Surface {
     bool hit = false;
@@ -175,30 +167,6 @@ class RgsStep {
   static void count_transform(State& t, std::uint64_t steps) {
     PipelineUnits<F>::count(t.u.transformation_ops, 9 * steps, 9 * steps, 0, 0);
   }
-  static DotOperand dot_operand(const Vec3<F>& a) {
-    DotOperand o;
-    o.range.include(a[0]);
-    o.range.include(a[1]);
-    o.range.include(a[2]);
-    o.xy = decode_pair<F>(a[0].bits, a[1].bits);
-    o.z = decode_pair<F>(a[2].bits, a[2].bits)[0];
-    return o;
-  }
-  // dot_step64 on decoded operands: the same condition, the same ops on the same values.
-  static bool dot64(const DotOperand& a, const DotOperand& b, bool nearest, F& out) {
-    const int low = a.range.lo + b.range.lo - F::kManBits;
-    const int high = a.range.hi + b.range.hi + 2;
-    if (!(nearest & a.range.normal & b.range.normal & (low >= F::kFormat.emin()) &
-          (high + 2 <= F::kFormat.emax())))
-      return false;
-    const V2d p = a.xy * b.xy;
-    const double x = round_in_range<F>(p[0]);
-    const double y = round_in_range<F>(p[1]);
-    const double z = round_in_range<F>(a.z * b.z);
-    out = encoding_of<F>(round_in_range<F>(round_in_range<F>(x + y) + round_in_range<F>(z + 0.0)));
-    return true;
-  }
-
   // A direction step (ops counted by the caller) as three dot products: each of its rows is
   // dot_step's expression with the row as the first vector. With a matrix per lane (T_shadow, T_R)
   // the exponent ranges are cheaper than matrix_values for one step.
@@ -219,10 +187,7 @@ class RgsStep {
     rv.include(v[0]);
     rv.include(v[1]);
     rv.include(v[2]);
-    const int low = rm.lo + rv.lo - F::kManBits;
-    const int high = rm.hi + rv.hi + 2;
-    return t.nearest & rm.normal & rv.normal & (low >= F::kFormat.emin()) &
-           (high + 2 <= F::kFormat.emax());
+    return dot_step64_decides<F>(rm, rv, t.nearest);
   }
   // Two lanes' direction steps (a matrix each): where direction_decides holds, both lanes' rows go
   // through dot_step64's ops together (one lane per half of a vector register: each lane's ops
@@ -277,7 +242,7 @@ class RgsStep {
                      const DotOperand& db) {
     PipelineUnits<F>::count(t.u.transformation_ops, 3, 3, 0, 0);
     F r;
-    if (dot64(da, db, t.nearest, r)) return r;
+    if (dot_step64<F>(da, db, t.nearest, r)) return r;
     return dot_step(t.u.raw, a, b);
   }
   // -x / sqrt(a * b) on the RGS helper (1 mul, 1 sqrt, 1 div). Normal operands in nearest-even:
@@ -356,7 +321,7 @@ class RgsStep {
     s.rec = l.hit;
     const memif::InstanceHeader h = t.image.instance_header(s.rec.instance);
     s.n = world_normal(t, h, s.rec);
-    s.n_op = dot_operand(s.n);
+    s.n_op = dot_operand<F>(s.n);
     s.nn = shade_dot(t, s.n, s.n_op, s.n, s.n_op);
     t.u.shading_transformation_steps += 1;  // normal step; the dots count below
     const std::uint32_t record = h.shading_base + s.rec.triangle;
@@ -381,12 +346,12 @@ class RgsStep {
     s.spec = shininess >= 1 && (s.mat.specular_rgb_shininess & 0xFFFFFFu) != 0;
     const bool reflect = t.params.secondary && t.depth < max_depth_ && s.mat.reflectivity > 0;
     if (s.spec || reflect)
-      s.kk = twice_quotient(t, shade_dot(t, s.ray.d, dot_operand(s.ray.d), s.n, s.n_op), s.nn);
+      s.kk = twice_quotient(t, shade_dot(t, s.ray.d, dot_operand<F>(s.ray.d), s.n, s.n_op), s.nn);
     if (s.spec) {
       const Mat34<F> tr = reflect_matrix(s.ray, s.n);
       count_transform(t, 1);
       s.r = direction_step(t, tr, Vec3<F>{F::one(), s.kk.neg(), F::zero()});
-      s.r_op = dot_operand(s.r);
+      s.r_op = dot_operand<F>(s.r);
       s.rr = shade_dot(t, s.r, s.r_op, s.r, s.r_op);
       t.u.shading_transformation_steps += 1;
     }
