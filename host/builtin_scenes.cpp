@@ -483,8 +483,8 @@ Scene make_suncor() {
   s.cameras.push_back(look_at({0.0, 3.5, 6.0}, {0.0, 0.5, -20.0}, "field"));
   // Two more views of the same field (`--set image.camera=1|2`), for measuring how much of a
   // frame's work is the view: "above" looks down into the field so that nearly every pixel hits
-  // a sunflower (as the paper's 31 shading bytes per pixel say of its SunCOR frames), "heads"
-  // looks along the rows at head height (docs/fidelity.md).
+  // a sunflower (as the paper's 31 shading bytes per pixel suggest of its SunCOR frames, if its
+  // misses read nothing), "heads" looks along the rows at head height (docs/fidelity.md).
   s.cameras.push_back(look_at({0.0, 8.0, 4.0}, {0.0, 0.0, -10.0}, "above"));
   s.cameras.push_back(look_at({0.0, 2.2, 4.0}, {0.0, 1.6, -6.0}, "heads"));
   s.lights.push_back(light_at({-30.0, 80.0, 40.0}, {1.0, 0.97, 0.9}));
