@@ -153,7 +153,9 @@ void BM_CycleModelFrame(benchmark::State& state) {
       rate / 1e6, target, functional > 0 ? times.best / functional : 0.0, functional,
       functional > 0 ? times.best / functional / 20.0 : 0.0, embree > 0 ? rate / embree : 0.0,
       embree * 1e-6);
-  if (p.pipelines != 1) return;
+  if (p.pipelines != 1) {
+    return;
+  }
   const int mode = static_cast<int>(state.range(2));
   const double per_cycle = times.best / static_cast<double>(last.cycles);
   if (!shade) {
