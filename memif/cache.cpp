@@ -116,7 +116,7 @@ int Cache::evaluate() {
   int progress = fills_.can_pop() ? accept_fill() : 0;
   const int delivered = filled_.empty() ? 0 : deliver();
   progress += delivered;
-  if (!one_port_ || request0_->can_pop()) progress += lookup(delivered == 0);
+  progress += lookup(delivered == 0);
   return progress;
 }
 

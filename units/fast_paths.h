@@ -227,6 +227,16 @@ template <class F>
           F{static_cast<std::uint32_t>(e[2][lane])}};
 }
 
+// One row of transform_step64 on two lanes: m0·x0 + m1·x1 + (m2·x2 + t), each op rounded to F's
+// precision; a lane's row entries and translation may differ from the other lane's.
+template <class F>
+[[gnu::always_inline]] inline V2u row_pair64(V2d m0, V2d m1, V2d m2, V2d t, const V2d (&x)[3]) {
+  const V2d a = round_in_range2<F>(m0 * x[0]);
+  const V2d b = round_in_range2<F>(m1 * x[1]);
+  const V2d c = round_in_range2<F>(m2 * x[2]);
+  return encode_pair<F>(round_in_range2<F>(round_in_range2<F>(a + b) + round_in_range2<F>(c + t)));
+}
+
 // transform_step64's arithmetic for two vectors x (components as pairs); each lane must satisfy
 // transform_decides (lanes that do not give meaningless results, to be discarded).
 template <class F>
@@ -235,19 +245,10 @@ template <class F>
   for (std::size_t k = 0; k < 3; ++k) {
     const auto& m = mv.m[k];
     const double tk = translate ? m[3] : 0.0;
-    const V2d a = round_in_range2<F>(m[0] * x[0]);
-    const V2d b = round_in_range2<F>(m[1] * x[1]);
-    const V2d c = round_in_range2<F>(m[2] * x[2]);
-    out[k] =
-        encode_pair<F>(round_in_range2<F>(round_in_range2<F>(a + b) + round_in_range2<F>(c + tk)));
+    out[k] = row_pair64<F>(V2d{m[0], m[0]}, V2d{m[1], m[1]}, V2d{m[2], m[2]}, V2d{tk, tk}, x);
   }
 }
 
-// dot_step on values. dot_step(a, b) is row 0 of a direction step with the linear part (a; 0; 0),
-// so transform_decides' condition with a's exponent range for the matrix's and no translation
-// (L = la + lb - M >= emin, B = ha + hb + 2 <= emax - 2, every operand normal or zero) makes each
-// op its binary64 result rounded once to F's precision, as in transform_step64. rb: b's exponent
-// range (a direction step's rows share it). false: not decided here, use dot_step.
 // A vector as dot_step64 reads it: its components' exact values (meaningful when its range says
 // normal or zero) and its exponent range. Decoded once, it serves every dot it takes part in (the
 // RGS's normal meets each light's shadow direction).
@@ -272,9 +273,13 @@ template <class F>
   r.include(a[2]);
   return dot_operand<F>(a, r);
 }
-// Whether dot_step64 decides a dot product of vectors within these exponent ranges: nearest-even,
-// normal entries, and every product and partial sum a normal value of F (or zero), so that each
-// rounding in binary64 is F's. A range that contains several vectors' ranges decides for each.
+// dot_step on values. dot_step(a, b) is row 0 of a direction step with the linear part (a; 0; 0),
+// so transform_decides' condition with a's exponent range for the matrix's and no translation
+// (L = la + lb - M >= emin, B = ha + hb + 2 <= emax - 2, every operand normal or zero) makes each
+// op its binary64 result rounded once to F's precision, as in transform_step64. dot_step64_decides
+// is that condition on two exponent ranges (a range containing several vectors' ranges decides
+// for each of them: a direction step's rows); dot_step64 returns false where it is not decided
+// (use dot_step), on decoded operands or on vectors (rb: b's exponent range, when known).
 template <class F>
 [[gnu::always_inline]] inline bool dot_step64_decides(const ExponentRange& a,
                                                       const ExponentRange& b, bool nearest) {

@@ -205,11 +205,9 @@ class RgsStep {
                         decode_pair<F>(va[2].bits, vb[2].bits)};
       V2u e[3];
       for (int r = 0; r < 3; ++r) {
-        const V2d a = round_in_range2<F>(decode_pair<F>(ma[r][0].bits, mb[r][0].bits) * x[0]);
-        const V2d b = round_in_range2<F>(decode_pair<F>(ma[r][1].bits, mb[r][1].bits) * x[1]);
-        const V2d c = round_in_range2<F>(decode_pair<F>(ma[r][2].bits, mb[r][2].bits) * x[2]);
-        e[r] = encode_pair<F>(
-            round_in_range2<F>(round_in_range2<F>(a + b) + round_in_range2<F>(c + 0.0)));
+        e[r] = row_pair64<F>(decode_pair<F>(ma[r][0].bits, mb[r][0].bits),
+                             decode_pair<F>(ma[r][1].bits, mb[r][1].bits),
+                             decode_pair<F>(ma[r][2].bits, mb[r][2].bits), V2d{0.0, 0.0}, x);
       }
       if (db) out_b = lane_of<F>(e, 1);
       if (da) out_a = lane_of<F>(e, 0);
