@@ -133,11 +133,11 @@ inline std::uint32_t key_id(Key k) {
 void radix_sort(Key* data, std::size_t n, std::vector<Key>& scratch) {
   constexpr int kDigit = 12;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
-  if (n <= 16) {
+  if (n <= 32) {
     // The exact stage's leaf decisions sort a few events per axis, hundreds of thousands of
     // times: ranks by counting (no branch on the keys; they are unique, one event per type and
     // item).
-    Key sorted[16];
+    Key sorted[32];
     for (std::size_t i = 0; i < n; ++i) {
       std::size_t rank = 0;
       for (std::size_t j = 0; j < n; ++j) {
@@ -792,44 +792,54 @@ void sweep_bins_portable(const BinHist& hist_lo, const BinHist& hist_hi, std::ui
 // rules those planes out as the step does, and a flat axis (all items in bin 0) never has one.
 __attribute__((target("avx"))) void sweep_bins_avx(const BinHist& hist_lo, const BinHist& hist_hi,
                                                    int nb_max, std::uint32_t n, BinSweep& sw) {
-  const __m128i nv = _mm_set1_epi32(static_cast<int>(n));
+  // The plane index as a double, loaded per plane instead of counted in a register.
+  static const auto kIndex = [] {
+    std::array<double, kMaxBins> idx{};
+    for (int j = 0; j < kMaxBins; ++j) {
+      idx[j] = j;
+    }
+    return idx;
+  }();
   const __m256d da = _mm256_setr_pd(sw.da[0], sw.da[1], sw.da[2], 0.0);
   const __m256d zero = _mm256_setzero_pd();
-  const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
-  const __m256d one = _mm256_set1_pd(1.0);
   __m256d al = _mm256_setr_pd(sw.al[0], sw.al[1], sw.al[2], 0.0);
   __m256d ar = _mm256_setr_pd(sw.ar[0], sw.ar[1], sw.ar[2], 0.0);
   __m128i nl = _mm_setzero_si128();
-  __m128i not_right = nl;
-  __m256d bm = inf;
+  __m128i nr = _mm_set1_epi32(static_cast<int>(n));
+  __m256d bm = _mm256_set1_pd(std::numeric_limits<double>::infinity());
   __m256d bj = _mm256_set1_pd(-1.0);
-  __m256d jv = zero;
+  // Few registers, so that the running minimum stays in one (with sixteen live values GCC kept
+  // it on the stack: a store and a reload in the loop's chain). A plane with an empty side gets
+  // an all-ones pattern (a NaN) instead of infinity: min(NaN, best) is best and NaN < best is
+  // false, as inf would give; the other planes' values pass unchanged (m | 0).
   for (int j = 0; j + 1 < nb_max; ++j) {
     nl = _mm_add_epi32(nl, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_lo[j])));
-    not_right =
-        _mm_add_epi32(not_right, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_hi[j])));
+    nr = _mm_sub_epi32(nr, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_hi[j])));
     const __m256d nld = _mm256_cvtepi32_pd(nl);
-    const __m256d nrd = _mm256_cvtepi32_pd(_mm_sub_epi32(nv, not_right));
+    const __m256d nrd = _mm256_cvtepi32_pd(nr);
     al = _mm256_add_pd(al, da);
     ar = _mm256_sub_pd(ar, da);
     const __m256d m = _mm256_add_pd(_mm256_mul_pd(al, nld), _mm256_mul_pd(ar, nrd));
-    const __m256d ok =
-        _mm256_and_pd(_mm256_cmp_pd(nld, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(nrd, zero, _CMP_NEQ_UQ));
-    // Selections as and / andnot / or: GCC turns blendv on a comparison into per-lane branches.
-    const __m256d mv = _mm256_or_pd(_mm256_and_pd(ok, m), _mm256_andnot_pd(ok, inf));
+    const __m256d empty =
+        _mm256_or_pd(_mm256_cmp_pd(nld, zero, _CMP_EQ_OQ), _mm256_cmp_pd(nrd, zero, _CMP_EQ_OQ));
+    const __m256d mv = _mm256_or_pd(m, empty);
     const __m256d lt = _mm256_cmp_pd(mv, bm, _CMP_LT_OQ);
-    bj = _mm256_or_pd(_mm256_and_pd(lt, jv), _mm256_andnot_pd(lt, bj));
+    // Selections as and / andnot / or: GCC turns blendv on a comparison into per-lane branches.
+    bj = _mm256_or_pd(_mm256_and_pd(lt, _mm256_broadcast_sd(&kIndex[j])), _mm256_andnot_pd(lt, bj));
     bm = _mm256_min_pd(mv, bm);
-    jv = _mm256_add_pd(jv, one);
   }
-  alignas(32) double m4[4];
-  alignas(32) double j4[4];
-  _mm256_store_pd(m4, bm);
-  _mm256_store_pd(j4, bj);
-  for (int k = 0; k < 3; ++k) {
-    sw.best_m[k] = m4[k];
-    sw.best_j[k] = static_cast<int>(j4[k]);
-  }
+  // Lanes taken out by shuffles: stored to an array, the minimum's register shared the array's
+  // stack slot and the loop kept it there (a store and a reload per plane).
+  const __m128d m01 = _mm256_castpd256_pd128(bm);
+  const __m128d m23 = _mm256_extractf128_pd(bm, 1);
+  const __m128d j01 = _mm256_castpd256_pd128(bj);
+  const __m128d j23 = _mm256_extractf128_pd(bj, 1);
+  sw.best_m[0] = _mm_cvtsd_f64(m01);
+  sw.best_m[1] = _mm_cvtsd_f64(_mm_unpackhi_pd(m01, m01));
+  sw.best_m[2] = _mm_cvtsd_f64(m23);
+  sw.best_j[0] = static_cast<int>(_mm_cvtsd_f64(j01));
+  sw.best_j[1] = static_cast<int>(_mm_cvtsd_f64(_mm_unpackhi_pd(j01, j01)));
+  sw.best_j[2] = static_cast<int>(_mm_cvtsd_f64(j23));
 }
 #endif
 
