@@ -128,24 +128,67 @@ inline std::uint32_t key_id(Key k) {
   return static_cast<std::uint32_t>(k) & kIdMask;
 }
 
+// The exact stage's leaf decisions sort a few events per axis, hundreds of thousands of times:
+// by ranks (each key's count of smaller keys; keys are unique, one event per type and item), with
+// no branch on the keys. n <= kRankSortMax.
+constexpr std::size_t kRankSortMax = 32;
+void rank_sort_scalar(Key* data, std::size_t n) {
+  Key sorted[kRankSortMax];
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t rank = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      rank += data[j] < data[i];
+    }
+    sorted[rank] = data[i];
+  }
+  std::copy(sorted, sorted + n, data);
+}
+#if SAARCOR_KD_AVX
+// The same ranks four comparisons at a time where the processor has AVX2 (signed 64-bit compares
+// on keys with the top bit flipped; the slots past n hold the largest value, never below a key).
+__attribute__((target("avx2"))) void rank_sort_avx2(Key* data, std::size_t n) {
+  constexpr std::size_t kLanes = 4;
+  alignas(32) Key biased[kRankSortMax];
+  const std::size_t groups = (n + kLanes - 1) / kLanes;
+  constexpr Key kFlip = Key{1} << 63;
+  for (std::size_t i = 0; i < groups * kLanes; ++i) {
+    biased[i] = i < n ? data[i] ^ kFlip : ~kFlip;
+  }
+  Key sorted[kRankSortMax];
+  for (std::size_t i = 0; i < n; ++i) {
+    const __m256i x = _mm256_set1_epi64x(static_cast<long long>(biased[i]));
+    __m256i count = _mm256_setzero_si256();
+    for (std::size_t g = 0; g < groups; ++g) {
+      const __m256i v = _mm256_load_si256(reinterpret_cast<const __m256i*>(biased + g * kLanes));
+      count = _mm256_sub_epi64(count, _mm256_cmpgt_epi64(x, v));  // -1 where v < x
+    }
+    const __m128i c2 =
+        _mm_add_epi64(_mm256_castsi256_si128(count), _mm256_extracti128_si256(count, 1));
+    const auto rank =
+        static_cast<std::size_t>(_mm_cvtsi128_si64(_mm_add_epi64(c2, _mm_unpackhi_epi64(c2, c2))));
+    sorted[rank] = data[i];
+  }
+  std::copy(sorted, sorted + n, data);
+}
+#endif
+void rank_sort(Key* data, std::size_t n) {
+#if SAARCOR_KD_AVX
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) {
+    rank_sort_avx2(data, n);
+    return;
+  }
+#endif
+  rank_sort_scalar(data, n);
+}
+
 // Stable LSD radix sort on bits [30, 64) (ties keep their order, i.e. ascending id when the input
 // is in id order; the id bits are compared only through that stability).
 void radix_sort(Key* data, std::size_t n, std::vector<Key>& scratch) {
   constexpr int kDigit = 12;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
-  if (n <= 32) {
-    // The exact stage's leaf decisions sort a few events per axis, hundreds of thousands of
-    // times: ranks by counting (no branch on the keys; they are unique, one event per type and
-    // item).
-    Key sorted[32];
-    for (std::size_t i = 0; i < n; ++i) {
-      std::size_t rank = 0;
-      for (std::size_t j = 0; j < n; ++j) {
-        rank += data[j] < data[i];
-      }
-      sorted[rank] = data[i];
-    }
-    std::copy(sorted, sorted + n, data);
+  if (n <= kRankSortMax) {
+    rank_sort(data, n);
     return;
   }
   if (n < 1024) {  // the 4096-bucket passes cost more than a comparison sort here
