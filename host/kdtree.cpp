@@ -28,9 +28,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <memory>
+#include <new>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -55,32 +61,37 @@ class SplitGrid {
  public:
   explicit SplitGrid(const ff::Format& f)
       : mask_((1u << (23 - f.man_bits)) - 1u),
-        min_normal_(std::ldexp(1.0f, f.emin())),
+        min_normal_bits_(std::bit_cast<std::uint32_t>(std::ldexp(1.0f, f.emin()))),
         max_finite_(
             static_cast<float>((2.0 - std::ldexp(1.0, -f.man_bits)) * std::ldexp(1.0, f.emax()))) {}
 
   float max_finite() const { return max_finite_; }
-  // Largest grid value <= v (v finite, |v| <= max_finite()).
-  float down(float v) const { return (v < 0.0f ? -up_mag(-v) : down_mag(v)) + 0.0f; }
-  // Smallest grid value >= v.
-  float up(float v) const { return (v < 0.0f ? -down_mag(-v) : up_mag(v)) + 0.0f; }
+  // Largest grid value <= v (v finite, |v| <= max_finite()); never -0.
+  float down(float v) const { return round(v, 0u); }
+  // Smallest grid value >= v; never -0.
+  float up(float v) const { return round(v, 0x80000000u); }
 
  private:
-  float down_mag(float a) const {
-    if (!(a >= min_normal_)) return 0.0f;
-    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(a) & ~mask_);
-  }
-  float up_mag(float a) const {
-    if (a == 0.0f) return 0.0f;
-    if (a <= min_normal_) return min_normal_;
-    const std::uint32_t u = std::bit_cast<std::uint32_t>(a);
-    std::uint32_t t = u & ~mask_;
-    if (t != u) t += mask_ + 1u;  // carries into the exponent; stays <= max_finite for a <= it
-    return std::bit_cast<float>(t);
+  // On the sign and magnitude bits, without a branch on the sign (coordinates of either sign
+  // come in random order): the magnitude is rounded up where the sign bit differs from `up`
+  // (towards -inf for a negative value), else down. Magnitude bits order like the magnitudes.
+  float round(float v, std::uint32_t up) const {
+    const std::uint32_t u = std::bit_cast<std::uint32_t>(v);
+    const std::uint32_t sign = u & 0x80000000u;
+    const std::uint32_t a = u ^ sign;
+    // Down: below the smallest normal the grid has only 0.
+    const std::uint32_t mag_down = a >= min_normal_bits_ ? a & ~mask_ : 0u;
+    // Up: 0 stays 0, anything else reaches at least the smallest normal (a multiple of mask + 1,
+    // so the masked sum never passes it for smaller a); carries into the exponent stay <=
+    // max_finite for a <= it.
+    const std::uint32_t t = std::max((a + mask_) & ~mask_, min_normal_bits_);
+    const std::uint32_t mag_up = a == 0u ? 0u : t;
+    const std::uint32_t r = (sign ^ up) != 0u ? mag_up : mag_down;
+    return std::bit_cast<float>(r == 0u ? 0u : r | sign);
   }
 
   std::uint32_t mask_;
-  float min_normal_;
+  std::uint32_t min_normal_bits_;
   float max_finite_;
 };
 
@@ -117,11 +128,69 @@ inline std::uint32_t key_id(Key k) {
   return static_cast<std::uint32_t>(k) & kIdMask;
 }
 
+// The exact stage's leaf decisions sort a few events per axis, hundreds of thousands of times:
+// by ranks (each key's count of smaller keys; keys are unique, one event per type and item), with
+// no branch on the keys. n <= kRankSortMax.
+constexpr std::size_t kRankSortMax = 32;
+void rank_sort_scalar(Key* data, std::size_t n) {
+  Key sorted[kRankSortMax];
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t rank = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      rank += data[j] < data[i];
+    }
+    sorted[rank] = data[i];
+  }
+  std::copy(sorted, sorted + n, data);
+}
+#if SAARCOR_KD_AVX
+// The same ranks four comparisons at a time where the processor has AVX2 (signed 64-bit compares
+// on keys with the top bit flipped; the slots past n hold the largest value, never below a key).
+__attribute__((target("avx2"))) void rank_sort_avx2(Key* data, std::size_t n) {
+  constexpr std::size_t kLanes = 4;
+  alignas(32) Key biased[kRankSortMax];
+  const std::size_t groups = (n + kLanes - 1) / kLanes;
+  constexpr Key kFlip = Key{1} << 63;
+  for (std::size_t i = 0; i < groups * kLanes; ++i) {
+    biased[i] = i < n ? data[i] ^ kFlip : ~kFlip;
+  }
+  Key sorted[kRankSortMax];
+  for (std::size_t i = 0; i < n; ++i) {
+    const __m256i x = _mm256_set1_epi64x(static_cast<long long>(biased[i]));
+    __m256i count = _mm256_setzero_si256();
+    for (std::size_t g = 0; g < groups; ++g) {
+      const __m256i v = _mm256_load_si256(reinterpret_cast<const __m256i*>(biased + g * kLanes));
+      count = _mm256_sub_epi64(count, _mm256_cmpgt_epi64(x, v));  // -1 where v < x
+    }
+    const __m128i c2 =
+        _mm_add_epi64(_mm256_castsi256_si128(count), _mm256_extracti128_si256(count, 1));
+    const auto rank =
+        static_cast<std::size_t>(_mm_cvtsi128_si64(_mm_add_epi64(c2, _mm_unpackhi_epi64(c2, c2))));
+    sorted[rank] = data[i];
+  }
+  std::copy(sorted, sorted + n, data);
+}
+#endif
+void rank_sort(Key* data, std::size_t n) {
+#if SAARCOR_KD_AVX
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) {
+    rank_sort_avx2(data, n);
+    return;
+  }
+#endif
+  rank_sort_scalar(data, n);
+}
+
 // Stable LSD radix sort on bits [30, 64) (ties keep their order, i.e. ascending id when the input
 // is in id order; the id bits are compared only through that stability).
 void radix_sort(Key* data, std::size_t n, std::vector<Key>& scratch) {
   constexpr int kDigit = 12;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
+  if (n <= kRankSortMax) {
+    rank_sort(data, n);
+    return;
+  }
   if (n < 1024) {  // the 4096-bucket passes cost more than a comparison sort here
     std::sort(data, data + n);
     return;
@@ -150,14 +219,23 @@ void radix_sort(Key* data, std::size_t n, std::vector<Key>& scratch) {
 
 // A list used as a stack (one axis's events, or the binned stage's items): a node's list is a
 // range; its children go on top and are popped when the subtree is done.
+// Large stacks (the root's item list of a big mesh and the lists above it) are asked for in 2 MB
+// pages where the kernel gives them on request (Linux: transparent huge pages in "madvise"
+// mode): every build touches them afresh, and 4 KB pages cost a page fault each.
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+struct FreeDeleter {
+  void operator()(void* p) const { std::free(p); }
+};
 template <class T>
 class Stack {
+  static_assert(std::is_trivially_copyable_v<T> && alignof(T) <= 16);
+
  public:
   T* data() const { return buf_.get(); }
   void ensure(std::size_t n) {
     if (n <= cap_) return;
     const std::size_t cap = std::max(n, cap_ + cap_ / 2);
-    auto buf = std::make_unique_for_overwrite<T[]>(cap);
+    std::unique_ptr<T[], FreeDeleter> buf(static_cast<T*>(allocate(cap * sizeof(T))));
     if (top_ > 0) std::copy(buf_.get(), buf_.get() + top_, buf.get());
     buf_ = std::move(buf);
     cap_ = cap;
@@ -165,7 +243,25 @@ class Stack {
   std::size_t top_ = 0;
 
  private:
-  std::unique_ptr<T[]> buf_;
+  static void* allocate(std::size_t bytes) {
+    void* p = nullptr;
+    if (bytes >= 4 * kHugePage) {
+      const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+      p = std::aligned_alloc(kHugePage, rounded);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+      if (p != nullptr) {
+        madvise(p, rounded, MADV_HUGEPAGE);  // a hint: without it the build is the same
+      }
+#endif
+    } else {
+      p = std::malloc(bytes);
+    }
+    if (p == nullptr) {
+      throw std::bad_alloc();
+    }
+    return p;
+  }
+  std::unique_ptr<T[], FreeDeleter> buf_;
   std::size_t cap_ = 0;
 };
 using Arena = Stack<Key>;
@@ -462,6 +558,7 @@ class Builder {
   std::vector<std::uint32_t> both_left_;  // straddlers kept on each side
   std::vector<std::uint32_t> both_right_;
   std::uint32_t item_count_ = 0;
+  std::uint32_t exact_root_ = 0;  // the node exact_subtree started at (make_leaf)
   Box root_{};
   double min_half_area_ = 0.0;  // nodes below it are leaves (kMinAreaShare of the root's)
   double root_half_area_ = 0.0;
@@ -651,6 +748,7 @@ void Builder::exact_subtree(std::uint32_t node, int depth, const Box& box, std::
   }
   for (std::uint32_t i = 0; i < n; ++i)
     gid_[i] = items[i].id;
+  exact_root_ = node;
   build_node(node, depth, box, eb, ee, n, no_empty);
 }
 
@@ -737,44 +835,54 @@ void sweep_bins_portable(const BinHist& hist_lo, const BinHist& hist_hi, std::ui
 // rules those planes out as the step does, and a flat axis (all items in bin 0) never has one.
 __attribute__((target("avx"))) void sweep_bins_avx(const BinHist& hist_lo, const BinHist& hist_hi,
                                                    int nb_max, std::uint32_t n, BinSweep& sw) {
-  const __m128i nv = _mm_set1_epi32(static_cast<int>(n));
+  // The plane index as a double, loaded per plane instead of counted in a register.
+  static const auto kIndex = [] {
+    std::array<double, kMaxBins> idx{};
+    for (int j = 0; j < kMaxBins; ++j) {
+      idx[j] = j;
+    }
+    return idx;
+  }();
   const __m256d da = _mm256_setr_pd(sw.da[0], sw.da[1], sw.da[2], 0.0);
   const __m256d zero = _mm256_setzero_pd();
-  const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
-  const __m256d one = _mm256_set1_pd(1.0);
   __m256d al = _mm256_setr_pd(sw.al[0], sw.al[1], sw.al[2], 0.0);
   __m256d ar = _mm256_setr_pd(sw.ar[0], sw.ar[1], sw.ar[2], 0.0);
   __m128i nl = _mm_setzero_si128();
-  __m128i not_right = nl;
-  __m256d bm = inf;
+  __m128i nr = _mm_set1_epi32(static_cast<int>(n));
+  __m256d bm = _mm256_set1_pd(std::numeric_limits<double>::infinity());
   __m256d bj = _mm256_set1_pd(-1.0);
-  __m256d jv = zero;
+  // Few registers, so that the running minimum stays in one (with sixteen live values GCC kept
+  // it on the stack: a store and a reload in the loop's chain). A plane with an empty side gets
+  // an all-ones pattern (a NaN) instead of infinity: min(NaN, best) is best and NaN < best is
+  // false, as inf would give; the other planes' values pass unchanged (m | 0).
   for (int j = 0; j + 1 < nb_max; ++j) {
     nl = _mm_add_epi32(nl, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_lo[j])));
-    not_right =
-        _mm_add_epi32(not_right, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_hi[j])));
+    nr = _mm_sub_epi32(nr, _mm_load_si128(reinterpret_cast<const __m128i*>(hist_hi[j])));
     const __m256d nld = _mm256_cvtepi32_pd(nl);
-    const __m256d nrd = _mm256_cvtepi32_pd(_mm_sub_epi32(nv, not_right));
+    const __m256d nrd = _mm256_cvtepi32_pd(nr);
     al = _mm256_add_pd(al, da);
     ar = _mm256_sub_pd(ar, da);
     const __m256d m = _mm256_add_pd(_mm256_mul_pd(al, nld), _mm256_mul_pd(ar, nrd));
-    const __m256d ok =
-        _mm256_and_pd(_mm256_cmp_pd(nld, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(nrd, zero, _CMP_NEQ_UQ));
-    // Selections as and / andnot / or: GCC turns blendv on a comparison into per-lane branches.
-    const __m256d mv = _mm256_or_pd(_mm256_and_pd(ok, m), _mm256_andnot_pd(ok, inf));
+    const __m256d empty =
+        _mm256_or_pd(_mm256_cmp_pd(nld, zero, _CMP_EQ_OQ), _mm256_cmp_pd(nrd, zero, _CMP_EQ_OQ));
+    const __m256d mv = _mm256_or_pd(m, empty);
     const __m256d lt = _mm256_cmp_pd(mv, bm, _CMP_LT_OQ);
-    bj = _mm256_or_pd(_mm256_and_pd(lt, jv), _mm256_andnot_pd(lt, bj));
+    // Selections as and / andnot / or: GCC turns blendv on a comparison into per-lane branches.
+    bj = _mm256_or_pd(_mm256_and_pd(lt, _mm256_broadcast_sd(&kIndex[j])), _mm256_andnot_pd(lt, bj));
     bm = _mm256_min_pd(mv, bm);
-    jv = _mm256_add_pd(jv, one);
   }
-  alignas(32) double m4[4];
-  alignas(32) double j4[4];
-  _mm256_store_pd(m4, bm);
-  _mm256_store_pd(j4, bj);
-  for (int k = 0; k < 3; ++k) {
-    sw.best_m[k] = m4[k];
-    sw.best_j[k] = static_cast<int>(j4[k]);
-  }
+  // Lanes taken out by shuffles: stored to an array, the minimum's register shared the array's
+  // stack slot and the loop kept it there (a store and a reload per plane).
+  const __m128d m01 = _mm256_castpd256_pd128(bm);
+  const __m128d m23 = _mm256_extractf128_pd(bm, 1);
+  const __m128d j01 = _mm256_castpd256_pd128(bj);
+  const __m128d j23 = _mm256_extractf128_pd(bj, 1);
+  sw.best_m[0] = _mm_cvtsd_f64(m01);
+  sw.best_m[1] = _mm_cvtsd_f64(_mm_unpackhi_pd(m01, m01));
+  sw.best_m[2] = _mm_cvtsd_f64(m23);
+  sw.best_j[0] = static_cast<int>(_mm_cvtsd_f64(j01));
+  sw.best_j[1] = static_cast<int>(_mm_cvtsd_f64(_mm_unpackhi_pd(j01, j01)));
+  sw.best_j[2] = static_cast<int>(_mm_cvtsd_f64(j23));
 }
 #endif
 
@@ -850,7 +958,12 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items, std
     const __m128 zero = _mm_setzero_ps();
     __m128 vlo = _mm_set1_ps(std::numeric_limits<float>::infinity());
     __m128 vkey = _mm_set1_ps(-std::numeric_limits<float>::infinity());
-    alignas(16) std::int32_t idx[8];
+    const __m128i lane_bytes = _mm_setr_epi32(0, 4, 8, 12);
+    auto* lo_bytes = reinterpret_cast<unsigned char*>(&hist_lo[0][0]);
+    auto* hi_bytes = reinterpret_cast<unsigned char*>(&hist_hi[0][0]);
+#if !defined(__x86_64__)
+    alignas(16) std::uint32_t idx[8];
+#endif
     for (std::uint32_t i = 0; i < n; ++i) {
       const float* p = items[i].lo;
       const __m128 a = _mm_loadu_ps(p);
@@ -861,14 +974,29 @@ BinnedSplit Builder::find_binned_split(const Box& box, const BinItem* items, std
           _mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(a, base_a), scale_a), zero), top_a);
       const __m128 fc =
           _mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(c, base_a), scale_b), zero), top_a);
-      _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(fa));
-      _mm_store_si128(reinterpret_cast<__m128i*>(idx + 4), _mm_cvttps_epi32(fc));
-      ++hist_lo[idx[0]][0];
-      ++hist_lo[idx[1]][1];
-      ++hist_lo[idx[2]][2];
-      ++hist_hi[idx[4]][0];
-      ++hist_hi[idx[5]][1];
-      ++hist_hi[idx[6]][2];
+      // Byte offsets into the histograms (bin * 16 + lane * 4) computed in the register, so
+      // that each increment needs no index arithmetic of its own.
+      const __m128i oa = _mm_add_epi32(_mm_slli_epi32(_mm_cvttps_epi32(fa), 4), lane_bytes);
+      const __m128i oc = _mm_add_epi32(_mm_slli_epi32(_mm_cvttps_epi32(fc), 4), lane_bytes);
+#if defined(__x86_64__)
+      const auto a01 = static_cast<std::uint64_t>(_mm_cvtsi128_si64(oa));
+      const auto c01 = static_cast<std::uint64_t>(_mm_cvtsi128_si64(oc));
+      const std::uint32_t off[6] = {
+          static_cast<std::uint32_t>(a01),
+          static_cast<std::uint32_t>(a01 >> 32),
+          static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm_unpackhi_epi64(oa, oa))),
+          static_cast<std::uint32_t>(c01),
+          static_cast<std::uint32_t>(c01 >> 32),
+          static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm_unpackhi_epi64(oc, oc)))};
+#else
+      _mm_store_si128(reinterpret_cast<__m128i*>(idx), oa);
+      _mm_store_si128(reinterpret_cast<__m128i*>(idx + 4), oc);
+      const std::uint32_t off[6] = {idx[0], idx[1], idx[2], idx[4], idx[5], idx[6]};
+#endif
+      for (int k = 0; k < 3; ++k) {
+        ++*reinterpret_cast<std::uint32_t*>(lo_bytes + off[k]);
+        ++*reinterpret_cast<std::uint32_t*>(hi_bytes + off[3 + k]);
+      }
     }
     alignas(16) float l4[4];
     alignas(16) float k4[4];
@@ -1240,8 +1368,15 @@ void Builder::face_slabs(const Box& box, int k, double sum, double prod, std::si
 }
 
 void Builder::make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0) {
-  // Every item has exactly one start or planar event per axis.
   leaf_scratch_.clear();
+  if (node == exact_root_) {
+    // The exact subtree's root holds every local id, whose item ids ascend (gid_, from the
+    // binned list, which keeps the root's id order): most hand-overs end here as a leaf.
+    leaf_scratch_.assign(gid_.begin(), gid_.end());
+    emit_leaf(node, leaf_scratch_);
+    return;
+  }
+  // Every item has exactly one start or planar event per axis.
   const Key* ev = ev_[0].data();
   for (std::size_t i = b0; i < e0; ++i)
     if (key_type(ev[i]) != kEnd) leaf_scratch_.push_back(gid_[key_id(ev[i])]);
@@ -1250,7 +1385,10 @@ void Builder::make_leaf(std::uint32_t node, std::size_t b0, std::size_t e0) {
 
 // A leaf's list in ascending item id (deterministic; the hardware's tie rule may depend on it).
 void Builder::emit_leaf(std::uint32_t node, std::vector<std::uint32_t>& ids) {
-  std::sort(ids.begin(), ids.end());
+  // Lists taken from the binned stage are in id order already.
+  if (!std::is_sorted(ids.begin(), ids.end())) {
+    std::sort(ids.begin(), ids.end());
+  }
   KdTreeNode& nd = tree_.nodes[node];
   nd.leaf = true;
   nd.first = static_cast<std::uint32_t>(tree_.items.size());
