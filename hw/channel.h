@@ -71,6 +71,21 @@ class ChannelBase {
   bool can_push() const { return push_ready_ <= *now_; }
   bool can_pop() const { return pop_ready_ <= *now_; }
 
+  // A fast path that serves this channel's items without moving them (memif's lanes: the
+  // controller computes each request's cycles when it is pushed) books each push and pop here in
+  // the cycle it stands for, so the channel's statistics (pushes, occupancy, largest occupancy)
+  // are those of the stepped model. `occupancy` is the committed occupancy at the end of the push
+  // cycle. Neither wakes a module: the fast path's owner knows its cycles.
+  void book_push(std::uint64_t cycle, std::uint64_t occupancy) {
+    ++tail_;
+    push_cycles_ += cycle;
+    max_count_ = std::max(max_count_, occupancy);
+  }
+  void book_pop(std::uint64_t cycle) {
+    ++head_;
+    pop_cycles_ += cycle;
+  }
+
   Module* producer() const { return producer_; }
   Module* consumer() const { return consumer_; }
   std::uint64_t total_pushes() const { return tail_; }

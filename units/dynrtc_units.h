@@ -159,6 +159,13 @@ class RaySource : public CycleUnit {
   }
   void issue_access(memif::MemoryController::Port& port, std::uint16_t client, ThreadToken t,
                     Held& h);
+  // A port's request side, through its lane when it has one (docs/memif.md "Lanes").
+  static bool can_push(const memif::MemoryController::Port& port) {
+    return port.lane != nullptr ? port.lane->can_push() : port.requests.can_push();
+  }
+  static std::uint64_t push_ready_cycle(const memif::MemoryController::Port& port) {
+    return port.lane != nullptr ? port.lane->push_ready_cycle() : port.requests.push_ready_cycle();
+  }
 
   RayGenerationController& rgc_;
   int pipeline_;

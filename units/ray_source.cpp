@@ -105,9 +105,15 @@ int RaySource::admit() {
 // wave queues for the read port behind the reads already waiting; its last read starts its
 // shading, done `depth` cycles later.
 int RaySource::receive_shading() {
-  auto& responses = ports_.shading->responses;
-  if (!responses.can_pop()) return 0;
-  const auto t = static_cast<ThreadToken>(responses.pop().tag);
+  ThreadToken t;
+  if (memif::MemoryController::Lane* lane = ports_.shading->lane) {
+    if (!lane->can_pop()) return 0;
+    t = static_cast<ThreadToken>(lane->pop());
+  } else {
+    auto& responses = ports_.shading->responses;
+    if (!responses.can_pop()) return 0;
+    t = static_cast<ThreadToken>(responses.pop().tag);
+  }
   Held& h = held(t);
   if (--h.outstanding == 0) {
     if (h.next < h.reads)
@@ -130,13 +136,16 @@ void RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t 
   m.offset = a.offset;
   m.data[0] = a.data;
   if (a.write) m.counted_bytes = 3;  // a pixel's RGB8: 3 bytes of the word count (D36)
-  port.requests.push(m);
+  if (port.lane != nullptr)
+    port.lane->push(m);
+  else
+    port.requests.push(m);
 }
 
 // One read per cycle on the shading port: the front thread's wave, back to back; a thread leaves
 // the queue at the end of its wave (the next one waits for this one's words).
 int RaySource::issue_read() {
-  if (reading_.empty() || !ports_.shading->requests.can_push()) return 0;
+  if (reading_.empty() || !can_push(*ports_.shading)) return 0;
   const ThreadToken t = reading_.front();
   Held& h = held(t);
   const std::uint8_t wave = (*h.access)[h.next].wave;
@@ -156,7 +165,7 @@ int RaySource::write_and_leave() {
     shading_.pop_front();
     (held(t).next < held(t).access->size() ? writing_ : leaving_).push_back(t);
   }
-  if (!writing_.empty() && ports_.frame->requests.can_push()) {
+  if (!writing_.empty() && can_push(*ports_.frame)) {
     const ThreadToken t = writing_.front();
     Held& h = held(t);
     issue_access(*ports_.frame, ports_.frame_client, t, h);
@@ -181,10 +190,11 @@ int RaySource::write_and_leave() {
 std::uint64_t RaySource::extra_wakeup(std::uint64_t now) const {
   if (!leaving_.empty()) return now + 1;
   std::uint64_t t = shading_.empty() ? hw::kNever : std::max(now + 1, held(shading_.front()).due);
-  if (!reading_.empty())
-    t = std::min(t, std::max(now + 1, ports_.shading->requests.push_ready_cycle()));
-  if (!writing_.empty())
-    t = std::min(t, std::max(now + 1, ports_.frame->requests.push_ready_cycle()));
+  if (!reading_.empty()) t = std::min(t, std::max(now + 1, push_ready_cycle(*ports_.shading)));
+  if (!writing_.empty()) t = std::min(t, std::max(now + 1, push_ready_cycle(*ports_.frame)));
+  // A lane's response wakes no one: the RGS takes it in the cycle it becomes visible.
+  if (ports_.shading != nullptr && ports_.shading->lane != nullptr)
+    t = std::min(t, ports_.shading->lane->response_cycle());
   if (free_list_.empty() || !rgc_.packets_left(pipeline_, now)) return t;
   return std::min(t, rgc_.next_grant(pipeline_, now));
 }
