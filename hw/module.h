@@ -88,9 +88,12 @@ class Module {
   // the kernel's count of evaluated and repeated cycles, so the caller counts only cycles the
   // kernel does not (a busy cycle in which evaluate() made no progress, a stall cycle that was
   // neither evaluated as stalled nor repeated from a stalled evaluation).
-  void count_cycles(std::uint64_t busy, std::uint64_t stall) {
+  // `unstall`: cycles the kernel counted (or is about to count, for the cycle being evaluated) as
+  // stalled that the work served stands for progress in.
+  void count_cycles(std::uint64_t busy, std::uint64_t stall, std::uint64_t unstall = 0) {
     busy_count_ += busy;
     stall_count_ += stall;
+    stall_count_ -= unstall;  // (the kernel's count is added first, or in this cycle)
   }
   // Counts the cycles since the module's last evaluation now, as the kernel would before its next
   // evaluation (repeats of the last one, then skipped()); nothing if it was evaluated in this

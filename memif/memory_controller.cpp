@@ -161,7 +161,7 @@ bool MemoryController::Lane::bind(const MemRequest& r) {
 
 bool MemoryController::Lane::can_push() const {
   const std::uint64_t t = mc_.now();
-  if (last_push_ == t) return false;  // the port's width: one request per cycle
+  if (last_push_ != hw::kNever && last_push_ >= t) return false;  // one request per cycle
   const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
   // Full at the end of the last cycle: the cap-th newest request was not taken in before it.
   return pushed_ < cap || accepts_[(pushed_ - cap) & hist_mask_] < t;
@@ -180,10 +180,21 @@ std::uint64_t MemoryController::Lane::push_ready_cycle() const {
 // intake at the earliest, when the bank is free and (reads) fewer than the limit of reads are in
 // flight after that cycle's retire; a read retires at its due cycle (its port's response channel
 // always has room: the client takes each response the cycle it becomes visible).
-void MemoryController::Lane::push(const MemRequest& r) {
+std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const {
+  std::uint64_t c = std::max(from, last_push_ == hw::kNever ? 0 : last_push_ + 1);
+  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
+  if (pushed_ >= cap) c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  return c;
+}
+
+bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
+  return state_ == State::kOpen && cycle + mc_.lane_horizon() - mc_.lane_from_ < mc_.lane_mask_ / 2;
+}
+
+std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t t) {
   if (state_ == State::kUnbound && !bind(r)) {
     port_.requests.push(r);
-    return;
+    return 0;
   }
   if (r.words < 1 || r.words > kMaxRequestWords || r.bank != bank_ ||
       static_cast<std::uint64_t>(r.offset) + r.words > mc_.image_.bank(r.bank).size() ||
@@ -194,8 +205,9 @@ void MemoryController::Lane::push(const MemRequest& r) {
                              ", " + std::to_string(r.words) + " words, client " +
                              std::to_string(r.client) + ")");
   }
-  const std::uint64_t t = mc_.now();
   const std::uint64_t k = pushed_;
+  if (t < mc_.now() || (last_push_ != hw::kNever && t <= last_push_))
+    throw std::logic_error("memory controller: lane " + port_.name + " pushed out of order");
   // The lane's steps are booked when the controller's cycles are counted (its evaluations, the
   // kernel's accounting); a lane whose controller sleeps long books them here when its ring of
   // requests is full.
@@ -245,14 +257,20 @@ void MemoryController::Lane::push(const MemRequest& r) {
   last_accept_ = accept;
   bank_free_ = start + r.words;
   ++pushed_;
+  return reads_ ? retire + 1 : 0;
 }
 
 // (Booked with the lane's other steps: the response is taken in the cycle after its retire.)
 std::uint32_t MemoryController::Lane::pop() {
-  if (popped_ >= pushed_ || item(popped_).retire + 1 != mc_.now())
+  return pop_through(1);
+}
+
+std::uint32_t MemoryController::Lane::pop_through(std::uint64_t count) {
+  if (count == 0 || popped_ + count > pushed_ || item(popped_ + count - 1).retire + 1 != mc_.now())
     throw std::logic_error("memory controller: lane " + port_.name +
                            "'s response not taken in the cycle it became visible");
-  return item(popped_++).tag;
+  popped_ += count;
+  return item(popped_ - 1).tag;
 }
 
 bool MemoryController::Lane::idle() const {

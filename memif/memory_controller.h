@@ -83,6 +83,8 @@ class MemoryController : public hw::Module {
   // all into one bank that nothing else uses. Before the first cycle; the lane decides at its
   // first request whether it can run (otherwise the port works through its channels).
   Lane& add_lane(Port& port, bool reads);
+  // Cycles in a lane's window (a client planning ahead keeps its own marks in as many).
+  std::uint64_t lane_window() const { return lane_mask_ + 1; }
   // Returns every lane's port to its channels (a host upload is about to write into the banks).
   // Throws std::logic_error once a lane has served a request.
   void close_lanes();
@@ -199,7 +201,18 @@ class MemoryController::Lane {
   // The port's request channel would take a push in this cycle / from which cycle on it will.
   bool can_push() const;
   std::uint64_t push_ready_cycle() const;
-  void push(const MemRequest& r);
+  void push(const MemRequest& r) { (void)push_at(r, mc_.now()); }
+  // Planning ahead (the client knows what it will push in which cycle, as the RGS does for a
+  // wave of reads going out back to back): the first cycle from `from` on in which the port would
+  // take a push after those pushed so far; whether a push in `cycle` stays within the lane's
+  // window; a push in a cycle from now on (in cycle order, each where the port takes it).
+  // push_at returns the cycle a read's response becomes visible (0 for a write).
+  std::uint64_t next_push_cycle(std::uint64_t from) const;
+  bool plannable(std::uint64_t cycle) const;
+  std::uint64_t push_at(const MemRequest& r, std::uint64_t cycle);
+  // Takes the next `count` responses, the last of which becomes visible in this cycle (the ones
+  // before it were visible in earlier cycles: taken then, booked as such); returns its tag.
+  std::uint32_t pop_through(std::uint64_t count);
   // A response visible in this cycle; the cycle the next one becomes visible (kNever: none).
   bool can_pop() const { return response_cycle() <= mc_.now(); }
   std::uint64_t response_cycle() const {

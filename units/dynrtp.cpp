@@ -58,7 +58,8 @@ CycleUnit& make_rgs(const UnitContext& c) {
   // statistics as through the channels).
   if (c.params.pipelines == 1) c.memory.add_lanes(pipe);
   const RgsPorts ports{&c.memory.shading_port(pipe), &c.memory.frame_port(pipe),
-                       c.memory.shading_client(pipe), c.memory.frame_client(pipe)};
+                       c.memory.shading_client(pipe), c.memory.frame_client(pipe),
+                       c.params.pipelines == 1 ? c.memory.controller().lane_window() : 0};
   return c.kernel.make<RaySource>(c.name, c.threads, c.params.rgs_depth, c.rgc, pipe,
                                   static_cast<ThreadToken>(pipe * c.params.threads),
                                   c.params.threads, ports);
