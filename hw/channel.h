@@ -76,14 +76,15 @@ class ChannelBase {
   // the cycle it stands for, so the channel's statistics (pushes, occupancy, largest occupancy)
   // are those of the stepped model. `occupancy` is the committed occupancy at the end of the push
   // cycle. Neither wakes a module: the fast path's owner knows its cycles.
-  void book_push(std::uint64_t cycle, std::uint64_t occupancy) {
-    ++tail_;
-    push_cycles_ += cycle;
+  // (Several at once: their count, the sum of their cycles, the largest occupancy.)
+  void book_pushes(std::uint64_t n, std::uint64_t cycles, std::uint64_t occupancy) {
+    tail_ += n;
+    push_cycles_ += cycles;
     max_count_ = std::max(max_count_, occupancy);
   }
-  void book_pop(std::uint64_t cycle) {
-    ++head_;
-    pop_cycles_ += cycle;
+  void book_pops(std::uint64_t n, std::uint64_t cycles) {
+    head_ += n;
+    pop_cycles_ += cycles;
   }
 
   Module* producer() const { return producer_; }

@@ -281,30 +281,45 @@ bool MemoryController::Lane::idle() const {
 // Books the steps of every request before cycle `to`, as the stepped model does in those cycles.
 void MemoryController::Lane::settle(std::uint64_t to) {
   Bank& bank = mc_.banks_[static_cast<std::size_t>(bank_)];
-  for (; booked_ < pushed_ && item(booked_).push < to; ++booked_)
-    port_.requests.book_push(item(booked_).push, item(booked_).occupancy);
-  for (; accepted_ < booked_ && item(accepted_).accept < to; ++accepted_) {
-    port_.requests.book_pop(item(accepted_).accept);
-    bank.max_queue->set_max(item(accepted_).queued);
+  std::uint64_t n = 0, sum = 0, most = 0;
+  for (; booked_ < pushed_ && item(booked_).push < to; ++booked_, ++n) {
+    sum += item(booked_).push;
+    most = std::max<std::uint64_t>(most, item(booked_).occupancy);
   }
-  for (; started_ < accepted_ && item(started_).start < to; ++started_) {
+  if (n != 0) port_.requests.book_pushes(n, sum, most);
+  n = sum = most = 0;
+  for (; accepted_ < booked_ && item(accepted_).accept < to; ++accepted_, ++n) {
+    sum += item(accepted_).accept;
+    most = std::max<std::uint64_t>(most, item(accepted_).queued);
+  }
+  if (n != 0) {
+    port_.requests.book_pops(n, sum);
+    bank.max_queue->set_max(most);
+  }
+  n = sum = 0;
+  for (; started_ < accepted_ && item(started_).start < to; ++started_, ++n) {
     const Item& it = item(started_);
-    *bank.words += it.words;
+    sum += it.words;
     *mc_.clients_[it.client].bytes += it.counted_bytes ? it.counted_bytes : 4u * it.words;
-    if (reads_) {
-      ++*bank.reads;
-    } else {
-      ++*bank.writes;
+    if (!reads_) {
       std::uint32_t* const mem = mc_.image_.bank(bank_).data() + it.offset;
       for (int i = 0; i < it.words; ++i)
         mem[i] = it.data[static_cast<std::size_t>(i)];
     }
   }
+  if (n != 0) {
+    *bank.words += sum;
+    *(reads_ ? bank.reads : bank.writes) += n;
+  }
   if (reads_) {
-    for (; retired_ < started_ && item(retired_).retire < to; ++retired_)
-      port_.responses.book_push(item(retired_).retire, 1);
-    for (; taken_ < retired_ && item(taken_).retire + 1 < to; ++taken_)
-      port_.responses.book_pop(item(taken_).retire + 1);
+    n = sum = 0;
+    for (; retired_ < started_ && item(retired_).retire < to; ++retired_, ++n)
+      sum += item(retired_).retire;
+    if (n != 0) port_.responses.book_pushes(n, sum, 1);
+    n = sum = 0;
+    for (; taken_ < retired_ && item(taken_).retire + 1 < to; ++taken_, ++n)
+      sum += item(taken_).retire + 1;
+    if (n != 0) port_.responses.book_pops(n, sum);
   }
 }
 
@@ -331,7 +346,10 @@ std::uint64_t MemoryController::take_lane_cycles(std::vector<std::uint64_t>& bit
     const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
     const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
     std::uint64_t& w = bits[(c >> 6) & words];
-    n += static_cast<std::uint64_t>(std::popcount(w & m));
+    // (The marks are a few per word: counted one by one, as the build's target has no popcount
+    // instruction and std::popcount becomes a library call.)
+    for (std::uint64_t x = w & m; x != 0; x &= x - 1)
+      ++n;
     w &= ~m;
     c += len;
   }

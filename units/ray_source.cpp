@@ -154,7 +154,10 @@ std::uint64_t RaySource::take_virtual(std::uint64_t from, std::uint64_t to) {
     const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
     const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
     std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
-    n += static_cast<std::uint64_t>(std::popcount(w & m));
+    // (The marks are a few per word: counted one by one, as the build's target has no popcount
+    // instruction and std::popcount becomes a library call.)
+    for (std::uint64_t x = w & m; x != 0; x &= x - 1)
+      ++n;
     w &= ~m;
     c += len;
   }
