@@ -248,10 +248,17 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
   it.data = r.data;
   // The controller's cycles: progress at the intake, the start and the retire; a stall while the
   // request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
-  if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_) mc_.account_now();
-  mc_.mark_lane_cycles(mc_.lane_busy_, accept, accept + 1);
-  mc_.mark_lane_cycles(mc_.lane_busy_, start, start + 1);
-  if (reads_) mc_.mark_lane_cycles(mc_.lane_busy_, retire, retire + 1);
+  if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_) {
+    mc_.account_now();
+    if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_)
+      throw std::logic_error("memory controller: lane " + port_.name + "'s cycle " +
+                             std::to_string(std::max(start, retire)) + " beyond its window");
+  }
+  std::uint64_t* const busy = mc_.lane_busy_.data();
+  const std::uint64_t words = mc_.lane_busy_.size() - 1;
+  busy[(accept >> 6) & words] |= std::uint64_t{1} << (accept & 63);
+  busy[(start >> 6) & words] |= std::uint64_t{1} << (start & 63);
+  if (reads_) busy[(retire >> 6) & words] |= std::uint64_t{1} << (retire & 63);
   if (accept > visible) mc_.mark_lane_cycles(mc_.lane_stall_, visible, accept);
   last_push_ = t;
   last_accept_ = accept;
