@@ -170,8 +170,15 @@ std::uint64_t RaySource::take_virtual(std::uint64_t from, std::uint64_t to) {
 // the cycles after it, as repeats of it).
 int RaySource::evaluate() {
   const int p = CycleUnit::evaluate();
-  if (virtual_marked_ != 0 && take_virtual(now(), now() + 1) != 0 && p == 0)
-    count_cycles(1, 0, stalled() ? 1 : 0);
+  if (virtual_marked_ != 0) {
+    const std::uint64_t c = now(), bit = std::uint64_t{1} << (c & 63);
+    std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
+    if ((w & bit) != 0) {
+      w &= ~bit;
+      --virtual_marked_;
+      if (p == 0) count_cycles(1, 0, stalled() ? 1 : 0);
+    }
+  }
   virtual_from_ = now() + 1;
   return p;
 }
