@@ -83,6 +83,7 @@ MemoryController::Lane& MemoryController::add_lane(Port& port, bool reads) {
   lanes_.push_back(std::unique_ptr<Lane>(new Lane(*this, port, index, reads)));
   port.lane = lanes_.back().get();
   bound_idle_skip();
+  lane_reach_ = lane_horizon();
   if (lane_busy_.empty()) {
     // Wide enough that a lane's pushes rarely have to book the past first (the controller's
     // own evaluations book it as they go).
@@ -188,7 +189,7 @@ std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const 
 }
 
 bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
-  return state_ == State::kOpen && cycle + mc_.lane_horizon() - mc_.lane_from_ < mc_.lane_mask_ / 2;
+  return state_ == State::kOpen && cycle + mc_.lane_reach_ - mc_.lane_from_ < mc_.lane_mask_ / 2;
 }
 
 std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t t) {

@@ -183,8 +183,9 @@ class MemoryController : public hw::Module {
   unsigned lane_banks_ = 0;  // bit b: bank b is a lane's
   int open_lanes_ = 0;       // lanes serving requests
   std::vector<std::uint64_t> lane_busy_, lane_stall_;
-  std::uint64_t lane_mask_ = 0;  // cycles in the window - 1
-  std::uint64_t lane_from_ = 0;  // the first cycle not yet counted
+  std::uint64_t lane_mask_ = 0;   // cycles in the window - 1
+  std::uint64_t lane_reach_ = 0;  // lane_horizon(), computed once
+  std::uint64_t lane_from_ = 0;   // the first cycle not yet counted
 };
 
 // A lane: a port whose requests all go to one bank that nothing else uses, on an issue path of
