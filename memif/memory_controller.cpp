@@ -129,13 +129,14 @@ MemoryController::Lane::Lane(MemoryController& mc, Port& port, int port_index, b
 // The lane runs only where its closed form is the stepped model's: its bank alone on its issue
 // path and idle, no other lane on it, the kernel skipping idle work (the reference evaluates
 // every cycle), no VCD trace (it samples the channels every cycle), and a watchdog that no
-// stretch of lane-only progress can reach (the kernel sees no progress in those cycles).
+// stretch of lane-only progress can reach (the kernel sees no progress in those cycles; a client
+// planning ahead, as the RGS does up to 16 requests, stretches it to about as many horizons).
 bool MemoryController::Lane::bind(const MemRequest& r) {
   hw::Kernel& k = mc_.kernel();
   const int b = r.bank;
   const std::uint64_t wd = k.config().watchdog_cycles;
   bool ok = b < kNumBanks && r.write != reads_ && k.config().idle_skip && !k.tracing() &&
-            k.config().time_series_period == 0 && (wd == 0 || wd > mc_.lane_horizon());
+            k.config().time_series_period == 0 && (wd == 0 || wd > 32 * mc_.lane_horizon());
   if (ok) {
     const Path& path =
         mc_.paths_[static_cast<std::size_t>(mc_.config_.bank_path[static_cast<std::size_t>(b)])];
