@@ -71,6 +71,22 @@ class ChannelBase {
   bool can_push() const { return push_ready_ <= *now_; }
   bool can_pop() const { return pop_ready_ <= *now_; }
 
+  // A fast path that serves this channel's items without moving them (memif's lanes: the
+  // controller computes each request's cycles when it is pushed) books each push and pop here in
+  // the cycle it stands for, so the channel's statistics (pushes, occupancy, largest occupancy)
+  // are those of the stepped model. `occupancy` is the committed occupancy at the end of the push
+  // cycle. Neither wakes a module: the fast path's owner knows its cycles.
+  // (Several at once: their count, the sum of their cycles, the largest occupancy.)
+  void book_pushes(std::uint64_t n, std::uint64_t cycles, std::uint64_t occupancy) {
+    tail_ += n;
+    push_cycles_ += cycles;
+    max_count_ = std::max(max_count_, occupancy);
+  }
+  void book_pops(std::uint64_t n, std::uint64_t cycles) {
+    head_ += n;
+    pop_cycles_ += cycles;
+  }
+
   Module* producer() const { return producer_; }
   Module* consumer() const { return consumer_; }
   std::uint64_t total_pushes() const { return tail_; }

@@ -58,6 +58,10 @@ Stats& Module::stats() const {
   return kernel_->stats();
 }
 
+void Module::account_now() {
+  if (accounted_ < *now_) kernel_->account(this);
+}
+
 void Module::consumes(ChannelBase& c) {
   if (c.consumer_ != nullptr && c.consumer_ != this)
     throw std::logic_error("channel '" + c.name() + "': consumed by both '" + c.consumer_->name() +
@@ -279,8 +283,10 @@ RunResult Kernel::run_cycles(const std::function<bool()>& done, std::uint64_t ma
     if (step_cycle() != 0 || !config_.idle_skip) continue;
     // Idle cycle: jump to the earliest cycle where anything (or anything we report) can change.
     std::uint64_t target = std::min(next_event(), limit);
-    for (const Module* m : modules_)  // a sleeper's pending wake (next_event covers the rest)
+    for (const Module* m : modules_) {  // a sleeper's pending wake (next_event covers the rest)
       if (m->sleeps_) target = std::min(target, schedule_.wake_cycle(m->slot_));
+      if (m->bounds_skip_) target = std::min(target, m->skip_bound(cycle_));
+    }
     if (wd != 0) target = std::min(target, progress_mark_ + wd);
     const std::uint64_t period = config_.time_series_period;
     if (period != 0) target = std::min(target, (cycle_ / period + 1) * period);

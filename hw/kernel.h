@@ -85,6 +85,9 @@ class Kernel {
   std::uint64_t skipped_cycles() const { return skipped_; }
   std::uint64_t evaluated_cycles() const { return evaluated_; }
   std::uint64_t module_evaluations() const { return evaluations_; }
+  // A VCD trace is set (it samples every channel and module every cycle: fast paths that serve
+  // work without moving it through channels stay off).
+  bool tracing() const { return tracer_ != nullptr; }
 
   // Kernel-owned construction: the object lives as long as the kernel (modules and channels may
   // also be owned elsewhere; they register themselves either way).

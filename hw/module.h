@@ -52,6 +52,12 @@ class Module {
   // busy/stall cycles are kept by the kernel already.
   virtual void skipped(std::uint64_t /*cycles*/) { skipped_is_noop_ = true; }
 
+  // The earliest cycle > now at which state that the run's done() test or the figures read
+  // changes without any module being evaluated (a fast path's completion cycles, e.g. memif's
+  // lanes): the idle skip jumps no further than that. Asked only of modules that declared one
+  // (bound_idle_skip) and only when a cycle made no progress.
+  virtual std::uint64_t skip_bound(std::uint64_t /*now*/) const { return kNever; }
+
   // Kernel-kept per-module statistics: <name>.busy_cycles, <name>.stall_cycles.
   bool busy() const { return last_progress_ > 0; }
   bool stalled() const { return stalled_; }
@@ -77,6 +83,24 @@ class Module {
 
   // Marks this cycle as a stall: the module has work but is blocked (full output, no credit).
   void stall() { stalled_ = true; }
+  // Fast paths (work served in closed form, without the evaluations the stepped model spends on
+  // it) book the busy and stall cycles that work stands for: cycles counted here are on top of
+  // the kernel's count of evaluated and repeated cycles, so the caller counts only cycles the
+  // kernel does not (a busy cycle in which evaluate() made no progress, a stall cycle that was
+  // neither evaluated as stalled nor repeated from a stalled evaluation).
+  // `unstall`: cycles the kernel counted (or is about to count, for the cycle being evaluated) as
+  // stalled that the work served stands for progress in.
+  void count_cycles(std::uint64_t busy, std::uint64_t stall, std::uint64_t unstall = 0) {
+    busy_count_ += busy;
+    stall_count_ += stall;
+    stall_count_ -= unstall;  // (the kernel's count is added first, or in this cycle)
+  }
+  // Counts the cycles since the module's last evaluation now, as the kernel would before its next
+  // evaluation (repeats of the last one, then skipped()); nothing if it was evaluated in this
+  // cycle already. For a fast path that books cycles as they pass (count_cycles).
+  void account_now();
+  // The module overrides skip_bound().
+  void bound_idle_skip() { bounds_skip_ = true; }
   Kernel& kernel() const { return *kernel_; }
   Stats& stats() const;
   std::uint64_t now() const { return *now_; }
@@ -96,6 +120,7 @@ class Module {
   int last_progress_ = 0;
   bool stalled_ = false;
   bool sleeps_ = false;
+  bool bounds_skip_ = false;
   bool skipped_is_noop_ = false;  // set by the default skipped(): the kernel stops calling it
   bool commit_is_noop_ = false;   // set by the default commit(): the kernel stops calling it
   Kernel* kernel_;

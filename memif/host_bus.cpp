@@ -89,6 +89,7 @@ bool HostBus::stored() const {
 
 void HostBus::upload(int bank, std::uint32_t offset, const std::vector<std::uint32_t>& words) {
   check_protected(bank, offset, words.size());
+  controller_.close_lanes();  // the upload's writes may reach a lane's bank
   if (queue_.empty()) {
     start_ = now();
     spent_ = 0;

@@ -62,6 +62,340 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
   }
 }
 
+// ---- Lanes (docs/memif.md "Lanes") ----------------------------------------------------------
+
+// How far ahead of its push cycle a lane request's last step can lie: behind it at most the
+// port's other entries, a full bank queue and the reads in flight, each starting at most a
+// latency and a few cycles after the one before; then its own latency.
+std::uint64_t MemoryController::lane_horizon() const {
+  const auto lat = static_cast<std::uint64_t>(config_.latency);
+  const auto ahead =
+      static_cast<std::uint64_t>(config_.port_capacity + config_.queue_depth + inflight_limit_ + 2);
+  return ahead * (lat + 6) + lat + 8;
+}
+
+MemoryController::Lane& MemoryController::add_lane(Port& port, bool reads) {
+  int index = -1;
+  for (std::size_t p = 0; p < ports_.size(); ++p)
+    if (ports_[p].get() == &port) index = static_cast<int>(p);
+  if (index < 0 || port.lane != nullptr)
+    throw std::logic_error("memory controller '" + name() + "': no lane for port " + port.name);
+  lanes_.push_back(std::unique_ptr<Lane>(new Lane(*this, port, index, reads)));
+  port.lane = lanes_.back().get();
+  bound_idle_skip();
+  lane_reach_ = lane_horizon();
+  if (lane_busy_.empty()) {
+    // Wide enough that a lane's pushes rarely have to book the past first (the controller's
+    // own evaluations book it as they go).
+    std::uint64_t window = 4096;
+    while (window < 4 * lane_horizon())
+      window *= 2;
+    lane_busy_.assign(window / 64, 0);
+    lane_stall_.assign(window / 64, 0);
+    lane_mask_ = window - 1;
+  }
+  return *port.lane;
+}
+
+void MemoryController::close_lanes() {
+  for (auto& l : lanes_) {
+    if (l->state_ == Lane::State::kOpen)
+      throw std::logic_error("memory controller '" + name() + "': lane " + l->port_.name +
+                             " closed after it served requests");
+    l->state_ = Lane::State::kClosed;
+    l->port_.lane = nullptr;
+  }
+}
+
+MemoryController::Lane::Lane(MemoryController& mc, Port& port, int port_index, bool reads)
+    : mc_(mc), port_(port), port_index_(port_index), reads_(reads) {
+  const MemoryControllerConfig& c = mc.config_;
+  std::uint64_t n = 1;
+  while (n <
+         4 * static_cast<std::uint64_t>(c.port_capacity + c.queue_depth + mc.inflight_limit_ + 8))
+    n *= 2;
+  items_.resize(n);
+  item_mask_ = n - 1;
+  std::uint64_t h = 1;
+  while (h < static_cast<std::uint64_t>(
+                 std::max({c.port_capacity, c.queue_depth, mc.inflight_limit_}) + 2))
+    h *= 2;
+  accepts_.assign(h, 0);
+  starts_.assign(h, 0);
+  retires_.assign(h, 0);
+  hist_mask_ = h - 1;
+}
+
+// The lane runs only where its closed form is the stepped model's: its bank alone on its issue
+// path and idle, no other lane on it, the kernel skipping idle work (the reference evaluates
+// every cycle), no VCD trace (it samples the channels every cycle), and a watchdog that no
+// stretch of lane-only progress can reach (the kernel sees no progress in those cycles; a client
+// planning ahead, as the RGS does up to 16 requests, stretches it to about as many horizons).
+bool MemoryController::Lane::bind(const MemRequest& r) {
+  hw::Kernel& k = mc_.kernel();
+  const int b = r.bank;
+  const std::uint64_t wd = k.config().watchdog_cycles;
+  bool ok = b < kNumBanks && r.write != reads_ && k.config().idle_skip && !k.tracing() &&
+            k.config().time_series_period == 0 && (wd == 0 || wd > 32 * mc_.lane_horizon());
+  if (ok) {
+    const Path& path =
+        mc_.paths_[static_cast<std::size_t>(mc_.config_.bank_path[static_cast<std::size_t>(b)])];
+    const Bank& bank = mc_.banks_[static_cast<std::size_t>(b)];
+    ok = path.banks == (1u << b) && (mc_.lane_banks_ >> b & 1u) == 0 && bank.queue.empty() &&
+         bank.inflight.empty() && port_.requests.empty() && port_.responses.empty();
+  }
+  if (!ok) {
+    state_ = State::kClosed;
+    port_.lane = nullptr;
+    return false;
+  }
+  state_ = State::kOpen;
+  bank_ = b;
+  mc_.lane_banks_ |= 1u << b;
+  ++mc_.open_lanes_;
+  mc_.intake_[static_cast<std::size_t>(port_index_)] = nullptr;
+  bank_free_ = std::max(
+      mc_.free_at_[static_cast<std::size_t>(b)],
+      mc_.paths_[static_cast<std::size_t>(mc_.config_.bank_path[static_cast<std::size_t>(b)])]
+          .free_at);
+  return true;
+}
+
+bool MemoryController::Lane::can_push() const {
+  const std::uint64_t t = mc_.now();
+  if (last_push_ != hw::kNever && last_push_ >= t) return false;  // one request per cycle
+  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
+  // Full at the end of the last cycle: the cap-th newest request was not taken in before it.
+  return pushed_ < cap || accepts_[(pushed_ - cap) & hist_mask_] < t;
+}
+
+std::uint64_t MemoryController::Lane::push_ready_cycle() const {
+  std::uint64_t c = last_push_ == hw::kNever ? 0 : last_push_ + 1;
+  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
+  if (pushed_ >= cap) c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  return c;
+}
+
+// The request's cycles, from the stepped model's rules (memory_controller.h): visible at the
+// intake a cycle after its push, one intake per port and cycle, into a bank queue with room after
+// that cycle's start (the depth-th request before it has started); started a cycle after its
+// intake at the earliest, when the bank is free and (reads) fewer than the limit of reads are in
+// flight after that cycle's retire; a read retires at its due cycle (its port's response channel
+// always has room: the client takes each response the cycle it becomes visible).
+std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const {
+  std::uint64_t c = std::max(from, last_push_ == hw::kNever ? 0 : last_push_ + 1);
+  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
+  if (pushed_ >= cap) c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  return c;
+}
+
+bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
+  return state_ == State::kOpen && cycle + mc_.lane_reach_ - mc_.lane_from_ < mc_.lane_mask_ / 2;
+}
+
+std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t t) {
+  if (state_ == State::kUnbound && !bind(r)) {
+    port_.requests.push(r);
+    return 0;
+  }
+  if (r.words < 1 || r.words > kMaxRequestWords || r.bank != bank_ ||
+      static_cast<std::uint64_t>(r.offset) + r.words > mc_.image_.bank(r.bank).size() ||
+      r.client >= mc_.clients_.size() || r.write == reads_) {
+    throw std::runtime_error("memory controller '" + mc_.name() + "': port " + port_.name +
+                             " sent a request outside memory or its lane (bank " +
+                             std::to_string(r.bank) + ", offset " + std::to_string(r.offset) +
+                             ", " + std::to_string(r.words) + " words, client " +
+                             std::to_string(r.client) + ")");
+  }
+  const std::uint64_t k = pushed_;
+  if (t < mc_.now() || (last_push_ != hw::kNever && t <= last_push_))
+    throw std::logic_error("memory controller: lane " + port_.name + " pushed out of order");
+  // The lane's steps are booked when the controller's cycles are counted (its evaluations, the
+  // kernel's accounting); a lane whose controller sleeps long books them here when its ring of
+  // requests is full.
+  if (k - (reads_ ? taken_ : started_) > item_mask_) mc_.account_now();
+  if (k - (reads_ ? taken_ : started_) > item_mask_)
+    throw std::logic_error("memory controller: lane " + port_.name + " holds too many requests");
+  const auto depth = static_cast<std::uint64_t>(mc_.config_.queue_depth);
+  const auto limit = static_cast<std::uint64_t>(mc_.inflight_limit_);
+  const std::uint64_t visible = std::max(t + 1, k == 0 ? 0 : last_accept_ + 1);
+  std::uint64_t accept = visible;
+  if (k >= depth) accept = std::max(accept, starts_[(k - depth) & hist_mask_]);
+  std::uint64_t start = std::max(accept + 1, bank_free_);
+  if (reads_ && k >= limit) start = std::max(start, retires_[(k - limit) & hist_mask_]);
+  const std::uint64_t retire =
+      reads_ ? start + r.words - 1 + static_cast<std::uint64_t>(mc_.config_.latency) : 0;
+  // The bank queue after the intake: the requests from the first not started by then on.
+  while (queue_front_ < k && starts_[queue_front_ & hist_mask_] <= accept)
+    ++queue_front_;
+  // The port's request channel at the end of this cycle: this request and those taken in later.
+  std::uint64_t occupancy = 1;
+  for (std::uint64_t j = k; j > 0 && j + hist_mask_ > k && accepts_[(j - 1) & hist_mask_] > t; --j)
+    ++occupancy;
+  accepts_[k & hist_mask_] = accept;
+  starts_[k & hist_mask_] = start;
+  retires_[k & hist_mask_] = retire;
+  Item& it = item(k);
+  it.push = t;
+  it.occupancy = static_cast<std::uint32_t>(occupancy);
+  it.accept = accept;
+  it.start = start;
+  it.retire = retire;
+  it.tag = r.tag;
+  it.queued = static_cast<std::uint32_t>(k - queue_front_ + 1);
+  it.offset = r.offset;
+  it.client = r.client;
+  it.words = r.words;
+  it.counted_bytes = r.counted_bytes;
+  it.data = r.data;
+  // The controller's cycles: progress at the intake, the start and the retire; a stall while the
+  // request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
+  if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_) {
+    mc_.account_now();
+    if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_)
+      throw std::logic_error("memory controller: lane " + port_.name + "'s cycle " +
+                             std::to_string(std::max(start, retire)) + " beyond its window");
+  }
+  std::uint64_t* const busy = mc_.lane_busy_.data();
+  const std::uint64_t words = mc_.lane_busy_.size() - 1;
+  busy[(accept >> 6) & words] |= std::uint64_t{1} << (accept & 63);
+  busy[(start >> 6) & words] |= std::uint64_t{1} << (start & 63);
+  if (reads_) busy[(retire >> 6) & words] |= std::uint64_t{1} << (retire & 63);
+  if (accept > visible) mc_.mark_lane_cycles(mc_.lane_stall_, visible, accept);
+  last_push_ = t;
+  last_accept_ = accept;
+  bank_free_ = start + r.words;
+  ++pushed_;
+  return reads_ ? retire + 1 : 0;
+}
+
+// (Booked with the lane's other steps: the response is taken in the cycle after its retire.)
+std::uint32_t MemoryController::Lane::pop() {
+  return pop_through(1);
+}
+
+std::uint32_t MemoryController::Lane::pop_through(std::uint64_t count) {
+  if (count == 0 || popped_ + count > pushed_ || item(popped_ + count - 1).retire + 1 != mc_.now())
+    throw std::logic_error("memory controller: lane " + port_.name +
+                           "'s response not taken in the cycle it became visible");
+  popped_ += count;
+  return item(popped_ - 1).tag;
+}
+
+bool MemoryController::Lane::idle() const {
+  if (reads_) return popped_ == pushed_;
+  return pushed_ == 0 || bank_free_ - item(pushed_ - 1).words < mc_.now();
+}
+
+// Books the steps of every request before cycle `to`, as the stepped model does in those cycles.
+void MemoryController::Lane::settle(std::uint64_t to) {
+  Bank& bank = mc_.banks_[static_cast<std::size_t>(bank_)];
+  std::uint64_t n = 0, sum = 0, most = 0;
+  for (; booked_ < pushed_ && item(booked_).push < to; ++booked_, ++n) {
+    sum += item(booked_).push;
+    most = std::max<std::uint64_t>(most, item(booked_).occupancy);
+  }
+  if (n != 0) port_.requests.book_pushes(n, sum, most);
+  n = sum = most = 0;
+  for (; accepted_ < booked_ && item(accepted_).accept < to; ++accepted_, ++n) {
+    sum += item(accepted_).accept;
+    most = std::max<std::uint64_t>(most, item(accepted_).queued);
+  }
+  if (n != 0) {
+    port_.requests.book_pops(n, sum);
+    bank.max_queue->set_max(most);
+  }
+  n = sum = 0;
+  for (; started_ < accepted_ && item(started_).start < to; ++started_, ++n) {
+    const Item& it = item(started_);
+    sum += it.words;
+    *mc_.clients_[it.client].bytes += it.counted_bytes ? it.counted_bytes : 4u * it.words;
+    if (!reads_) {
+      std::uint32_t* const mem = mc_.image_.bank(bank_).data() + it.offset;
+      for (int i = 0; i < it.words; ++i)
+        mem[i] = it.data[static_cast<std::size_t>(i)];
+    }
+  }
+  if (n != 0) {
+    *bank.words += sum;
+    *(reads_ ? bank.reads : bank.writes) += n;
+  }
+  if (reads_) {
+    n = sum = 0;
+    for (; retired_ < started_ && item(retired_).retire < to; ++retired_, ++n)
+      sum += item(retired_).retire;
+    if (n != 0) port_.responses.book_pushes(n, sum, 1);
+    n = sum = 0;
+    for (; taken_ < retired_ && item(taken_).retire + 1 < to; ++taken_, ++n)
+      sum += item(taken_).retire + 1;
+    if (n != 0) port_.responses.book_pops(n, sum);
+  }
+}
+
+void MemoryController::mark_lane_cycles(std::vector<std::uint64_t>& bits, std::uint64_t from,
+                                        std::uint64_t to) {
+  if (to - 1 - lane_from_ > lane_mask_)
+    throw std::logic_error("memory controller '" + name() + "': a lane's cycle " +
+                           std::to_string(to - 1) + " beyond its window");
+  const std::uint64_t words = lane_busy_.size() - 1;
+  for (std::uint64_t c = from; c < to;) {
+    const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
+    const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
+    bits[(c >> 6) & words] |= m;
+    c += len;
+  }
+}
+
+std::uint64_t MemoryController::take_lane_cycles(std::vector<std::uint64_t>& bits,
+                                                 std::uint64_t from, std::uint64_t to) {
+  to = std::min(to, from + lane_mask_ + 1);  // nothing lies beyond the window
+  const std::uint64_t words = lane_busy_.size() - 1;
+  std::uint64_t n = 0;
+  for (std::uint64_t c = from; c < to;) {
+    const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
+    const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
+    std::uint64_t& w = bits[(c >> 6) & words];
+    // (The marks are a few per word: counted one by one, as the build's target has no popcount
+    // instruction and std::popcount becomes a library call.)
+    for (std::uint64_t x = w & m; x != 0; x &= x - 1)
+      ++n;
+    w &= ~m;
+    c += len;
+  }
+  return n;
+}
+
+// The lanes' steps in cycles [lane_from_, to) booked; the controller's busy and stall cycles
+// among them counted, but those the kernel counts already (the evaluated cycle's own progress or
+// stall, the repeats of a stalled evaluation).
+void MemoryController::account_lanes(std::uint64_t to, bool busy_counted, bool stall_counted) {
+  for (auto& l : lanes_)
+    if (l->state_ == Lane::State::kOpen) l->settle(to);
+  if (open_lanes_ != 0 && to > lane_from_) {
+    const std::uint64_t busy = take_lane_cycles(lane_busy_, lane_from_, to);
+    const std::uint64_t stalls = take_lane_cycles(lane_stall_, lane_from_, to);
+    count_cycles(busy_counted ? 0 : busy, stall_counted ? 0 : stalls);
+  }
+  lane_from_ = to;
+}
+
+void MemoryController::skipped(std::uint64_t) {
+  if (!lanes_.empty()) account_lanes(now(), false, stalled());
+}
+
+// The cycle after the lanes' next step: there the frame buffer's last write may have been
+// stored (the run's end) without any module evaluated.
+std::uint64_t MemoryController::skip_bound(std::uint64_t now) const {
+  if (open_lanes_ == 0) return hw::kNever;
+  const std::uint64_t words = lane_busy_.size() - 1;
+  for (std::uint64_t c = std::max(now, lane_from_); c < lane_from_ + lane_mask_ + 1;) {
+    const std::uint64_t w = lane_busy_[(c >> 6) & words] >> (c & 63);
+    if (w != 0) return c + static_cast<std::uint64_t>(std::countr_zero(w)) + 1;
+    c = (c | 63) + 1;
+  }
+  return hw::kNever;
+}
+
 MemoryController::Port& MemoryController::add_port(const std::string& name, int response_width) {
   if (response_width < 1)
     throw std::runtime_error("memory controller '" + this->name() + "': port " + name +
@@ -117,13 +451,18 @@ std::uint64_t MemoryController::bank_switches() const {
 
 bool MemoryController::idle() const {
   if (queued_ != 0 || inflight_ != 0) return false;
+  for (const auto& l : lanes_)
+    if (l->open() && !l->idle()) return false;
+  // (A lane's channels hold its booked steps only: its own idle() answers for its port.)
   for (const auto& p : ports_) {
+    if (p->lane != nullptr && p->lane->open()) continue;
     if (!p->requests.empty() || !p->responses.empty()) return false;
   }
   return true;
 }
 
 bool MemoryController::port_idle(const Port& port) const {
+  if (port.lane != nullptr && port.lane->open()) return port.lane->idle();
   if (!port.requests.empty() || !port.responses.empty()) return false;
   int index = -1;
   for (std::size_t p = 0; p < ports_.size(); ++p)
@@ -142,6 +481,7 @@ int MemoryController::evaluate() {
   int progress = next_due_ <= now() ? retire_responses() : 0;
   progress += issue();
   progress += accept_requests();
+  if (!lanes_.empty()) account_lanes(now() + 1, progress > 0, stalled());
   return progress;
 }
 
@@ -290,6 +630,7 @@ int MemoryController::issue() {
 int MemoryController::accept_requests() {
   int accepted = 0;
   for (std::size_t p = 0; p < intake_.size(); ++p) {
+    if (intake_[p] == nullptr) continue;  // a lane's port
     hw::Channel<MemRequest>& in = *intake_[p];
     if (!in.can_pop()) continue;
     const MemRequest& r = in.peek();
@@ -302,6 +643,10 @@ int MemoryController::accept_requests() {
                                std::to_string(r.words) + " words, client " +
                                std::to_string(r.client) + ")");
     }
+    if ((lane_banks_ >> r.bank & 1u) != 0)
+      throw std::logic_error("memory controller '" + name() + "': port " + ports_[p]->name +
+                             " sent a request to bank " + std::to_string(r.bank) +
+                             ", a lane's own");
     Bank& bank = banks_[r.bank];
     if (static_cast<int>(bank.queue.size()) >= config_.queue_depth) {
       stall();

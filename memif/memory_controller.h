@@ -52,10 +52,14 @@ struct MemoryControllerConfig {
 
 class MemoryController : public hw::Module {
  public:
+  class Lane;
   struct Port {
     std::string name;
     hw::Channel<MemRequest> requests;    // client pushes, controller pops
     hw::Channel<MemResponse> responses;  // controller pushes, client pops
+    // Set while the port is served as a lane (add_lane): its client uses the lane's calls instead
+    // of the two channels.
+    Lane* lane = nullptr;
     Port(hw::Kernel& k, const std::string& n, int capacity, int response_width = 1)
         : name(n),
           requests(k, n + ".req", capacity, 1),
@@ -75,10 +79,21 @@ class MemoryController : public hw::Module {
   // broadcast width).
   Port& add_port(const std::string& name, int response_width = 1);
   std::uint16_t add_client(const std::string& name);
+  // Serves `port` as a lane (below; docs/memif.md "Lanes"): reads only (`reads`) or writes only,
+  // all into one bank that nothing else uses. Before the first cycle; the lane decides at its
+  // first request whether it can run (otherwise the port works through its channels).
+  Lane& add_lane(Port& port, bool reads);
+  // Cycles in a lane's window (a client planning ahead keeps its own marks in as many).
+  std::uint64_t lane_window() const { return lane_mask_ + 1; }
+  // Returns every lane's port to its channels (a host upload is about to write into the banks).
+  // Throws std::logic_error once a lane has served a request.
+  void close_lanes();
 
   int evaluate() override;
   std::string dump_state() const override;
   std::uint64_t next_wakeup(std::uint64_t now) const override;
+  void skipped(std::uint64_t cycles) override;
+  std::uint64_t skip_bound(std::uint64_t now) const override;
 
   // Bandwidth per client: bytes so far, and MB/s over `cycles` cycles at the modelled clock.
   std::uint64_t client_bytes(std::uint16_t client) const;
@@ -154,6 +169,100 @@ class MemoryController : public hw::Module {
   std::array<unsigned, kNumBanks> path_bit_{};
   // Per port: its request channel (the intake polls every port every cycle it runs).
   std::vector<hw::Channel<MemRequest>*> intake_;
+
+  // Lanes. Their requests' cycles in which the controller makes progress (intake, start,
+  // retire) and in which it stalls (a lane's request visible but its bank queue full), as bits
+  // of a window of cycles from lane_from_ on (each cycle's bit at cycle & lane_mask_); counted
+  // into the controller's busy and stall cycles as the cycles pass (account_lanes).
+  void account_lanes(std::uint64_t to, bool busy_counted, bool stall_counted);
+  void mark_lane_cycles(std::vector<std::uint64_t>& bits, std::uint64_t from, std::uint64_t to);
+  std::uint64_t take_lane_cycles(std::vector<std::uint64_t>& bits, std::uint64_t from,
+                                 std::uint64_t to);
+  std::uint64_t lane_horizon() const;
+  std::vector<std::unique_ptr<Lane>> lanes_;
+  unsigned lane_banks_ = 0;  // bit b: bank b is a lane's
+  int open_lanes_ = 0;       // lanes serving requests
+  std::vector<std::uint64_t> lane_busy_, lane_stall_;
+  std::uint64_t lane_mask_ = 0;   // cycles in the window - 1
+  std::uint64_t lane_reach_ = 0;  // lane_horizon(), computed once
+  std::uint64_t lane_from_ = 0;   // the first cycle not yet counted
+};
+
+// A lane: a port whose requests all go to one bank that nothing else uses, on an issue path of
+// its own, served in closed form. The stepped model moves a request through the port's request
+// channel, the controller's intake, the bank's queue, its start and (for a read) its return
+// buffer and response channel, a module evaluation each; with nothing else on the bank or its
+// path, the cycle of every one of these steps follows from the request's push cycle and the
+// cycles of the requests before it (docs/memif.md "Lanes" derives them), so the lane computes
+// them when the request is pushed, and books the channels', bank's, client's and controller's
+// statistics in the cycles they stand for. The client must take every response in the cycle it
+// becomes visible (the RGS does: it pops one per cycle and the bank returns at most one).
+class MemoryController::Lane {
+ public:
+  // The port's request channel would take a push in this cycle / from which cycle on it will.
+  bool can_push() const;
+  std::uint64_t push_ready_cycle() const;
+  void push(const MemRequest& r) { (void)push_at(r, mc_.now()); }
+  // Planning ahead (the client knows what it will push in which cycle, as the RGS does for a
+  // wave of reads going out back to back): the first cycle from `from` on in which the port would
+  // take a push after those pushed so far; whether a push in `cycle` stays within the lane's
+  // window; a push in a cycle from now on (in cycle order, each where the port takes it).
+  // push_at returns the cycle a read's response becomes visible (0 for a write).
+  std::uint64_t next_push_cycle(std::uint64_t from) const;
+  bool plannable(std::uint64_t cycle) const;
+  std::uint64_t push_at(const MemRequest& r, std::uint64_t cycle);
+  // Takes the next `count` responses, the last of which becomes visible in this cycle (the ones
+  // before it were visible in earlier cycles: taken then, booked as such); returns its tag.
+  std::uint32_t pop_through(std::uint64_t count);
+  // A response visible in this cycle; the cycle the next one becomes visible (kNever: none).
+  bool can_pop() const { return response_cycle() <= mc_.now(); }
+  std::uint64_t response_cycle() const {
+    return popped_ < pushed_ ? item(popped_).retire + 1 : hw::kNever;
+  }
+  // Takes the visible response; returns its tag.
+  std::uint32_t pop();
+  // Nothing of the lane's queued, in flight or unanswered in the current cycle.
+  bool idle() const;
+  bool open() const { return state_ == State::kOpen; }
+
+ private:
+  friend class MemoryController;
+  Lane(MemoryController& mc, Port& port, int port_index, bool reads);
+  struct Item {
+    std::uint64_t push = 0, accept = 0, start = 0, retire = 0;  // cycles (retire: reads only)
+    std::uint32_t tag = 0;
+    std::uint32_t queued = 0;     // the bank queue's occupancy after this request's intake
+    std::uint32_t occupancy = 0;  // the port's request channel's at the end of the push cycle
+    std::uint32_t offset = 0;
+    std::uint16_t client = 0;
+    std::uint8_t words = 0, counted_bytes = 0;
+    std::array<std::uint32_t, kMaxRequestWords> data{};
+  };
+  enum class State { kUnbound, kOpen, kClosed };
+  Item& item(std::uint64_t k) { return items_[k & item_mask_]; }
+  const Item& item(std::uint64_t k) const { return items_[k & item_mask_]; }
+  bool bind(const MemRequest& r);  // at the first request: can the lane run?
+  void settle(std::uint64_t to);   // books every step before cycle `to`
+
+  MemoryController& mc_;
+  Port& port_;
+  int port_index_;
+  bool reads_;
+  State state_ = State::kUnbound;
+  int bank_ = -1;
+  std::vector<Item> items_;
+  std::uint64_t item_mask_ = 0;
+  // Requests pushed; the first whose push / intake / start / retire / response pop is not yet
+  // booked; the first read not yet taken by the client.
+  std::uint64_t pushed_ = 0, booked_ = 0, accepted_ = 0, started_ = 0, retired_ = 0, taken_ = 0,
+                popped_ = 0;
+  // The cycles the recurrences read: the last request's push, intake, start and words; per
+  // request the intake and start cycles of the last few (ring by request number), per read the
+  // retire cycles of the last few (reads in flight are at most the controller's limit).
+  std::uint64_t last_push_ = hw::kNever, last_accept_ = 0, bank_free_ = 0;
+  std::vector<std::uint64_t> accepts_, starts_, retires_;
+  std::uint64_t hist_mask_ = 0;
+  std::uint64_t queue_front_ = 0;  // the first request not yet started at the last intake
 };
 
 }  // namespace saarcor::memif

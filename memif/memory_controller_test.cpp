@@ -316,5 +316,161 @@ TEST(MemoryController, RequestsOutsideMemoryAndBadConfigurationsAreRefused) {
   EXPECT_THROW(make([](auto& c) { c.clock_hz = 0; }), std::runtime_error);
 }
 
+// Lanes (docs/memif.md "Lanes"): a shading-like port reading one bank and a frame-like port
+// writing another, served in closed form, give the same cycles, responses, stored words and
+// statistics (the controller's busy and stall cycles, the banks', the clients', the channels')
+// as the same ports through their channels, beside a third port stepped through the controller
+// (its own busy and stall cycles overlap the lanes'). Shallow queues and small ports make the
+// lanes stall and wait for room; gaps let the kernel skip idle cycles.
+}  // namespace
+struct LaneRun {
+  std::uint64_t cycles = 0;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> shading, other;  // (cycle, tag) received
+  std::vector<std::uint32_t> frame_words;
+  std::string stats;
+};
+
+LaneRun run_lanes(bool lanes, MemoryControllerConfig cfg, std::uint64_t seed) {
+  MemoryImage img = numbered_image();
+  hw::Kernel k;
+  cfg.bank_path = {0, 1, 2, 3, 3, 3};
+  MemoryController mc(k, "ctrl", img, cfg);
+  MemoryController::Port& other = mc.add_port("other");
+  MemoryController::Port& shading = mc.add_port("shading");
+  MemoryController::Port& frame = mc.add_port("frame");
+  const std::uint16_t co = mc.add_client("other"), cs = mc.add_client("shading"),
+                      cf = mc.add_client("frame");
+  if (lanes) {
+    mc.add_lane(shading, true);
+    mc.add_lane(frame, false);
+  }
+  std::mt19937_64 rng(seed);
+  auto script = [&](int n, auto make) {
+    std::vector<std::pair<std::uint64_t, MemRequest>> s;
+    std::uint64_t at = 0;
+    for (int i = 0; i < n; ++i) {
+      at += rng() % 8 == 0 ? rng() % 60 : 0;  // bursts that fill the queues, gaps to skip
+      s.emplace_back(at, make(i));
+    }
+    return s;
+  };
+  const auto reads = script(300, [&](int i) {
+    return read(cs, static_cast<std::uint32_t>(i), 2, static_cast<std::uint32_t>(rng() % 4000),
+                1 + static_cast<int>(rng() % 4));
+  });
+  const auto writes = script(200, [&](int i) {
+    MemRequest w = read(cf, 0, 0, static_cast<std::uint32_t>(i), 1);
+    w.write = true;
+    w.counted_bytes = 3;
+    w.data[0] = 0xABC000u + static_cast<std::uint32_t>(i);
+    return w;
+  });
+  const auto others = script(150, [&](int i) {
+    return read(co, static_cast<std::uint32_t>(i), 3 + static_cast<int>(rng() % 3),
+                static_cast<std::uint32_t>(rng() % 4000), 1 + static_cast<int>(rng() % 3));
+  });
+  LaneRun out;
+  std::size_t next_read = 0, next_write = 0, next_other = 0;
+  // The RGS's way with its ports: one request per cycle when the port takes it, every response
+  // taken the cycle it becomes visible.
+  FnModule client(k, "client", [&] {
+    int p = 0;
+    if (next_read < reads.size() && reads[next_read].first <= k.now()) {
+      if (shading.lane != nullptr ? shading.lane->can_push() : shading.requests.can_push()) {
+        if (shading.lane != nullptr)
+          shading.lane->push(reads[next_read++].second);
+        else
+          shading.requests.push(reads[next_read++].second);
+        ++p;
+      }
+    }
+    if (next_write < writes.size() && writes[next_write].first <= k.now()) {
+      if (frame.lane != nullptr ? frame.lane->can_push() : frame.requests.can_push()) {
+        if (frame.lane != nullptr)
+          frame.lane->push(writes[next_write++].second);
+        else
+          frame.requests.push(writes[next_write++].second);
+        ++p;
+      }
+    }
+    if (shading.lane != nullptr ? shading.lane->can_pop() : shading.responses.can_pop()) {
+      out.shading.emplace_back(
+          k.now(), shading.lane != nullptr ? shading.lane->pop() : shading.responses.pop().tag);
+      ++p;
+    }
+    if (next_other < others.size() && others[next_other].first <= k.now() &&
+        other.requests.can_push()) {
+      other.requests.push(others[next_other++].second);
+      ++p;
+    }
+    if (other.responses.can_pop()) {
+      out.other.emplace_back(k.now(), other.responses.pop().tag);
+      ++p;
+    }
+    return p;
+  });
+  out.cycles = k.run_to_completion(
+      [&] {
+        return out.shading.size() == reads.size() && out.other.size() == others.size() &&
+               next_write == writes.size() && mc.port_idle(frame) && mc.idle();
+      },
+      1000000);
+  for (std::uint32_t o = 0; o < 200; ++o)
+    out.frame_words.push_back(img.bank(0)[o]);
+  // The lanes ran (they would have left their ports to the channels if they could not).
+  EXPECT_EQ(lanes, shading.lane != nullptr);
+  EXPECT_EQ(lanes, frame.lane != nullptr);
+  out.stats = k.stats().json();
+  return out;
+}
+
+namespace {
+TEST(MemoryController, LanesGiveTheSteppedCyclesAndStatistics) {
+  std::vector<MemoryControllerConfig> configs(3);
+  configs[1].queue_depth = 1;
+  configs[1].port_capacity = 2;
+  configs[1].latency = 1;
+  configs[2].queue_depth = 2;
+  configs[2].port_capacity = 3;
+  configs[2].latency = 17;
+  for (std::size_t c = 0; c < configs.size(); ++c) {
+    for (std::uint64_t seed : {1u, 2u, 3u}) {
+      const LaneRun stepped = run_lanes(false, configs[c], seed);
+      const LaneRun lane = run_lanes(true, configs[c], seed);
+      EXPECT_EQ(stepped.cycles, lane.cycles) << c << " " << seed;
+      EXPECT_EQ(stepped.shading, lane.shading) << c << " " << seed;
+      EXPECT_EQ(stepped.other, lane.other) << c << " " << seed;
+      EXPECT_EQ(stepped.frame_words, lane.frame_words) << c << " " << seed;
+      EXPECT_EQ(stepped.stats, lane.stats) << c << " " << seed;
+    }
+  }
+}
+
+// A lane runs only where nothing else reaches its bank: another port's request to it is a model
+// error, and a bank sharing its issue path leaves the port on its channels.
+TEST(MemoryController, LanesKeepTheirBanksToThemselves) {
+  MemoryImage img = numbered_image();
+  hw::Kernel k;
+  MemoryController mc(k, "ctrl", img);
+  MemoryController::Port& lane_port = mc.add_port("lane");
+  MemoryController::Port& shared = mc.add_port("shared");
+  MemoryController::Port& other = mc.add_port("other");
+  const std::uint16_t c = mc.add_client("c");
+  mc.add_lane(lane_port, true);
+  mc.add_lane(shared, true);
+  FnModule client(k, "client", [&] {
+    if (k.now() == 0) {
+      lane_port.lane->push(read(c, 1, 2, 0, 1));
+      shared.lane->push(read(c, 2, 3, 0, 1));  // bank 3 shares its path with 4 and 5
+      return 1;
+    }
+    if (k.now() == 1) other.requests.push(read(c, 3, 2, 0, 1));
+    return k.now() == 1 ? 1 : 0;
+  });
+  EXPECT_THROW(k.run_to_completion([] { return false; }, 10), std::logic_error);
+  EXPECT_EQ(shared.lane, nullptr);
+  EXPECT_NE(lane_port.lane, nullptr);
+}
+
 }  // namespace
 }  // namespace saarcor::memif

@@ -46,6 +46,10 @@ class MemorySystem {
   MemoryController::Port& frame_port(int pipeline);
   std::uint16_t shading_client(int pipeline) const;
   std::uint16_t frame_client(int pipeline) const;
+  // Serves the pipeline's shading port (reads of the shading bank) and frame port (writes of the
+  // frame-buffer bank) as the controller's lanes (docs/memif.md "Lanes"): only where no other
+  // port reaches those banks, i.e. with one DynRTP (several share the shading bank).
+  void add_lanes(int pipeline);
   MemoryController& controller() { return *controller_; }
   SimpleRouting& routing() { return *routing_; }
   HostBus& host() { return *host_; }

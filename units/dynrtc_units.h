@@ -101,6 +101,7 @@ struct RgsPorts {
   memif::MemoryController::Port* shading = nullptr;
   memif::MemoryController::Port* frame = nullptr;
   std::uint16_t shading_client = 0, frame_client = 0;
+  std::uint64_t lane_window = 0;  // the controller's lane window, when the ports are lanes
 };
 
 // The ray generation and shading unit of one DynRTP with the RGC's admission (path g in, a out):
@@ -133,6 +134,8 @@ class RaySource : public CycleUnit {
   int extra() override;
   std::uint64_t extra_wakeup(std::uint64_t now) const override;
   bool hold(ThreadToken thread) override;
+  int evaluate() override;
+  void skipped(std::uint64_t cycles) override;
 
  private:
   // A thread the RGS keeps while its request's accesses are served. It waits in one of four
@@ -157,8 +160,31 @@ class RaySource : public CycleUnit {
     h.due = now() + static_cast<std::uint64_t>(depth());
     shading_.push_back(t);
   }
-  void issue_access(memif::MemoryController::Port& port, std::uint16_t client, ThreadToken t,
-                    Held& h);
+  // Pushes the thread's next access in cycle `at` (now, or later through a lane); returns the
+  // cycle a lane's read response becomes visible.
+  std::uint64_t issue_access(memif::MemoryController::Port& port, std::uint16_t client,
+                             ThreadToken t, Held& h, std::uint64_t at);
+  // Lanes (docs/memif.md "Lanes"): with its ports served in closed form, the RGS knows in which
+  // cycles a wave's reads and a packet's writes go out and its responses arrive, and pushes them
+  // ahead (up to kPlan at a time) instead of being evaluated in each of those cycles. The
+  // cycles it would have made progress in only through them are marked (virtual_) and counted
+  // as busy, not stalled, as they pass (evaluate, skipped); it is evaluated where the stepped
+  // RGS acts on them: a wave's last response, the next wave's first read, a packet's last write.
+  static constexpr int kPlan = 16;
+  struct Wave {
+    ThreadToken thread;
+    std::uint32_t reads;
+    std::uint64_t last;  // the cycle its last response becomes visible
+  };
+  void mark_virtual(std::uint64_t cycle);
+  std::uint64_t take_virtual(std::uint64_t from, std::uint64_t to);
+  // A port's request side, through its lane when it has one (docs/memif.md "Lanes").
+  static bool can_push(const memif::MemoryController::Port& port) {
+    return port.lane != nullptr ? port.lane->can_push() : port.requests.can_push();
+  }
+  static std::uint64_t push_ready_cycle(const memif::MemoryController::Port& port) {
+    return port.lane != nullptr ? port.lane->push_ready_cycle() : port.requests.push_ready_cycle();
+  }
 
   RayGenerationController& rgc_;
   int pipeline_;
@@ -169,7 +195,12 @@ class RaySource : public CycleUnit {
   RgsPorts ports_;
   std::vector<Held> held_;  // by thread (minus first_)
   Ring<ThreadToken> reading_, shading_, writing_, leaving_;
-  int active_ = 0;  // held threads
+  int active_ = 0;    // held threads
+  Ring<Wave> waves_;  // through a lane: the waves sent and not answered, in order
+  // Through a lane: the first cycle the read / write port is free of planned pushes.
+  std::uint64_t read_free_at_ = 0, write_free_at_ = 0;
+  std::vector<std::uint64_t> virtual_;  // bit per cycle, cycle & virtual_mask_
+  std::uint64_t virtual_mask_ = 0, virtual_from_ = 0, virtual_marked_ = 0;
   hw::Counter* retired_;
   hw::Counter* admitted_;
   hw::Counter* reads_;

@@ -53,8 +53,13 @@ namespace {
 // Figure 2's units, each over its pipeline's cache (the RGS over its memory ports).
 CycleUnit& make_rgs(const UnitContext& c) {
   const int pipe = c.pipeline;
+  // With one DynRTP its RGS alone reads the shading bank and writes the frame buffer: its ports
+  // are the controller's lanes, served in closed form (docs/memif.md "Lanes"; same cycles and
+  // statistics as through the channels).
+  if (c.params.pipelines == 1) c.memory.add_lanes(pipe);
   const RgsPorts ports{&c.memory.shading_port(pipe), &c.memory.frame_port(pipe),
-                       c.memory.shading_client(pipe), c.memory.frame_client(pipe)};
+                       c.memory.shading_client(pipe), c.memory.frame_client(pipe),
+                       c.params.pipelines == 1 ? c.memory.controller().lane_window() : 0};
   return c.kernel.make<RaySource>(c.name, c.threads, c.params.rgs_depth, c.rgc, pipe,
                                   static_cast<ThreadToken>(pipe * c.params.threads),
                                   c.params.threads, ports);

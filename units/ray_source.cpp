@@ -3,6 +3,8 @@
 // shades them, spawns secondary rays and writes the finished pixels into the frame buffer;
 // DESIGN.md sections 5, 6 and 7; docs/shading.md "Shading traffic"; DIGEST D24, D25).
 #include <algorithm>
+#include <bit>
+#include <stdexcept>
 
 #include "units/dynrtc_units.h"
 
@@ -23,7 +25,8 @@ RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
       reading_(count),
       shading_(count),
       writing_(count),
-      leaving_(count) {
+      leaving_(count),
+      waves_(count) {
   has_extra_ = true;
   for (int i = 0; i < count; ++i)
     free_list_.push_back(first + static_cast<ThreadToken>(i));
@@ -32,6 +35,10 @@ RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
     consumes(ports_.shading->responses);
   }
   if (ports_.frame != nullptr) produces(ports_.frame->requests);
+  if (ports_.shading != nullptr && ports_.shading->lane != nullptr && ports_.lane_window != 0) {
+    virtual_.assign(ports_.lane_window / 64, 0);
+    virtual_mask_ = ports_.lane_window - 1;
+  }
   retired_ = &stats().counter(this->name() + ".packets_retired", "packets",
                               "primary packets whose thread was freed");
   admitted_ = &stats().counter(this->name() + ".packets_admitted", "packets",
@@ -105,9 +112,22 @@ int RaySource::admit() {
 // wave queues for the read port behind the reads already waiting; its last read starts its
 // shading, done `depth` cycles later.
 int RaySource::receive_shading() {
-  auto& responses = ports_.shading->responses;
-  if (!responses.can_pop()) return 0;
-  const auto t = static_cast<ThreadToken>(responses.pop().tag);
+  ThreadToken t;
+  if (memif::MemoryController::Lane* lane = ports_.shading->lane) {
+    // Through a lane only a wave's last response is an event (the others were taken as they
+    // became visible: marked cycles).
+    if (waves_.empty() || waves_.front().last > now()) return 0;
+    const Wave w = waves_.front();
+    waves_.pop_front();
+    if (static_cast<ThreadToken>(lane->pop_through(w.reads)) != w.thread)
+      throw std::logic_error(name() + ": a wave's responses out of order");
+    t = w.thread;
+    held(t).outstanding = 1;  // its last read
+  } else {
+    auto& responses = ports_.shading->responses;
+    if (!responses.can_pop()) return 0;
+    t = static_cast<ThreadToken>(responses.pop().tag);
+  }
   Held& h = held(t);
   if (--h.outstanding == 0) {
     if (h.next < h.reads)
@@ -118,8 +138,61 @@ int RaySource::receive_shading() {
   return 1;
 }
 
-void RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t client,
-                             ThreadToken t, Held& h) {
+void RaySource::mark_virtual(std::uint64_t c) {
+  if (c - virtual_from_ > virtual_mask_)
+    throw std::logic_error(name() + ": a planned cycle beyond the window");
+  std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
+  const std::uint64_t bit = std::uint64_t{1} << (c & 63);
+  virtual_marked_ += (w & bit) == 0;
+  w |= bit;
+}
+
+std::uint64_t RaySource::take_virtual(std::uint64_t from, std::uint64_t to) {
+  to = std::min(to, from + virtual_mask_ + 1);
+  std::uint64_t n = 0;
+  for (std::uint64_t c = from; c < to;) {
+    const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
+    const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
+    std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
+    // (The marks are a few per word: counted one by one, as the build's target has no popcount
+    // instruction and std::popcount becomes a library call.)
+    for (std::uint64_t x = w & m; x != 0; x &= x - 1)
+      ++n;
+    w &= ~m;
+    c += len;
+  }
+  virtual_marked_ -= n;
+  return n;
+}
+
+// A cycle in which the stepped RGS would only have pushed a planned request or taken a response
+// that ends no wave: busy, not stalled (the kernel counts the stall of an idle evaluation, and of
+// the cycles after it, as repeats of it).
+int RaySource::evaluate() {
+  const int p = CycleUnit::evaluate();
+  if (virtual_marked_ != 0) {
+    const std::uint64_t c = now(), bit = std::uint64_t{1} << (c & 63);
+    std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
+    if ((w & bit) != 0) {
+      w &= ~bit;
+      --virtual_marked_;
+      if (p == 0) count_cycles(1, 0, stalled() ? 1 : 0);
+    }
+  }
+  virtual_from_ = now() + 1;
+  return p;
+}
+
+void RaySource::skipped(std::uint64_t cycles) {
+  if (virtual_marked_ != 0) {
+    const std::uint64_t n = take_virtual(now() - cycles, now());
+    count_cycles(n, 0, stalled() ? n : 0);
+  }
+  virtual_from_ = now();
+}
+
+std::uint64_t RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t client,
+                                      ThreadToken t, Held& h, std::uint64_t at) {
   const RgsAccess& a = (*h.access)[h.next++];
   memif::MemRequest m;
   m.client = client;
@@ -130,20 +203,43 @@ void RaySource::issue_access(memif::MemoryController::Port& port, std::uint16_t 
   m.offset = a.offset;
   m.data[0] = a.data;
   if (a.write) m.counted_bytes = 3;  // a pixel's RGB8: 3 bytes of the word count (D36)
+  if (port.lane != nullptr) return port.lane->push_at(m, at);
   port.requests.push(m);
+  return 0;
 }
 
 // One read per cycle on the shading port: the front thread's wave, back to back; a thread leaves
 // the queue at the end of its wave (the next one waits for this one's words).
 int RaySource::issue_read() {
-  if (reading_.empty() || !ports_.shading->requests.can_push()) return 0;
+  if (reading_.empty() || now() < read_free_at_ || !can_push(*ports_.shading)) return 0;
   const ThreadToken t = reading_.front();
   Held& h = held(t);
   const std::uint8_t wave = (*h.access)[h.next].wave;
+  auto wave_sent = [&] { return h.next == h.reads || (*h.access)[h.next].wave != wave; };
   ++h.outstanding;
-  issue_access(*ports_.shading, ports_.shading_client, t, h);
+  std::uint64_t visible = issue_access(*ports_.shading, ports_.shading_client, t, h, now());
   ++*reads_;
-  if (h.next == h.reads || (*h.access)[h.next].wave != wave) reading_.pop_front();
+  if (memif::MemoryController::Lane* lane = ports_.shading->lane) {
+    // The rest of the wave (up to kPlan reads) in the cycles the port takes them.
+    std::uint64_t last = now();
+    for (int planned = 0; !wave_sent() && planned < kPlan; ++planned) {
+      const std::uint64_t at = lane->next_push_cycle(last + 1);
+      if (!lane->plannable(at)) break;
+      mark_virtual(visible);  // a response before the wave's last
+      mark_virtual(at);
+      ++h.outstanding;
+      visible = issue_access(*ports_.shading, ports_.shading_client, t, h, at);
+      ++*reads_;
+      last = at;
+    }
+    read_free_at_ = last + 1;
+    if (!wave_sent()) {
+      mark_virtual(visible);
+      return 1;
+    }
+    waves_.push_back({t, static_cast<std::uint32_t>(h.outstanding), visible});
+  }
+  if (wave_sent()) reading_.pop_front();
   return 1;
 }
 
@@ -156,12 +252,25 @@ int RaySource::write_and_leave() {
     shading_.pop_front();
     (held(t).next < held(t).access->size() ? writing_ : leaving_).push_back(t);
   }
-  if (!writing_.empty() && ports_.frame->requests.can_push()) {
+  if (!writing_.empty() && now() >= write_free_at_ && can_push(*ports_.frame)) {
     const ThreadToken t = writing_.front();
     Held& h = held(t);
-    issue_access(*ports_.frame, ports_.frame_client, t, h);
+    issue_access(*ports_.frame, ports_.frame_client, t, h, now());
     ++*writes_;
     ++progress;
+    if (memif::MemoryController::Lane* lane = ports_.frame->lane) {
+      // The packet's writes but its last (which frees the thread: an event) pushed ahead.
+      std::uint64_t last = now();
+      for (int planned = 0; h.access->size() - h.next >= 2 && planned < kPlan; ++planned) {
+        const std::uint64_t at = lane->next_push_cycle(last + 1);
+        if (!lane->plannable(at)) break;
+        mark_virtual(at);
+        issue_access(*ports_.frame, ports_.frame_client, t, h, at);
+        ++*writes_;
+        last = at;
+      }
+      write_free_at_ = last + 1;
+    }
     if (h.next == h.access->size()) {
       writing_.pop_front();
       leaving_.push_back(t);
@@ -182,9 +291,11 @@ std::uint64_t RaySource::extra_wakeup(std::uint64_t now) const {
   if (!leaving_.empty()) return now + 1;
   std::uint64_t t = shading_.empty() ? hw::kNever : std::max(now + 1, held(shading_.front()).due);
   if (!reading_.empty())
-    t = std::min(t, std::max(now + 1, ports_.shading->requests.push_ready_cycle()));
+    t = std::min(t, std::max({now + 1, read_free_at_, push_ready_cycle(*ports_.shading)}));
   if (!writing_.empty())
-    t = std::min(t, std::max(now + 1, ports_.frame->requests.push_ready_cycle()));
+    t = std::min(t, std::max({now + 1, write_free_at_, push_ready_cycle(*ports_.frame)}));
+  // A lane's response wakes no one: the RGS takes a wave's last in the cycle it becomes visible.
+  if (!waves_.empty()) t = std::min(t, std::max(now + 1, waves_.front().last));
   if (free_list_.empty() || !rgc_.packets_left(pipeline_, now)) return t;
   return std::min(t, rgc_.next_grant(pipeline_, now));
 }

@@ -451,6 +451,15 @@ class RgsStep {
 
   // Local colour into the pixel, then reflection, transparency and refraction children (D37).
   void finish_surface(State& t) {
+    if (!t.params.secondary || t.depth >= max_depth_) {
+      // No children at this depth (finish_lane then only writes the local colour): no child
+      // packets to clear (three lane vectors per packet on the primary-only frame).
+      for (int i = 0; i < t.p; ++i) {
+        const Surface& s = surf_[static_cast<std::size_t>(i)];
+        if (s.hit) local_colour(t, s);
+      }
+      return next_packet(t);
+    }
     // The children are built in the next three pending slots, whose lane vectors are kept from
     // earlier packets (no allocation per packet); the reflection packet is traced first.
     if (pending_.size() < pending_size_ + 3) pending_.resize(pending_size_ + 3);
@@ -481,7 +490,7 @@ class RgsStep {
 
   // One hit's local colour, weighted by what its children take, and its children's lanes. At the
   // depth bound the children's weights are lost (docs/shading.md section 7).
-  void finish_lane(State& t, const Surface& s, std::size_t i, Children& ch) {
+  static void local_colour(State& t, const Surface& s) {
     Rgb8 local{};
     for (int k = 0; k < 3; ++k)
       local[k] = std::min<std::uint32_t>(255u, s.acc[k]);
@@ -490,7 +499,12 @@ class RgsStep {
     const std::uint32_t wl =
         t.params.secondary ? mul8(s.weight, 255u - std::min(255u, kr + kt + kf)) : s.weight;
     add_colour(t, s.pixel, wl, local);
+  }
+  void finish_lane(State& t, const Surface& s, std::size_t i, Children& ch) {
+    local_colour(t, s);
     if (!t.params.secondary || t.depth >= max_depth_) return;
+    const std::uint32_t kr = s.mat.reflectivity, kt = s.mat.transparency;
+    const std::uint32_t kf = s.mat.refraction;
     std::uint32_t wr = mul8(s.weight, kr);
     const std::uint32_t wt = mul8(s.weight, kt), wf = mul8(s.weight, kf);
     const Mat34<F> tr = reflect_matrix(s.ray, s.n);
