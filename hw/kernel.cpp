@@ -59,7 +59,9 @@ Stats& Module::stats() const {
 }
 
 void Module::account_now() {
-  if (accounted_ < *now_) kernel_->account(this);
+  if (accounted_ < *now_) {
+    kernel_->account(this);
+  }
 }
 
 void Module::consumes(ChannelBase& c) {
@@ -285,7 +287,9 @@ RunResult Kernel::run_cycles(const std::function<bool()>& done, std::uint64_t ma
     std::uint64_t target = std::min(next_event(), limit);
     for (const Module* m : modules_) {  // a sleeper's pending wake (next_event covers the rest)
       if (m->sleeps_) target = std::min(target, schedule_.wake_cycle(m->slot_));
-      if (m->bounds_skip_) target = std::min(target, m->skip_bound(cycle_));
+      if (m->bounds_skip_) {
+        target = std::min(target, m->skip_bound(cycle_));
+      }
     }
     if (wd != 0) target = std::min(target, progress_mark_ + wd);
     const std::uint64_t period = config_.time_series_period;

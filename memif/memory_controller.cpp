@@ -69,17 +69,22 @@ MemoryController::MemoryController(hw::Kernel& kernel, std::string name, MemoryI
 // latency and a few cycles after the one before; then its own latency.
 std::uint64_t MemoryController::lane_horizon() const {
   const auto lat = static_cast<std::uint64_t>(config_.latency);
-  const auto ahead =
-      static_cast<std::uint64_t>(config_.port_capacity + config_.queue_depth + inflight_limit_ + 2);
+  const std::uint64_t ahead = static_cast<std::uint64_t>(config_.port_capacity) +
+                              static_cast<std::uint64_t>(config_.queue_depth) +
+                              static_cast<std::uint64_t>(inflight_limit_) + 2;
   return ahead * (lat + 6) + lat + 8;
 }
 
 MemoryController::Lane& MemoryController::add_lane(Port& port, bool reads) {
   int index = -1;
-  for (std::size_t p = 0; p < ports_.size(); ++p)
-    if (ports_[p].get() == &port) index = static_cast<int>(p);
-  if (index < 0 || port.lane != nullptr)
+  for (std::size_t p = 0; p < ports_.size(); ++p) {
+    if (ports_[p].get() == &port) {
+      index = static_cast<int>(p);
+    }
+  }
+  if (index < 0 || port.lane != nullptr) {
     throw std::logic_error("memory controller '" + name() + "': no lane for port " + port.name);
+  }
   lanes_.push_back(std::unique_ptr<Lane>(new Lane(*this, port, index, reads)));
   port.lane = lanes_.back().get();
   bound_idle_skip();
@@ -88,8 +93,9 @@ MemoryController::Lane& MemoryController::add_lane(Port& port, bool reads) {
     // Wide enough that a lane's pushes rarely have to book the past first (the controller's
     // own evaluations book it as they go).
     std::uint64_t window = 4096;
-    while (window < 4 * lane_horizon())
+    while (window < 4 * lane_horizon()) {
       window *= 2;
+    }
     lane_busy_.assign(window / 64, 0);
     lane_stall_.assign(window / 64, 0);
     lane_mask_ = window - 1;
@@ -99,9 +105,10 @@ MemoryController::Lane& MemoryController::add_lane(Port& port, bool reads) {
 
 void MemoryController::close_lanes() {
   for (auto& l : lanes_) {
-    if (l->state_ == Lane::State::kOpen)
+    if (l->state_ == Lane::State::kOpen) {
       throw std::logic_error("memory controller '" + name() + "': lane " + l->port_.name +
                              " closed after it served requests");
+    }
     l->state_ = Lane::State::kClosed;
     l->port_.lane = nullptr;
   }
@@ -111,15 +118,18 @@ MemoryController::Lane::Lane(MemoryController& mc, Port& port, int port_index, b
     : mc_(mc), port_(port), port_index_(port_index), reads_(reads) {
   const MemoryControllerConfig& c = mc.config_;
   std::uint64_t n = 1;
-  while (n <
-         4 * static_cast<std::uint64_t>(c.port_capacity + c.queue_depth + mc.inflight_limit_ + 8))
+  while (n < 4 * (static_cast<std::uint64_t>(c.port_capacity) +
+                  static_cast<std::uint64_t>(c.queue_depth) +
+                  static_cast<std::uint64_t>(mc.inflight_limit_) + 8)) {
     n *= 2;
+  }
   items_.resize(n);
   item_mask_ = n - 1;
   std::uint64_t h = 1;
   while (h < static_cast<std::uint64_t>(
-                 std::max({c.port_capacity, c.queue_depth, mc.inflight_limit_}) + 2))
+                 std::max({c.port_capacity, c.queue_depth, mc.inflight_limit_}) + 2)) {
     h *= 2;
+  }
   accepts_.assign(h, 0);
   starts_.assign(h, 0);
   retires_.assign(h, 0);
@@ -163,7 +173,9 @@ bool MemoryController::Lane::bind(const MemRequest& r) {
 
 bool MemoryController::Lane::can_push() const {
   const std::uint64_t t = mc_.now();
-  if (last_push_ != hw::kNever && last_push_ >= t) return false;  // one request per cycle
+  if (last_push_ != hw::kNever && last_push_ >= t) {
+    return false;  // one request per cycle
+  }
   const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
   // Full at the end of the last cycle: the cap-th newest request was not taken in before it.
   return pushed_ < cap || accepts_[(pushed_ - cap) & hist_mask_] < t;
@@ -172,7 +184,9 @@ bool MemoryController::Lane::can_push() const {
 std::uint64_t MemoryController::Lane::push_ready_cycle() const {
   std::uint64_t c = last_push_ == hw::kNever ? 0 : last_push_ + 1;
   const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
-  if (pushed_ >= cap) c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  if (pushed_ >= cap) {
+    c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  }
   return c;
 }
 
@@ -185,7 +199,9 @@ std::uint64_t MemoryController::Lane::push_ready_cycle() const {
 std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const {
   std::uint64_t c = std::max(from, last_push_ == hw::kNever ? 0 : last_push_ + 1);
   const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
-  if (pushed_ >= cap) c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  if (pushed_ >= cap) {
+    c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  }
   return c;
 }
 
@@ -208,30 +224,41 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
                              std::to_string(r.client) + ")");
   }
   const std::uint64_t k = pushed_;
-  if (t < mc_.now() || (last_push_ != hw::kNever && t <= last_push_))
+  if (t < mc_.now() || (last_push_ != hw::kNever && t <= last_push_)) {
     throw std::logic_error("memory controller: lane " + port_.name + " pushed out of order");
+  }
   // The lane's steps are booked when the controller's cycles are counted (its evaluations, the
   // kernel's accounting); a lane whose controller sleeps long books them here when its ring of
   // requests is full.
-  if (k - (reads_ ? taken_ : started_) > item_mask_) mc_.account_now();
-  if (k - (reads_ ? taken_ : started_) > item_mask_)
+  if (k - (reads_ ? taken_ : started_) > item_mask_) {
+    mc_.account_now();
+  }
+  if (k - (reads_ ? taken_ : started_) > item_mask_) {
     throw std::logic_error("memory controller: lane " + port_.name + " holds too many requests");
+  }
   const auto depth = static_cast<std::uint64_t>(mc_.config_.queue_depth);
   const auto limit = static_cast<std::uint64_t>(mc_.inflight_limit_);
   const std::uint64_t visible = std::max(t + 1, k == 0 ? 0 : last_accept_ + 1);
   std::uint64_t accept = visible;
-  if (k >= depth) accept = std::max(accept, starts_[(k - depth) & hist_mask_]);
+  if (k >= depth) {
+    accept = std::max(accept, starts_[(k - depth) & hist_mask_]);
+  }
   std::uint64_t start = std::max(accept + 1, bank_free_);
-  if (reads_ && k >= limit) start = std::max(start, retires_[(k - limit) & hist_mask_]);
+  if (reads_ && k >= limit) {
+    start = std::max(start, retires_[(k - limit) & hist_mask_]);
+  }
   const std::uint64_t retire =
       reads_ ? start + r.words - 1 + static_cast<std::uint64_t>(mc_.config_.latency) : 0;
   // The bank queue after the intake: the requests from the first not started by then on.
-  while (queue_front_ < k && starts_[queue_front_ & hist_mask_] <= accept)
+  while (queue_front_ < k && starts_[queue_front_ & hist_mask_] <= accept) {
     ++queue_front_;
+  }
   // The port's request channel at the end of this cycle: this request and those taken in later.
   std::uint64_t occupancy = 1;
-  for (std::uint64_t j = k; j > 0 && j + hist_mask_ > k && accepts_[(j - 1) & hist_mask_] > t; --j)
+  for (std::uint64_t j = k; j > 0 && j + hist_mask_ > k && accepts_[(j - 1) & hist_mask_] > t;
+       --j) {
     ++occupancy;
+  }
   accepts_[k & hist_mask_] = accept;
   starts_[k & hist_mask_] = start;
   retires_[k & hist_mask_] = retire;
@@ -252,16 +279,21 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
   // request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
   if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_) {
     mc_.account_now();
-    if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_)
+    if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_) {
       throw std::logic_error("memory controller: lane " + port_.name + "'s cycle " +
                              std::to_string(std::max(start, retire)) + " beyond its window");
+    }
   }
   std::uint64_t* const busy = mc_.lane_busy_.data();
   const std::uint64_t words = mc_.lane_busy_.size() - 1;
   busy[(accept >> 6) & words] |= std::uint64_t{1} << (accept & 63);
   busy[(start >> 6) & words] |= std::uint64_t{1} << (start & 63);
-  if (reads_) busy[(retire >> 6) & words] |= std::uint64_t{1} << (retire & 63);
-  if (accept > visible) mc_.mark_lane_cycles(mc_.lane_stall_, visible, accept);
+  if (reads_) {
+    busy[(retire >> 6) & words] |= std::uint64_t{1} << (retire & 63);
+  }
+  if (accept > visible) {
+    mc_.mark_lane_cycles(mc_.lane_stall_, visible, accept);
+  }
   last_push_ = t;
   last_accept_ = accept;
   bank_free_ = start + r.words;
@@ -275,15 +307,19 @@ std::uint32_t MemoryController::Lane::pop() {
 }
 
 std::uint32_t MemoryController::Lane::pop_through(std::uint64_t count) {
-  if (count == 0 || popped_ + count > pushed_ || item(popped_ + count - 1).retire + 1 != mc_.now())
+  if (count == 0 || popped_ + count > pushed_ ||
+      item(popped_ + count - 1).retire + 1 != mc_.now()) {
     throw std::logic_error("memory controller: lane " + port_.name +
                            "'s response not taken in the cycle it became visible");
+  }
   popped_ += count;
   return item(popped_ - 1).tag;
 }
 
 bool MemoryController::Lane::idle() const {
-  if (reads_) return popped_ == pushed_;
+  if (reads_) {
+    return popped_ == pushed_;
+  }
   return pushed_ == 0 || bank_free_ - item(pushed_ - 1).words < mc_.now();
 }
 
@@ -295,7 +331,9 @@ void MemoryController::Lane::settle(std::uint64_t to) {
     sum += item(booked_).push;
     most = std::max<std::uint64_t>(most, item(booked_).occupancy);
   }
-  if (n != 0) port_.requests.book_pushes(n, sum, most);
+  if (n != 0) {
+    port_.requests.book_pushes(n, sum, most);
+  }
   n = sum = most = 0;
   for (; accepted_ < booked_ && item(accepted_).accept < to; ++accepted_, ++n) {
     sum += item(accepted_).accept;
@@ -312,8 +350,9 @@ void MemoryController::Lane::settle(std::uint64_t to) {
     *mc_.clients_[it.client].bytes += it.counted_bytes ? it.counted_bytes : 4u * it.words;
     if (!reads_) {
       std::uint32_t* const mem = mc_.image_.bank(bank_).data() + it.offset;
-      for (int i = 0; i < it.words; ++i)
+      for (int i = 0; i < it.words; ++i) {
         mem[i] = it.data[static_cast<std::size_t>(i)];
+      }
     }
   }
   if (n != 0) {
@@ -322,21 +361,28 @@ void MemoryController::Lane::settle(std::uint64_t to) {
   }
   if (reads_) {
     n = sum = 0;
-    for (; retired_ < started_ && item(retired_).retire < to; ++retired_, ++n)
+    for (; retired_ < started_ && item(retired_).retire < to; ++retired_, ++n) {
       sum += item(retired_).retire;
-    if (n != 0) port_.responses.book_pushes(n, sum, 1);
+    }
+    if (n != 0) {
+      port_.responses.book_pushes(n, sum, 1);
+    }
     n = sum = 0;
-    for (; taken_ < retired_ && item(taken_).retire + 1 < to; ++taken_, ++n)
+    for (; taken_ < retired_ && item(taken_).retire + 1 < to; ++taken_, ++n) {
       sum += item(taken_).retire + 1;
-    if (n != 0) port_.responses.book_pops(n, sum);
+    }
+    if (n != 0) {
+      port_.responses.book_pops(n, sum);
+    }
   }
 }
 
 void MemoryController::mark_lane_cycles(std::vector<std::uint64_t>& bits, std::uint64_t from,
                                         std::uint64_t to) {
-  if (to - 1 - lane_from_ > lane_mask_)
+  if (to - 1 - lane_from_ > lane_mask_) {
     throw std::logic_error("memory controller '" + name() + "': a lane's cycle " +
                            std::to_string(to - 1) + " beyond its window");
+  }
   const std::uint64_t words = lane_busy_.size() - 1;
   for (std::uint64_t c = from; c < to;) {
     const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
@@ -357,8 +403,9 @@ std::uint64_t MemoryController::take_lane_cycles(std::vector<std::uint64_t>& bit
     std::uint64_t& w = bits[(c >> 6) & words];
     // (The marks are a few per word: counted one by one, as the build's target has no popcount
     // instruction and std::popcount becomes a library call.)
-    for (std::uint64_t x = w & m; x != 0; x &= x - 1)
+    for (std::uint64_t x = w & m; x != 0; x &= x - 1) {
       ++n;
+    }
     w &= ~m;
     c += len;
   }
@@ -369,8 +416,11 @@ std::uint64_t MemoryController::take_lane_cycles(std::vector<std::uint64_t>& bit
 // among them counted, but those the kernel counts already (the evaluated cycle's own progress or
 // stall, the repeats of a stalled evaluation).
 void MemoryController::account_lanes(std::uint64_t to, bool busy_counted, bool stall_counted) {
-  for (auto& l : lanes_)
-    if (l->state_ == Lane::State::kOpen) l->settle(to);
+  for (auto& l : lanes_) {
+    if (l->state_ == Lane::State::kOpen) {
+      l->settle(to);
+    }
+  }
   if (open_lanes_ != 0 && to > lane_from_) {
     const std::uint64_t busy = take_lane_cycles(lane_busy_, lane_from_, to);
     const std::uint64_t stalls = take_lane_cycles(lane_stall_, lane_from_, to);
@@ -380,17 +430,23 @@ void MemoryController::account_lanes(std::uint64_t to, bool busy_counted, bool s
 }
 
 void MemoryController::skipped(std::uint64_t) {
-  if (!lanes_.empty()) account_lanes(now(), false, stalled());
+  if (!lanes_.empty()) {
+    account_lanes(now(), false, stalled());
+  }
 }
 
 // The cycle after the lanes' next step: there the frame buffer's last write may have been
 // stored (the run's end) without any module evaluated.
 std::uint64_t MemoryController::skip_bound(std::uint64_t now) const {
-  if (open_lanes_ == 0) return hw::kNever;
+  if (open_lanes_ == 0) {
+    return hw::kNever;
+  }
   const std::uint64_t words = lane_busy_.size() - 1;
   for (std::uint64_t c = std::max(now, lane_from_); c < lane_from_ + lane_mask_ + 1;) {
     const std::uint64_t w = lane_busy_[(c >> 6) & words] >> (c & 63);
-    if (w != 0) return c + static_cast<std::uint64_t>(std::countr_zero(w)) + 1;
+    if (w != 0) {
+      return c + static_cast<std::uint64_t>(std::countr_zero(w)) + 1;
+    }
     c = (c | 63) + 1;
   }
   return hw::kNever;
@@ -451,18 +507,25 @@ std::uint64_t MemoryController::bank_switches() const {
 
 bool MemoryController::idle() const {
   if (queued_ != 0 || inflight_ != 0) return false;
-  for (const auto& l : lanes_)
-    if (l->open() && !l->idle()) return false;
+  for (const auto& l : lanes_) {
+    if (l->open() && !l->idle()) {
+      return false;
+    }
+  }
   // (A lane's channels hold its booked steps only: its own idle() answers for its port.)
   for (const auto& p : ports_) {
-    if (p->lane != nullptr && p->lane->open()) continue;
+    if (p->lane != nullptr && p->lane->open()) {
+      continue;
+    }
     if (!p->requests.empty() || !p->responses.empty()) return false;
   }
   return true;
 }
 
 bool MemoryController::port_idle(const Port& port) const {
-  if (port.lane != nullptr && port.lane->open()) return port.lane->idle();
+  if (port.lane != nullptr && port.lane->open()) {
+    return port.lane->idle();
+  }
   if (!port.requests.empty() || !port.responses.empty()) return false;
   int index = -1;
   for (std::size_t p = 0; p < ports_.size(); ++p)
@@ -481,7 +544,9 @@ int MemoryController::evaluate() {
   int progress = next_due_ <= now() ? retire_responses() : 0;
   progress += issue();
   progress += accept_requests();
-  if (!lanes_.empty()) account_lanes(now() + 1, progress > 0, stalled());
+  if (!lanes_.empty()) {
+    account_lanes(now() + 1, progress > 0, stalled());
+  }
   return progress;
 }
 
@@ -630,7 +695,9 @@ int MemoryController::issue() {
 int MemoryController::accept_requests() {
   int accepted = 0;
   for (std::size_t p = 0; p < intake_.size(); ++p) {
-    if (intake_[p] == nullptr) continue;  // a lane's port
+    if (intake_[p] == nullptr) {
+      continue;  // a lane's port
+    }
     hw::Channel<MemRequest>& in = *intake_[p];
     if (!in.can_pop()) continue;
     const MemRequest& r = in.peek();
@@ -643,10 +710,11 @@ int MemoryController::accept_requests() {
                                std::to_string(r.words) + " words, client " +
                                std::to_string(r.client) + ")");
     }
-    if ((lane_banks_ >> r.bank & 1u) != 0)
+    if ((lane_banks_ >> r.bank & 1u) != 0) {
       throw std::logic_error("memory controller '" + name() + "': port " + ports_[p]->name +
                              " sent a request to bank " + std::to_string(r.bank) +
                              ", a lane's own");
+    }
     Bank& bank = banks_[r.bank];
     if (static_cast<int>(bank.queue.size()) >= config_.queue_depth) {
       stall();

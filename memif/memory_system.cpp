@@ -74,8 +74,9 @@ std::uint16_t MemorySystem::frame_client(int pipeline) const {
 }
 
 void MemorySystem::add_lanes(int pipeline) {
-  if (config_.pipelines != 1)
+  if (config_.pipelines != 1) {
     throw std::logic_error("memory system: lanes need the shading and frame banks to one DynRTP");
+  }
   controller_->add_lane(shading_port(pipeline), true);
   controller_->add_lane(frame_port(pipeline), false);
 }

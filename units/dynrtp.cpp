@@ -56,7 +56,9 @@ CycleUnit& make_rgs(const UnitContext& c) {
   // With one DynRTP its RGS alone reads the shading bank and writes the frame buffer: its ports
   // are the controller's lanes, served in closed form (docs/memif.md "Lanes"; same cycles and
   // statistics as through the channels).
-  if (c.params.pipelines == 1) c.memory.add_lanes(pipe);
+  if (c.params.pipelines == 1) {
+    c.memory.add_lanes(pipe);
+  }
   const RgsPorts ports{&c.memory.shading_port(pipe), &c.memory.frame_port(pipe),
                        c.memory.shading_client(pipe), c.memory.frame_client(pipe),
                        c.params.pipelines == 1 ? c.memory.controller().lane_window() : 0};

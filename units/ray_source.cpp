@@ -116,16 +116,21 @@ int RaySource::receive_shading() {
   if (memif::MemoryController::Lane* lane = ports_.shading->lane) {
     // Through a lane only a wave's last response is an event (the others were taken as they
     // became visible: marked cycles).
-    if (waves_.empty() || waves_.front().last > now()) return 0;
+    if (waves_.empty() || waves_.front().last > now()) {
+      return 0;
+    }
     const Wave w = waves_.front();
     waves_.pop_front();
-    if (static_cast<ThreadToken>(lane->pop_through(w.reads)) != w.thread)
+    if (static_cast<ThreadToken>(lane->pop_through(w.reads)) != w.thread) {
       throw std::logic_error(name() + ": a wave's responses out of order");
+    }
     t = w.thread;
     held(t).outstanding = 1;  // its last read
   } else {
     auto& responses = ports_.shading->responses;
-    if (!responses.can_pop()) return 0;
+    if (!responses.can_pop()) {
+      return 0;
+    }
     t = static_cast<ThreadToken>(responses.pop().tag);
   }
   Held& h = held(t);
@@ -139,8 +144,9 @@ int RaySource::receive_shading() {
 }
 
 void RaySource::mark_virtual(std::uint64_t c) {
-  if (c - virtual_from_ > virtual_mask_)
+  if (c - virtual_from_ > virtual_mask_) {
     throw std::logic_error(name() + ": a planned cycle beyond the window");
+  }
   std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
   const std::uint64_t bit = std::uint64_t{1} << (c & 63);
   virtual_marked_ += (w & bit) == 0;
@@ -156,8 +162,9 @@ std::uint64_t RaySource::take_virtual(std::uint64_t from, std::uint64_t to) {
     std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
     // (The marks are a few per word: counted one by one, as the build's target has no popcount
     // instruction and std::popcount becomes a library call.)
-    for (std::uint64_t x = w & m; x != 0; x &= x - 1)
+    for (std::uint64_t x = w & m; x != 0; x &= x - 1) {
       ++n;
+    }
     w &= ~m;
     c += len;
   }
@@ -176,7 +183,9 @@ int RaySource::evaluate() {
     if ((w & bit) != 0) {
       w &= ~bit;
       --virtual_marked_;
-      if (p == 0) count_cycles(1, 0, stalled() ? 1 : 0);
+      if (p == 0) {
+        count_cycles(1, 0, stalled() ? 1 : 0);
+      }
     }
   }
   virtual_from_ = now() + 1;
@@ -203,7 +212,9 @@ std::uint64_t RaySource::issue_access(memif::MemoryController::Port& port, std::
   m.offset = a.offset;
   m.data[0] = a.data;
   if (a.write) m.counted_bytes = 3;  // a pixel's RGB8: 3 bytes of the word count (D36)
-  if (port.lane != nullptr) return port.lane->push_at(m, at);
+  if (port.lane != nullptr) {
+    return port.lane->push_at(m, at);
+  }
   port.requests.push(m);
   return 0;
 }
@@ -211,7 +222,9 @@ std::uint64_t RaySource::issue_access(memif::MemoryController::Port& port, std::
 // One read per cycle on the shading port: the front thread's wave, back to back; a thread leaves
 // the queue at the end of its wave (the next one waits for this one's words).
 int RaySource::issue_read() {
-  if (reading_.empty() || now() < read_free_at_ || !can_push(*ports_.shading)) return 0;
+  if (reading_.empty() || now() < read_free_at_ || !can_push(*ports_.shading)) {
+    return 0;
+  }
   const ThreadToken t = reading_.front();
   Held& h = held(t);
   const std::uint8_t wave = (*h.access)[h.next].wave;
@@ -224,7 +237,9 @@ int RaySource::issue_read() {
     std::uint64_t last = now();
     for (int planned = 0; !wave_sent() && planned < kPlan; ++planned) {
       const std::uint64_t at = lane->next_push_cycle(last + 1);
-      if (!lane->plannable(at)) break;
+      if (!lane->plannable(at)) {
+        break;
+      }
       mark_virtual(visible);  // a response before the wave's last
       mark_virtual(at);
       ++h.outstanding;
@@ -239,7 +254,9 @@ int RaySource::issue_read() {
     }
     waves_.push_back({t, static_cast<std::uint32_t>(h.outstanding), visible});
   }
-  if (wave_sent()) reading_.pop_front();
+  if (wave_sent()) {
+    reading_.pop_front();
+  }
   return 1;
 }
 
@@ -263,7 +280,9 @@ int RaySource::write_and_leave() {
       std::uint64_t last = now();
       for (int planned = 0; h.access->size() - h.next >= 2 && planned < kPlan; ++planned) {
         const std::uint64_t at = lane->next_push_cycle(last + 1);
-        if (!lane->plannable(at)) break;
+        if (!lane->plannable(at)) {
+          break;
+        }
         mark_virtual(at);
         issue_access(*ports_.frame, ports_.frame_client, t, h, at);
         ++*writes_;
@@ -295,7 +314,9 @@ std::uint64_t RaySource::extra_wakeup(std::uint64_t now) const {
   if (!writing_.empty())
     t = std::min(t, std::max({now + 1, write_free_at_, push_ready_cycle(*ports_.frame)}));
   // A lane's response wakes no one: the RGS takes a wave's last in the cycle it becomes visible.
-  if (!waves_.empty()) t = std::min(t, std::max(now + 1, waves_.front().last));
+  if (!waves_.empty()) {
+    t = std::min(t, std::max(now + 1, waves_.front().last));
+  }
   if (free_list_.empty() || !rgc_.packets_left(pipeline_, now)) return t;
   return std::min(t, rgc_.next_grant(pipeline_, now));
 }
