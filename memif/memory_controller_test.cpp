@@ -373,26 +373,25 @@ LaneRun run_lanes(bool lanes, MemoryControllerConfig cfg, std::uint64_t seed) {
   std::size_t next_read = 0, next_write = 0, next_other = 0;
   // The RGS's way with its ports: one request per cycle when the port takes it, every response
   // taken the cycle it becomes visible.
+  // The next due request of `list` into `port`, through its lane when it has one.
+  auto push_due = [&](MemoryController::Port& port,
+                      const std::vector<std::pair<std::uint64_t, MemRequest>>& list,
+                      std::size_t& next) {
+    if (next >= list.size() || list[next].first > k.now()) {
+      return 0;
+    }
+    if (!(port.lane != nullptr ? port.lane->can_push() : port.requests.can_push())) {
+      return 0;
+    }
+    if (port.lane != nullptr) {
+      port.lane->push(list[next++].second);
+    } else {
+      port.requests.push(list[next++].second);
+    }
+    return 1;
+  };
   FnModule client(k, "client", [&] {
-    int p = 0;
-    if (next_read < reads.size() && reads[next_read].first <= k.now()) {
-      if (shading.lane != nullptr ? shading.lane->can_push() : shading.requests.can_push()) {
-        if (shading.lane != nullptr)
-          shading.lane->push(reads[next_read++].second);
-        else
-          shading.requests.push(reads[next_read++].second);
-        ++p;
-      }
-    }
-    if (next_write < writes.size() && writes[next_write].first <= k.now()) {
-      if (frame.lane != nullptr ? frame.lane->can_push() : frame.requests.can_push()) {
-        if (frame.lane != nullptr)
-          frame.lane->push(writes[next_write++].second);
-        else
-          frame.requests.push(writes[next_write++].second);
-        ++p;
-      }
-    }
+    int p = push_due(shading, reads, next_read) + push_due(frame, writes, next_write);
     if (shading.lane != nullptr ? shading.lane->can_pop() : shading.responses.can_pop()) {
       out.shading.emplace_back(
           k.now(), shading.lane != nullptr ? shading.lane->pop() : shading.responses.pop().tag);
