@@ -125,6 +125,44 @@ TEST(DynRtc, IdleSkipChangesNothing) {
   }
 }
 
+// With one DynRTP the RGS's shading and frame-buffer ports are the memory controller's lanes,
+// served in closed form (docs/memif.md "Lanes"); evaluating every cycle steps each request
+// through the channels and the controller instead. Both give the same frame, from the tightest
+// queues and ports to deep ones behind a slow SRAM, with the textured room and with glass's
+// shadow, reflection and refraction rays (several waves per packet, child packets).
+TEST(DynRtc, LanesGiveTheSteppedFrame) {
+  struct Case {
+    const char* scene;
+    int threads, latency, queue_depth, port_capacity;
+    bool secondary;
+  };
+  const Case cases[] = {
+      {"builtin:room", 64, 4, 1, 2, false},
+      {"builtin:room", 16, 200, 64, 256, false},
+      {"builtin:glass", 8, 9, 2, 3, true},
+  };
+  for (const Case& c : cases) {
+    const host::BuiltImage b = build(c.scene, 16, 12);
+    CycleParams p = prototype_params();
+    p.threads = c.threads;
+    p.mem_latency = c.latency;
+    p.mem_queue_depth = c.queue_depth;
+    p.mem_port_capacity = c.port_capacity;
+    CycleRunOptions lanes;
+    lanes.shading.shadows = c.secondary;
+    lanes.shading.secondary = c.secondary;
+    CycleRunOptions stepped = lanes;
+    stepped.idle_skip = false;
+    const CycleFrame a = run_cycle(b.image, p, lanes);
+    const CycleFrame s = run_cycle(b.image, p, stepped);
+    const std::string what = std::string(c.scene) + " queue " + std::to_string(c.queue_depth);
+    EXPECT_GT(a.shading_bytes, 0u) << what;
+    EXPECT_EQ(a.cycles, s.cycles) << what;
+    EXPECT_EQ(a.stats_json, s.stats_json) << what;
+    EXPECT_EQ(a.frame.rgb, s.frame.rgb) << what;
+  }
+}
+
 // Several DynRTPs (D44): the RGC spreads the packets over the pipelines on demand, each pipeline
 // reads through its own caches, the results stay the functional model's, and the frame takes
 // fewer cycles; usage is per unit (averaged over the pipelines).
