@@ -171,23 +171,14 @@ bool MemoryController::Lane::bind(const MemRequest& r) {
   return true;
 }
 
+// The port takes one request per cycle, and only while its channel has room: the cap-th newest
+// request must have been taken in before the cycle.
 bool MemoryController::Lane::can_push() const {
-  const std::uint64_t t = mc_.now();
-  if (last_push_ != hw::kNever && last_push_ >= t) {
-    return false;  // one request per cycle
-  }
-  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
-  // Full at the end of the last cycle: the cap-th newest request was not taken in before it.
-  return pushed_ < cap || accepts_[(pushed_ - cap) & hist_mask_] < t;
+  return push_ready_cycle() <= mc_.now();
 }
 
 std::uint64_t MemoryController::Lane::push_ready_cycle() const {
-  std::uint64_t c = last_push_ == hw::kNever ? 0 : last_push_ + 1;
-  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
-  if (pushed_ >= cap) {
-    c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
-  }
-  return c;
+  return next_push_cycle(0);
 }
 
 // The request's cycles, from the stepped model's rules (memory_controller.h): visible at the
