@@ -181,12 +181,6 @@ std::uint64_t MemoryController::Lane::push_ready_cycle() const {
   return next_push_cycle(0);
 }
 
-// The request's cycles, from the stepped model's rules (memory_controller.h): visible at the
-// intake a cycle after its push, one intake per port and cycle, into a bank queue with room after
-// that cycle's start (the depth-th request before it has started); started a cycle after its
-// intake at the earliest, when the bank is free and (reads) fewer than the limit of reads are in
-// flight after that cycle's retire; a read retires at its due cycle (its port's response channel
-// always has room: the client takes each response the cycle it becomes visible).
 std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const {
   std::uint64_t c = std::max(from, last_push_ == hw::kNever ? 0 : last_push_ + 1);
   const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
@@ -200,6 +194,12 @@ bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
   return state_ == State::kOpen && cycle + mc_.lane_reach_ - mc_.lane_from_ < mc_.lane_mask_ / 2;
 }
 
+// The request's cycles, from the stepped model's rules (memory_controller.h): visible at the
+// intake a cycle after its push, one intake per port and cycle, into a bank queue with room after
+// that cycle's start (the depth-th request before it has started); started a cycle after its
+// intake at the earliest, when the bank is free and (reads) fewer than the limit of reads are in
+// flight after that cycle's retire; a read retires at its due cycle (its port's response channel
+// always has room: the client takes each response the cycle it becomes visible).
 std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t t) {
   if (state_ == State::kUnbound && !bind(r)) {
     port_.requests.push(r);
