@@ -96,9 +96,8 @@ MemoryController::Lane& MemoryController::add_lane(Port& port, bool reads) {
     while (window < 4 * lane_horizon()) {
       window *= 2;
     }
-    lane_busy_.assign(window / 64, 0);
-    lane_stall_.assign(window / 64, 0);
-    lane_mask_ = window - 1;
+    lane_busy_ = hw::CycleMarks(window);
+    lane_stall_ = hw::CycleMarks(window);
   }
   return *port.lane;
 }
@@ -191,7 +190,8 @@ std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const 
 }
 
 bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
-  return state_ == State::kOpen && cycle + mc_.lane_reach_ - mc_.lane_from_ < mc_.lane_mask_ / 2;
+  return state_ == State::kOpen &&
+         cycle + mc_.lane_reach_ - mc_.lane_from_ < (mc_.lane_busy_.window() - 1) / 2;
 }
 
 // The request's cycles, from the stepped model's rules (memory_controller.h): visible at the
@@ -268,22 +268,20 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
   it.data = r.data;
   // The controller's cycles: progress at the intake, the start and the retire; a stall while the
   // request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
-  if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_) {
+  if (std::max(start, retire) - mc_.lane_from_ >= mc_.lane_busy_.window()) {
     mc_.account_now();
-    if (std::max(start, retire) - mc_.lane_from_ > mc_.lane_mask_) {
+    if (std::max(start, retire) - mc_.lane_from_ >= mc_.lane_busy_.window()) {
       throw std::logic_error("memory controller: lane " + port_.name + "'s cycle " +
                              std::to_string(std::max(start, retire)) + " beyond its window");
     }
   }
-  std::uint64_t* const busy = mc_.lane_busy_.data();
-  const std::uint64_t words = mc_.lane_busy_.size() - 1;
-  busy[(accept >> 6) & words] |= std::uint64_t{1} << (accept & 63);
-  busy[(start >> 6) & words] |= std::uint64_t{1} << (start & 63);
+  mc_.lane_busy_.mark(accept);
+  mc_.lane_busy_.mark(start);
   if (reads_) {
-    busy[(retire >> 6) & words] |= std::uint64_t{1} << (retire & 63);
+    mc_.lane_busy_.mark(retire);
   }
   if (accept > visible) {
-    mc_.mark_lane_cycles(mc_.lane_stall_, visible, accept);
+    mc_.mark_lane_stalls(visible, accept);
   }
   last_push_ = t;
   last_accept_ = accept;
@@ -368,39 +366,12 @@ void MemoryController::Lane::settle(std::uint64_t to) {
   }
 }
 
-void MemoryController::mark_lane_cycles(std::vector<std::uint64_t>& bits, std::uint64_t from,
-                                        std::uint64_t to) {
-  if (to - 1 - lane_from_ > lane_mask_) {
+void MemoryController::mark_lane_stalls(std::uint64_t from, std::uint64_t to) {
+  if (to - 1 - lane_from_ >= lane_stall_.window()) {
     throw std::logic_error("memory controller '" + name() + "': a lane's cycle " +
                            std::to_string(to - 1) + " beyond its window");
   }
-  const std::uint64_t words = lane_busy_.size() - 1;
-  for (std::uint64_t c = from; c < to;) {
-    const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
-    const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
-    bits[(c >> 6) & words] |= m;
-    c += len;
-  }
-}
-
-std::uint64_t MemoryController::take_lane_cycles(std::vector<std::uint64_t>& bits,
-                                                 std::uint64_t from, std::uint64_t to) {
-  to = std::min(to, from + lane_mask_ + 1);  // nothing lies beyond the window
-  const std::uint64_t words = lane_busy_.size() - 1;
-  std::uint64_t n = 0;
-  for (std::uint64_t c = from; c < to;) {
-    const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
-    const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
-    std::uint64_t& w = bits[(c >> 6) & words];
-    // (The marks are a few per word: counted one by one, as the build's target has no popcount
-    // instruction and std::popcount becomes a library call.)
-    for (std::uint64_t x = w & m; x != 0; x &= x - 1) {
-      ++n;
-    }
-    w &= ~m;
-    c += len;
-  }
-  return n;
+  lane_stall_.mark(from, to);
 }
 
 // The lanes' steps in cycles [lane_from_, to) booked; the controller's busy and stall cycles
@@ -413,8 +384,8 @@ void MemoryController::account_lanes(std::uint64_t to, bool busy_counted, bool s
     }
   }
   if (open_lanes_ != 0 && to > lane_from_) {
-    const std::uint64_t busy = take_lane_cycles(lane_busy_, lane_from_, to);
-    const std::uint64_t stalls = take_lane_cycles(lane_stall_, lane_from_, to);
+    const std::uint64_t busy = lane_busy_.take(lane_from_, to);
+    const std::uint64_t stalls = lane_stall_.take(lane_from_, to);
     count_cycles(busy_counted ? 0 : busy, stall_counted ? 0 : stalls);
   }
   lane_from_ = to;
@@ -432,15 +403,9 @@ std::uint64_t MemoryController::skip_bound(std::uint64_t now) const {
   if (open_lanes_ == 0) {
     return hw::kNever;
   }
-  const std::uint64_t words = lane_busy_.size() - 1;
-  for (std::uint64_t c = std::max(now, lane_from_); c < lane_from_ + lane_mask_ + 1;) {
-    const std::uint64_t w = lane_busy_[(c >> 6) & words] >> (c & 63);
-    if (w != 0) {
-      return c + static_cast<std::uint64_t>(std::countr_zero(w)) + 1;
-    }
-    c = (c | 63) + 1;
-  }
-  return hw::kNever;
+  const std::uint64_t c =
+      lane_busy_.next(std::max(now, lane_from_), lane_from_ + lane_busy_.window());
+  return c == hw::kNever ? hw::kNever : c + 1;
 }
 
 MemoryController::Port& MemoryController::add_port(const std::string& name, int response_width) {

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "hw/cycle_marks.h"
 #include "hw/kernel.h"
 #include "hw/ring.h"
 #include "memif/image_format.h"
@@ -84,7 +85,7 @@ class MemoryController : public hw::Module {
   // first request whether it can run (otherwise the port works through its channels).
   Lane& add_lane(Port& port, bool reads);
   // Cycles in a lane's window (a client planning ahead keeps its own marks in as many).
-  std::uint64_t lane_window() const { return lane_mask_ + 1; }
+  std::uint64_t lane_window() const { return lane_busy_.window(); }
   // Returns every lane's port to its channels (a host upload is about to write into the banks).
   // Throws std::logic_error once a lane has served a request.
   void close_lanes();
@@ -172,18 +173,15 @@ class MemoryController : public hw::Module {
 
   // Lanes. Their requests' cycles in which the controller makes progress (intake, start,
   // retire) and in which it stalls (a lane's request visible but its bank queue full), as bits
-  // of a window of cycles from lane_from_ on (each cycle's bit at cycle & lane_mask_); counted
+  // of a window of cycles from lane_from_ on; counted
   // into the controller's busy and stall cycles as the cycles pass (account_lanes).
   void account_lanes(std::uint64_t to, bool busy_counted, bool stall_counted);
-  void mark_lane_cycles(std::vector<std::uint64_t>& bits, std::uint64_t from, std::uint64_t to);
-  std::uint64_t take_lane_cycles(std::vector<std::uint64_t>& bits, std::uint64_t from,
-                                 std::uint64_t to);
+  void mark_lane_stalls(std::uint64_t from, std::uint64_t to);
   std::uint64_t lane_horizon() const;
   std::vector<std::unique_ptr<Lane>> lanes_;
   unsigned lane_banks_ = 0;  // bit b: bank b is a lane's
   int open_lanes_ = 0;       // lanes serving requests
-  std::vector<std::uint64_t> lane_busy_, lane_stall_;
-  std::uint64_t lane_mask_ = 0;   // cycles in the window - 1
+  hw::CycleMarks lane_busy_, lane_stall_;
   std::uint64_t lane_reach_ = 0;  // lane_horizon(), computed once
   std::uint64_t lane_from_ = 0;   // the first cycle not yet counted
 };

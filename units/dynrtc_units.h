@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "hw/cycle_marks.h"
 #include "memif/memory_controller.h"
 #include "units/cycle_unit.h"
 
@@ -177,7 +178,6 @@ class RaySource : public CycleUnit {
     std::uint64_t last;  // the cycle its last response becomes visible
   };
   void mark_virtual(std::uint64_t cycle);
-  std::uint64_t take_virtual(std::uint64_t from, std::uint64_t to);
   // A port's request side, through its lane when it has one (docs/memif.md "Lanes").
   static bool can_push(const memif::MemoryController::Port& port) {
     return port.lane != nullptr ? port.lane->can_push() : port.requests.can_push();
@@ -199,8 +199,8 @@ class RaySource : public CycleUnit {
   Ring<Wave> waves_;  // through a lane: the waves sent and not answered, in order
   // Through a lane: the first cycle the read / write port is free of planned pushes.
   std::uint64_t read_free_at_ = 0, write_free_at_ = 0;
-  std::vector<std::uint64_t> virtual_;  // bit per cycle, cycle & virtual_mask_
-  std::uint64_t virtual_mask_ = 0, virtual_from_ = 0, virtual_marked_ = 0;
+  hw::CycleMarks virtual_;
+  std::uint64_t virtual_from_ = 0, virtual_marked_ = 0;
   hw::Counter* retired_;
   hw::Counter* admitted_;
   hw::Counter* reads_;

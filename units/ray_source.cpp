@@ -36,8 +36,7 @@ RaySource::RaySource(hw::Kernel& k, std::string name, ThreadTable& t, int depth,
   }
   if (ports_.frame != nullptr) produces(ports_.frame->requests);
   if (ports_.shading != nullptr && ports_.shading->lane != nullptr && ports_.lane_window != 0) {
-    virtual_.assign(ports_.lane_window / 64, 0);
-    virtual_mask_ = ports_.lane_window - 1;
+    virtual_ = hw::CycleMarks(ports_.lane_window);
   }
   retired_ = &stats().counter(this->name() + ".packets_retired", "packets",
                               "primary packets whose thread was freed");
@@ -144,32 +143,10 @@ int RaySource::receive_shading() {
 }
 
 void RaySource::mark_virtual(std::uint64_t c) {
-  if (c - virtual_from_ > virtual_mask_) {
+  if (c - virtual_from_ >= virtual_.window()) {
     throw std::logic_error(name() + ": a planned cycle beyond the window");
   }
-  std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
-  const std::uint64_t bit = std::uint64_t{1} << (c & 63);
-  virtual_marked_ += (w & bit) == 0;
-  w |= bit;
-}
-
-std::uint64_t RaySource::take_virtual(std::uint64_t from, std::uint64_t to) {
-  to = std::min(to, from + virtual_mask_ + 1);
-  std::uint64_t n = 0;
-  for (std::uint64_t c = from; c < to;) {
-    const std::uint64_t b = c & 63, len = std::min<std::uint64_t>(64 - b, to - c);
-    const std::uint64_t m = (len == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << len) - 1) << b;
-    std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
-    // (The marks are a few per word: counted one by one, as the build's target has no popcount
-    // instruction and std::popcount becomes a library call.)
-    for (std::uint64_t x = w & m; x != 0; x &= x - 1) {
-      ++n;
-    }
-    w &= ~m;
-    c += len;
-  }
-  virtual_marked_ -= n;
-  return n;
+  virtual_marked_ += virtual_.mark(c) ? 1 : 0;
 }
 
 // A cycle in which the stepped RGS would only have pushed a planned request or taken a response
@@ -177,15 +154,10 @@ std::uint64_t RaySource::take_virtual(std::uint64_t from, std::uint64_t to) {
 // the cycles after it, as repeats of it).
 int RaySource::evaluate() {
   const int p = CycleUnit::evaluate();
-  if (virtual_marked_ != 0) {
-    const std::uint64_t c = now(), bit = std::uint64_t{1} << (c & 63);
-    std::uint64_t& w = virtual_[(c >> 6) & (virtual_.size() - 1)];
-    if ((w & bit) != 0) {
-      w &= ~bit;
-      --virtual_marked_;
-      if (p == 0) {
-        count_cycles(1, 0, stalled() ? 1 : 0);
-      }
+  if (virtual_marked_ != 0 && virtual_.take(now())) {
+    --virtual_marked_;
+    if (p == 0) {
+      count_cycles(1, 0, stalled() ? 1 : 0);
     }
   }
   virtual_from_ = now() + 1;
@@ -194,7 +166,8 @@ int RaySource::evaluate() {
 
 void RaySource::skipped(std::uint64_t cycles) {
   if (virtual_marked_ != 0) {
-    const std::uint64_t n = take_virtual(now() - cycles, now());
+    const std::uint64_t n = virtual_.take(now() - cycles, now());
+    virtual_marked_ -= n;
     count_cycles(n, 0, stalled() ? n : 0);
   }
   virtual_from_ = now();
