@@ -172,9 +172,9 @@ class MemoryController : public hw::Module {
   std::vector<hw::Channel<MemRequest>*> intake_;
 
   // Lanes. Their requests' cycles in which the controller makes progress (intake, start,
-  // retire) and in which it stalls (a lane's request visible but its bank queue full), as bits
-  // of a window of cycles from lane_from_ on; counted
-  // into the controller's busy and stall cycles as the cycles pass (account_lanes).
+  // retire) and in which it stalls (a lane's request visible but its bank queue full), marked in
+  // a window of cycles from lane_from_ on; counted into the controller's busy and stall cycles as
+  // the cycles pass (account_lanes).
   void account_lanes(std::uint64_t to, bool busy_counted, bool stall_counted);
   void mark_lane_stalls(std::uint64_t from, std::uint64_t to);
   std::uint64_t lane_horizon() const;

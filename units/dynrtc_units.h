@@ -199,7 +199,7 @@ class RaySource : public CycleUnit {
   Ring<Wave> waves_;  // through a lane: the waves sent and not answered, in order
   // Through a lane: the first cycle the read / write port is free of planned pushes.
   std::uint64_t read_free_at_ = 0, write_free_at_ = 0;
-  hw::CycleMarks virtual_;
+  hw::CycleMarks virtual_;  // the cycles of planned pushes and responses, from virtual_from_ on
   std::uint64_t virtual_from_ = 0, virtual_marked_ = 0;
   hw::Counter* retired_;
   hw::Counter* admitted_;
