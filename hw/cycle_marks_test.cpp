@@ -58,8 +58,9 @@ TEST(CycleMarks, AgreesWithASetOfCycles) {
       case 1: {
         const std::uint64_t b = std::min(a + rng() % 80, from + 256);
         m.mark(a, b);
-        for (std::uint64_t c = a; c < b; ++c)
+        for (std::uint64_t c = a; c < b; ++c) {
           ref.insert(c);
+        }
         break;
       }
       case 2: {
