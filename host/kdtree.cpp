@@ -1171,11 +1171,14 @@ void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_
   std::uint32_t nl = 0;
   std::uint32_t nr = 0;
   for (std::uint32_t i = 0; i < n; ++i) {
+    // The split axis's fields read from the list, not from the copy: indexed by k, the copy
+    // would be kept on the stack and read back.
+    const float lo = all[b + i].lo[k];
+    const float key = all[b + i].key[k];
+    const bool planar = (all[b + i].planar >> k) & 1u;
     const BinItem it = all[b + i];  // a copy: the left list may overwrite its slot
-    const float lo = it.lo[k];
-    const bool planar = (it.planar >> k) & 1u;
-    const bool at_plane = planar && lo == split;
-    const bool left = at_plane ? planar_side == kLeft : it.key[k] < split;
+    const bool at_plane = planar & (lo == split);
+    const bool left = at_plane ? planar_side == kLeft : key < split;
     const bool right = at_plane ? planar_side == kRight : lo >= split;
     if (left || right) {
       // Written to both lists, kept by the cursor of its side: which side is unpredictable,
