@@ -22,8 +22,6 @@
 //   children are written above it and popped when the subtree is done): no per-node allocation.
 #include "host/kdtree.h"
 
-#include "host/float_bounds.h"
-
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -49,6 +47,8 @@
 #else
 #define SAARCOR_KD_AVX 0
 #endif
+
+#include "host/float_bounds.h"
 
 namespace saarcor::host {
 namespace {
