@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
-#include <vector>
 
 namespace saarcor::host {
 namespace {

@@ -73,7 +73,7 @@ class CycleMarks {
     to = std::min(to, from + mask_ + 1);
     for (std::uint64_t c = from; c < to;) {
       const std::uint64_t len = span(c, to);
-      const std::uint64_t w = (words_[(c >> 6) & (words_.size() - 1)] & bits(c, len)) >> (c & 63);
+      const std::uint64_t w = (word(c) & bits(c, len)) >> (c & 63);
       if (w != 0) {
         return c + static_cast<std::uint64_t>(std::countr_zero(w));
       }
@@ -84,6 +84,9 @@ class CycleMarks {
 
  private:
   std::uint64_t& word(std::uint64_t c) { return words_[(c >> 6) & (words_.size() - 1)]; }
+  const std::uint64_t& word(std::uint64_t c) const {
+    return words_[(c >> 6) & (words_.size() - 1)];
+  }
   // The cycles from c to the end of c's word or to `to`, whichever comes first.
   static std::uint64_t span(std::uint64_t c, std::uint64_t to) {
     return std::min<std::uint64_t>(64 - (c & 63), to - c);
