@@ -154,8 +154,8 @@ void BM_CycleModelFrame(benchmark::State& state) {
       p.pipelines, p.threads, shade ? "shaded (Table 3 setting)" : "hit sink (the issue's frame)",
       units::program_mode_name(options.programs),
       ahead ? "2 host threads, wall clock" : "1 host thread, CPU time", times.best, times.n,
-      times.mean(), cpu.best, sim.best, static_cast<unsigned long long>(last.cycles), last.fps, p.clock_mhz,
-      rate / 1e6, target, functional > 0 ? times.best / functional : 0.0, functional,
+      times.mean(), cpu.best, sim.best, static_cast<unsigned long long>(last.cycles), last.fps,
+      p.clock_mhz, rate / 1e6, target, functional > 0 ? times.best / functional : 0.0, functional,
       functional > 0 ? times.best / functional / 20.0 : 0.0, embree > 0 ? rate / embree : 0.0,
       embree * 1e-6);
   if (p.pipelines != 1) {
