@@ -2,13 +2,17 @@
 #include "testbench/paper_cmd.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <utility>
 
 #include "testbench/cycle_render.h"
+#include "testbench/heartbeat.h"
 #include "testbench/image_io.h"
 #include "testbench/render_cmd.h"
+#include "testbench/task_pool.h"
 
 namespace saarcor {
 
@@ -55,6 +59,7 @@ void check_options(const PaperOptions& opts) {
     throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
   if (!opts.json.empty() && !opts.json.ends_with(".json"))
     throw std::runtime_error("bad --json '" + opts.json + "': expected a .json file name");
+  (void)resolve_jobs(opts.jobs);
   CycleRenderOptions c;
   c.set = opts.set;
   resolve_cycle_params(c);  // bad --set keys fail before any scene loads
@@ -81,11 +86,42 @@ std::vector<PaperScene> chosen_scenes(const PaperOptions& opts) {
 }
 
 // One table's entry for one scene: the frame at the table's resolution and its figures.
+// The frames of several tasks (scenes, thread counts) on `jobs` host threads. With more than one,
+// each frame keeps its thread programs on its worker's thread (two frames per core would run
+// slower than one) and one heartbeat counts the frames in place of the frames' own and the
+// progress lines.
+class FramePool {
+ public:
+  FramePool(int jobs, std::size_t frames)
+      : jobs_(jobs), frames_(frames), beat_("paper", jobs > 1 && heartbeat_enabled()) {}
+  int jobs() const { return jobs_; }
+  void prepare(RenderSettings& s) const {
+    if (jobs_ <= 1) return;
+    s.heartbeat = false;
+    if (s.cycle.host_threads == 0) s.cycle.host_threads = 1;
+  }
+  void progress(const std::string& line) const {
+    if (jobs_ <= 1) saarcor::progress(line);
+  }
+  void frame_done() {
+    if (jobs_ > 1)
+      beat_.beat(std::to_string(++done_) + " / " + std::to_string(frames_) + " frames, " +
+                 std::to_string(jobs_) + " at once");
+  }
+  void finish() { beat_.finish(); }
+
+ private:
+  int jobs_;
+  std::size_t frames_;
+  std::atomic<std::size_t> done_{0};
+  Heartbeat beat_;
+};
+
 nlohmann::json table_entry(int table, const PaperScene& ps, PreparedScene& prep, RenderSettings& s,
-                           bool rebuild, int scale) {
+                           bool rebuild, int scale, const FramePool& pool) {
   s.res = table == 3 ? Resolution{512 / scale, 384 / scale} : Resolution{1024 / scale, 768 / scale};
   if (rebuild) build_prepared_image(prep, s, ff::kFp24);
-  progress("Table " + std::to_string(table) + ": " + ps.paper + " (" + ps.spec + ")");
+  pool.progress("Table " + std::to_string(table) + ": " + ps.paper + " (" + ps.spec + ")");
   const FrameResult f = render_model(parse_model("cycle"), prep, s);
   // A frame at 1/scale of the resolution: its fps as the paper's frame would have it (cycles
   // per packet and rays/s do not depend on the resolution but through the image's content).
@@ -199,17 +235,29 @@ nlohmann::json run_paper_tables(const PaperOptions& opts) {
   std::vector<int> tables;
   if (opts.table != 4) tables.push_back(3);
   if (opts.table != 3) tables.push_back(4);
-  nlohmann::json entries = nlohmann::json::array();
-  for (const PaperScene& ps : scenes) {
+  // One task per scene (its tables share the scene's load); the entries in scene order.
+  FramePool pool(std::min(resolve_jobs(opts.jobs), static_cast<int>(scenes.size())),
+                 scenes.size() * tables.size());
+  std::vector<nlohmann::json> per_scene(scenes.size(), nlohmann::json::array());
+  run_tasks(scenes.size(), pool.jobs(), [&](std::size_t i) {
+    const PaperScene& ps = scenes[i];
     RenderSettings s = frame_settings("512x384", 0.0, false, 0, ps.bank_mb);
     s.cycle.set = paper_settings(opts, ps.paper);
     s.res = tables.front() == 3 ? Resolution{512 / opts.scale, 384 / opts.scale}
                                 : Resolution{1024 / opts.scale, 768 / opts.scale};
-    progress("loading " + ps.spec);
+    pool.prepare(s);
+    pool.progress("loading " + ps.spec);
     PreparedScene prep = prepare_scene(ps.spec, s);
-    for (std::size_t t = 0; t < tables.size(); ++t)
-      entries.push_back(table_entry(tables[t], ps, prep, s, t > 0, opts.scale));
-  }
+    for (std::size_t t = 0; t < tables.size(); ++t) {
+      per_scene[i].push_back(table_entry(tables[t], ps, prep, s, t > 0, opts.scale, pool));
+      pool.frame_done();
+    }
+  });
+  pool.finish();
+  nlohmann::json entries = nlohmann::json::array();
+  for (nlohmann::json& scene_entries : per_scene)
+    for (nlohmann::json& e : scene_entries)
+      entries.push_back(std::move(e));
   nlohmann::json j;
   j["scale"] = opts.scale;
   j["configuration"] = opts.set;  // each entry lists its own, the paper's filter included
@@ -335,14 +383,24 @@ nlohmann::json run_thread_curve(const PaperOptions& opts) {
   s.cycle.set = paper_settings(opts, "Scene6");
   progress("thread curve: loading builtin:room");
   const PreparedScene prep = prepare_scene("builtin:room", s);
+  const std::vector<int> counts = {1, 2, 4, 8, 16, 32, 64};
+  FramePool pool(std::min(resolve_jobs(opts.jobs), static_cast<int>(counts.size())), counts.size());
+  std::vector<nlohmann::json> reports(counts.size());
+  run_tasks(counts.size(), pool.jobs(), [&](std::size_t i) {
+    RenderSettings st = s;
+    st.cycle.set.push_back("threads=" + std::to_string(counts[i]));
+    pool.prepare(st);
+    pool.progress("thread curve: " + std::to_string(counts[i]) + " threads");
+    reports[i] = render_model(parse_model("cycle"), prep, st).cycle;
+    pool.frame_done();
+  });
+  pool.finish();
   nlohmann::json rows = nlohmann::json::array();
   double first = 0.0, last = 0.0;
-  for (int t = 1; t <= 64; t *= 2) {
-    RenderSettings st = s;
-    st.cycle.set.push_back("threads=" + std::to_string(t));
-    progress("thread curve: " + std::to_string(t) + " threads");
-    const FrameResult f = render_model(parse_model("cycle"), prep, st);
-    const double fps = f.cycle["fps"].get<double>();
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const int t = counts[i];
+    const nlohmann::json& report = reports[i];
+    const double fps = report["fps"].get<double>();
     if (t == 1) first = fps;
     // The paper: nearly linear up to 32 threads, about +10 % from 32 to 64.
     const double paper_step = t == 1 ? 1.0 : t <= 32 ? 2.0 : 1.10;
@@ -353,7 +411,7 @@ nlohmann::json run_thread_curve(const PaperOptions& opts) {
                     {"step", step},
                     {"paper_step", paper_step},
                     {"ratio", step / paper_step},
-                    {"usage", f.cycle["usage"]}});
+                    {"usage", report["usage"]}});
     last = fps;
   }
   return {{"scene", "builtin:room"},

@@ -54,6 +54,9 @@ struct PaperOptions {
   std::vector<std::string> set;                 // cycle model --set keys for every run
   std::string csv;
   std::string json;
+  // Scenes (tables) or thread counts (--threads) rendered at once on this host: 0 = its cores.
+  // Every figure is the same for any count; each frame then runs on its worker's thread.
+  int jobs = 0;
 };
 
 // The --set keys a paper scene's frames run with: the user's, and the paper's texture filter for

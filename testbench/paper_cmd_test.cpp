@@ -113,6 +113,37 @@ TEST(Paper, RoomRowsBesideThePapers) {
   EXPECT_NE(csv.find("4,Scene6,builtin:room,stand-in,64x48,usage_list,"), std::string::npos);
 }
 
+// Scenes (and thread counts) rendered at once give the rows a serial run gives, in its order.
+TEST(Paper, RowsAreTheSameOnAnyNumberOfJobs) {
+  PaperOptions o;
+  o.scale = 16;
+  o.references = SAARCOR_SHARED_SCENES;
+  o.scenes = {"Scene6", "Office"};
+  o.jobs = 1;
+  const nlohmann::json serial = run_paper_tables(o);
+  o.jobs = 2;
+  const nlohmann::json parallel = run_paper_tables(o);
+  ASSERT_EQ(serial["entries"].size(), 4u);
+  ASSERT_EQ(parallel["entries"].size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const nlohmann::json& a = serial["entries"][i];
+    const nlohmann::json& b = parallel["entries"][i];
+    EXPECT_EQ(a["scene"], b["scene"]) << i;
+    EXPECT_EQ(a["table"], b["table"]) << i;
+    EXPECT_EQ(a["figures"], b["figures"]) << i;
+    EXPECT_EQ(a["report"]["cycles"], b["report"]["cycles"]) << i;
+  }
+  EXPECT_EQ(serial["entries"][2]["kind"], "reference");
+  EXPECT_EQ(paper_text(serial), paper_text(parallel));
+  EXPECT_EQ(paper_csv(serial), paper_csv(parallel));
+  o.jobs = 1;
+  const nlohmann::json curve = run_thread_curve(o);
+  o.jobs = 3;
+  EXPECT_EQ(thread_curve_text(curve), thread_curve_text(run_thread_curve(o)));
+  o.jobs = -1;
+  EXPECT_EQ(error_of([&] { run_paper_tables(o); }), "bad --jobs -1: 1 or more");
+}
+
 // The paper's filters: "all scenes use bilinear filtered textures, Scene6 and Office were rendered
 // with unfiltered textures"; a filter the user sets wins for every scene.
 TEST(Paper, EachSceneRendersWithThePapersTextureFilter) {

@@ -169,6 +169,9 @@ int main(int argc, char** argv) {
     sub->add_option("--set", paper_opts.set, "cycle model or kd.* key KEY=VALUE (repeatable)");
     sub->add_option("--csv", paper_opts.csv, "write the rows as CSV");
     sub->add_option("--json", paper_opts.json, "write the rows and every cycle report as JSON");
+    sub->add_option("--jobs", paper_opts.jobs,
+                    "scenes (or thread counts) rendered at once (default: the host's cores; same "
+                    "rows)");
     sub->callback([&] { status = saarcor::run_paper(paper_opts); });
   }
   saarcor::SweepOptions sweep_opts;

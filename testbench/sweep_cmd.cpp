@@ -8,13 +8,11 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
-#include <functional>
 #include <future>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 #include <tuple>
 
 #include "host/tree_settings.h"
@@ -24,6 +22,7 @@
 #include "testbench/image_io.h"
 #include "testbench/mpi_ranks.h"
 #include "testbench/run_dir.h"
+#include "testbench/task_pool.h"
 #include "units/cycle_params.h"
 
 namespace saarcor {
@@ -142,40 +141,6 @@ std::pair<std::size_t, std::size_t> parse_shard(const std::string& text) {
                              "': expected 1 <= K <= N <= " + std::to_string(kMaxSweepPoints));
   return {k - 1, n};
 }
-
-namespace {
-
-// Runs task(0..n-1) on `jobs` threads. A task that throws stops the tasks after it (in index
-// order) from starting, the ones before it still run, and the exception of the lowest index is
-// rethrown: the error a serial run (jobs = 1) would give.
-void run_tasks(std::size_t n, int jobs, const std::function<void(std::size_t)>& task) {
-  std::atomic<std::size_t> next{0};
-  std::atomic<std::size_t> first_error{n};
-  std::vector<std::exception_ptr> errors(n);
-  auto worker = [&] {
-    for (std::size_t i = next++; i < n; i = next++) {
-      if (i > first_error.load()) continue;
-      try {
-        task(i);
-      } catch (...) {
-        errors[i] = std::current_exception();
-        std::size_t e = first_error.load();
-        while (i < e && !first_error.compare_exchange_weak(e, i)) {
-        }
-      }
-    }
-  };
-  const int threads = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(jobs), n));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t)
-    pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool)
-    t.join();
-  if (first_error.load() < n) std::rethrow_exception(errors[first_error.load()]);
-}
-
-}  // namespace
 
 SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedScene& prepared,
                              const RenderSettings& settings, const SweepRun& run) {
@@ -640,7 +605,8 @@ int run_sweep(const SweepOptions& opts) {
             "--out-dir names every file it writes (sweep.csv, report.json): drop --csv and "
             "--report");
     }
-    if (jobs < 0) throw std::runtime_error("bad --jobs " + std::to_string(jobs) + ": 1 or more");
+    const bool per_core = jobs == 0;
+    jobs = resolve_jobs(jobs);
     SweepRun run;
     if (!opts.shard.empty()) std::tie(run.shard, run.shards) = parse_shard(opts.shard);
     if (ranks.size() > 1) {
@@ -649,10 +615,8 @@ int run_sweep(const SweepOptions& opts) {
       run.shard = static_cast<std::size_t>(ranks.rank());
       run.shards = static_cast<std::size_t>(ranks.size());
     }
-    if (jobs == 0) {
-      // The host's cores, shared by the ranks on it.
-      const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-      jobs = std::max(1, cores / ranks.local_size());
+    if (per_core) {
+      jobs = std::max(1, jobs / ranks.local_size());  // the host's cores, shared by its ranks
     }
     run.jobs = jobs;
     run.heartbeat = ranks.rank() == 0;
