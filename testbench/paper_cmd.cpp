@@ -96,17 +96,24 @@ class FramePool {
       : jobs_(jobs), frames_(frames), beat_("paper", jobs > 1 && heartbeat_enabled()) {}
   int jobs() const { return jobs_; }
   void prepare(RenderSettings& s) const {
-    if (jobs_ <= 1) return;
+    if (jobs_ <= 1) {
+      return;
+    }
     s.heartbeat = false;
-    if (s.cycle.host_threads == 0) s.cycle.host_threads = 1;
+    if (s.cycle.host_threads == 0) {
+      s.cycle.host_threads = 1;
+    }
   }
   void progress(const std::string& line) const {
-    if (jobs_ <= 1) saarcor::progress(line);
+    if (jobs_ <= 1) {
+      saarcor::progress(line);
+    }
   }
   void frame_done() {
-    if (jobs_ > 1)
+    if (jobs_ > 1) {
       beat_.beat(std::to_string(++done_) + " / " + std::to_string(frames_) + " frames, " +
                  std::to_string(jobs_) + " at once");
+    }
   }
   void finish() { beat_.finish(); }
 
@@ -255,9 +262,11 @@ nlohmann::json run_paper_tables(const PaperOptions& opts) {
   });
   pool.finish();
   nlohmann::json entries = nlohmann::json::array();
-  for (nlohmann::json& scene_entries : per_scene)
-    for (nlohmann::json& e : scene_entries)
+  for (nlohmann::json& scene_entries : per_scene) {
+    for (nlohmann::json& e : scene_entries) {
       entries.push_back(std::move(e));
+    }
+  }
   nlohmann::json j;
   j["scale"] = opts.scale;
   j["configuration"] = opts.set;  // each entry lists its own, the paper's filter included

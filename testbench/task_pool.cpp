@@ -17,7 +17,9 @@ void run_tasks(std::size_t n, int jobs, const std::function<void(std::size_t)>& 
   std::vector<std::exception_ptr> errors(n);
   auto worker = [&] {
     for (std::size_t i = next++; i < n; i = next++) {
-      if (i > first_error.load()) continue;
+      if (i > first_error.load()) {
+        continue;
+      }
       try {
         task(i);
       } catch (...) {
@@ -31,17 +33,25 @@ void run_tasks(std::size_t n, int jobs, const std::function<void(std::size_t)>& 
   const int threads =
       static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs, 1)), n));
   std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t)
+  for (int t = 1; t < threads; ++t) {
     pool.emplace_back(worker);
+  }
   worker();
-  for (std::thread& t : pool)
+  for (std::thread& t : pool) {
     t.join();
-  if (first_error.load() < n) std::rethrow_exception(errors[first_error.load()]);
+  }
+  if (first_error.load() < n) {
+    std::rethrow_exception(errors[first_error.load()]);
+  }
 }
 
 int resolve_jobs(int jobs) {
-  if (jobs < 0) throw std::runtime_error("bad --jobs " + std::to_string(jobs) + ": 1 or more");
-  if (jobs > 0) return jobs;
+  if (jobs < 0) {
+    throw std::runtime_error("bad --jobs " + std::to_string(jobs) + ": 1 or more");
+  }
+  if (jobs > 0) {
+    return jobs;
+  }
   return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 

@@ -16,8 +16,9 @@ TEST(TaskPool, EveryTaskRunsOnceOnAnyNumberOfJobs) {
   for (int jobs : {1, 2, 3, 8, 64}) {
     std::vector<std::atomic<int>> runs(37);
     run_tasks(runs.size(), jobs, [&](std::size_t i) { ++runs[i]; });
-    for (std::size_t i = 0; i < runs.size(); ++i)
+    for (std::size_t i = 0; i < runs.size(); ++i) {
       EXPECT_EQ(runs[i].load(), 1) << "task " << i << ", " << jobs << " jobs";
+    }
   }
   int ran = 0;
   run_tasks(0, 4, [&](std::size_t) { ++ran; });
@@ -30,15 +31,18 @@ TEST(TaskPool, TheLowestFailingTaskIsTheError) {
     try {
       run_tasks(runs.size(), jobs, [&](std::size_t i) {
         ++runs[i];
-        if (i == 5 || i == 11) throw std::runtime_error("task " + std::to_string(i));
+        if (i == 5 || i == 11) {
+          throw std::runtime_error("task " + std::to_string(i));
+        }
       });
       ADD_FAILURE() << "no error with " << jobs << " jobs";
     } catch (const std::runtime_error& e) {
       EXPECT_EQ(std::string(e.what()), "task 5") << jobs << " jobs";
     }
     // The tasks before the first failure all ran (a serial run would have run them).
-    for (std::size_t i = 0; i <= 5; ++i)
+    for (std::size_t i = 0; i <= 5; ++i) {
       EXPECT_EQ(runs[i].load(), 1) << "task " << i << ", " << jobs << " jobs";
+    }
   }
 }
 
