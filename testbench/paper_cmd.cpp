@@ -85,7 +85,6 @@ std::vector<PaperScene> chosen_scenes(const PaperOptions& opts) {
   return v;
 }
 
-// One table's entry for one scene: the frame at the table's resolution and its figures.
 // The frames of several tasks (scenes, thread counts) on `jobs` host threads. With more than one,
 // each frame keeps its thread programs on its worker's thread (two frames per core would run
 // slower than one) and one heartbeat counts the frames in place of the frames' own and the
@@ -124,6 +123,7 @@ class FramePool {
   Heartbeat beat_;
 };
 
+// One table's entry for one scene: the frame at the table's resolution and its figures.
 nlohmann::json table_entry(int table, const PaperScene& ps, PreparedScene& prep, RenderSettings& s,
                            bool rebuild, int scale, const FramePool& pool) {
   s.res = table == 3 ? Resolution{512 / scale, 384 / scale} : Resolution{1024 / scale, 768 / scale};
