@@ -86,21 +86,16 @@ std::vector<PaperScene> chosen_scenes(const PaperOptions& opts) {
 }
 
 // The frames of several tasks (scenes, thread counts) on `jobs` host threads. With more than one,
-// each frame keeps its thread programs on its worker's thread (two frames per core would run
-// slower than one) and one heartbeat counts the frames in place of the frames' own and the
-// progress lines.
+// each frame runs beside the others (run_beside_others) and one heartbeat counts the frames in
+// place of the frames' own and the progress lines.
 class FramePool {
  public:
   FramePool(int jobs, std::size_t frames)
       : jobs_(jobs), frames_(frames), beat_("paper", jobs > 1 && heartbeat_enabled()) {}
   int jobs() const { return jobs_; }
   void prepare(RenderSettings& s) const {
-    if (jobs_ <= 1) {
-      return;
-    }
-    s.heartbeat = false;
-    if (s.cycle.host_threads == 0) {
-      s.cycle.host_threads = 1;
+    if (jobs_ > 1) {
+      run_beside_others(s);
     }
   }
   void progress(const std::string& line) const {

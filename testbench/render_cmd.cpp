@@ -317,6 +317,13 @@ void check_functional_format(const ModelSpec& model, const PreparedScene& prep) 
 
 }  // namespace
 
+void run_beside_others(RenderSettings& s) {
+  s.heartbeat = false;
+  if (s.cycle.host_threads == 0) {
+    s.cycle.host_threads = 1;
+  }
+}
+
 void progress(const std::string& line) {
   if (heartbeat_enabled()) std::fprintf(stderr, "%s\n", line.c_str());
 }

@@ -70,6 +70,12 @@ struct RenderSettings {
   int top_level_buffers = 1;
 };
 
+// A frame rendered beside others, one per worker thread (`saarcor sweep`'s points, `saarcor
+// paper`'s scenes): its thread programs stay on the worker's thread unless --host-threads says
+// otherwise (two frames per core would run slower than one; the results are the same,
+// docs/cycle-model.md), and it writes no heartbeat of its own (the command's counts frames).
+void run_beside_others(RenderSettings& s);
+
 // The scene loaded, set to the time, with its memory image built in `format`.
 struct PreparedScene {
   std::string spec;

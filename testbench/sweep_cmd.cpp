@@ -215,9 +215,9 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
       RenderSettings s = settings;
       s.heartbeat = group_settings.heartbeat;
       s.cycle.set.insert(s.cycle.set.end(), points[i].begin(), points[i].end());
-      // Two frames per core would run slower than one: with several jobs each frame keeps its
-      // thread programs on its own worker thread (same results, docs/cycle-model.md).
-      if (jobs > 1 && s.cycle.host_threads == 0) s.cycle.host_threads = 1;
+      if (jobs > 1) {
+        run_beside_others(s);
+      }
       const FrameResult f = render_model(cycle, prep, s);
       check_sweep_point(f, reference.get(), join_words(points[i]));
       SweepPoint& p = group_points[task - 1];
