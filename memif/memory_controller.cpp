@@ -218,13 +218,7 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
   if (t < mc_.now() || (last_push_ != hw::kNever && t <= last_push_)) {
     throw std::logic_error("memory controller: lane " + port_.name + " pushed out of order");
   }
-  // The lane's steps are booked when the controller's cycles are counted (its evaluations, the
-  // kernel's accounting); a lane whose controller sleeps long books them here when its ring of
-  // requests is full.
-  if (k - (reads_ ? taken_ : started_) > item_mask_) {
-    mc_.account_now();
-  }
-  if (k - (reads_ ? taken_ : started_) > item_mask_) {
+  if (reads_ && k - popped_ > item_mask_) {
     throw std::logic_error("memory controller: lane " + port_.name + " holds too many requests");
   }
   const auto depth = static_cast<std::uint64_t>(mc_.config_.queue_depth);
@@ -245,27 +239,35 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
     ++queue_front_;
   }
   // The port's request channel at the end of this cycle: this request and those taken in later.
-  std::uint64_t occupancy = 1;
-  for (std::uint64_t j = k; j > 0 && j + hist_mask_ > k && accepts_[(j - 1) & hist_mask_] > t;
-       --j) {
-    ++occupancy;
+  // Intake cycles increase with the request number and push cycles with each push, so the first
+  // of them only moves forward (the history holds the last hist_mask_ + 1 requests).
+  channel_front_ = std::max(channel_front_, k > hist_mask_ ? k - hist_mask_ : 0);
+  while (channel_front_ < k && accepts_[channel_front_ & hist_mask_] <= t) {
+    ++channel_front_;
   }
+  const std::uint64_t occupancy = k - channel_front_ + 1;
   accepts_[k & hist_mask_] = accept;
   starts_[k & hist_mask_] = start;
   retires_[k & hist_mask_] = retire;
-  Item& it = item(k);
-  it.push = t;
-  it.occupancy = static_cast<std::uint32_t>(occupancy);
-  it.accept = accept;
-  it.start = start;
-  it.retire = retire;
-  it.tag = r.tag;
-  it.queued = static_cast<std::uint32_t>(k - queue_front_ + 1);
-  it.offset = r.offset;
-  it.client = r.client;
-  it.words = r.words;
-  it.counted_bytes = r.counted_bytes;
-  it.data = r.data;
+  // The statistics of every step (the stepped model books them in the cycles the request takes
+  // each step; the sums are the same, and nothing reads them before the run ends: a lane runs
+  // only without time series and traces).
+  ++booked_.requests;
+  booked_.push_cycles += t;
+  booked_.accept_cycles += accept;
+  booked_.words += r.words;
+  booked_.most_in_channel = std::max(booked_.most_in_channel, occupancy);
+  booked_.most_queued = std::max(booked_.most_queued, k - queue_front_ + 1);
+  *mc_.clients_[r.client].bytes += r.counted_bytes ? r.counted_bytes : 4u * r.words;
+  if (reads_) {
+    booked_.retire_cycles += retire;
+    Item& it = item(k);
+    it.retire = retire;
+    it.tag = r.tag;
+  } else {
+    // Stored at its start in the stepped model; nothing reads a lane's bank before then.
+    std::copy_n(r.data.begin(), r.words, mc_.image_.bank(bank_).data() + r.offset);
+  }
   // The controller's cycles: progress at the intake, the start and the retire; a stall while the
   // request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
   if (std::max(start, retire) - mc_.lane_from_ >= mc_.lane_busy_.window()) {
@@ -285,6 +287,7 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
   }
   last_push_ = t;
   last_accept_ = accept;
+  last_words_ = r.words;
   bank_free_ = start + r.words;
   ++pushed_;
   return reads_ ? retire + 1 : 0;
@@ -309,60 +312,24 @@ bool MemoryController::Lane::idle() const {
   if (reads_) {
     return popped_ == pushed_;
   }
-  return pushed_ == 0 || bank_free_ - item(pushed_ - 1).words < mc_.now();
+  return pushed_ == 0 || bank_free_ - last_words_ < mc_.now();
 }
 
-// Books the steps of every request before cycle `to`, as the stepped model does in those cycles.
-void MemoryController::Lane::settle(std::uint64_t to) {
+void MemoryController::Lane::settle() {
+  const Booked b = booked_;
+  if (b.requests == 0) {
+    return;
+  }
+  booked_ = {};
+  port_.requests.book_pushes(b.requests, b.push_cycles, b.most_in_channel);
+  port_.requests.book_pops(b.requests, b.accept_cycles);
   Bank& bank = mc_.banks_[static_cast<std::size_t>(bank_)];
-  std::uint64_t n = 0, sum = 0, most = 0;
-  for (; booked_ < pushed_ && item(booked_).push < to; ++booked_, ++n) {
-    sum += item(booked_).push;
-    most = std::max<std::uint64_t>(most, item(booked_).occupancy);
-  }
-  if (n != 0) {
-    port_.requests.book_pushes(n, sum, most);
-  }
-  n = sum = most = 0;
-  for (; accepted_ < booked_ && item(accepted_).accept < to; ++accepted_, ++n) {
-    sum += item(accepted_).accept;
-    most = std::max<std::uint64_t>(most, item(accepted_).queued);
-  }
-  if (n != 0) {
-    port_.requests.book_pops(n, sum);
-    bank.max_queue->set_max(most);
-  }
-  n = sum = 0;
-  for (; started_ < accepted_ && item(started_).start < to; ++started_, ++n) {
-    const Item& it = item(started_);
-    sum += it.words;
-    *mc_.clients_[it.client].bytes += it.counted_bytes ? it.counted_bytes : 4u * it.words;
-    if (!reads_) {
-      std::uint32_t* const mem = mc_.image_.bank(bank_).data() + it.offset;
-      for (int i = 0; i < it.words; ++i) {
-        mem[i] = it.data[static_cast<std::size_t>(i)];
-      }
-    }
-  }
-  if (n != 0) {
-    *bank.words += sum;
-    *(reads_ ? bank.reads : bank.writes) += n;
-  }
+  bank.max_queue->set_max(b.most_queued);
+  *bank.words += b.words;
+  *(reads_ ? bank.reads : bank.writes) += b.requests;
   if (reads_) {
-    n = sum = 0;
-    for (; retired_ < started_ && item(retired_).retire < to; ++retired_, ++n) {
-      sum += item(retired_).retire;
-    }
-    if (n != 0) {
-      port_.responses.book_pushes(n, sum, 1);
-    }
-    n = sum = 0;
-    for (; taken_ < retired_ && item(taken_).retire + 1 < to; ++taken_, ++n) {
-      sum += item(taken_).retire + 1;
-    }
-    if (n != 0) {
-      port_.responses.book_pops(n, sum);
-    }
+    port_.responses.book_pushes(b.requests, b.retire_cycles, 1);
+    port_.responses.book_pops(b.requests, b.retire_cycles + b.requests);
   }
 }
 
@@ -380,7 +347,7 @@ void MemoryController::mark_lane_stalls(std::uint64_t from, std::uint64_t to) {
 void MemoryController::account_lanes(std::uint64_t to, bool busy_counted, bool stall_counted) {
   for (auto& l : lanes_) {
     if (l->state_ == Lane::State::kOpen) {
-      l->settle(to);
+      l->settle();
     }
   }
   if (open_lanes_ != 0 && to > lane_from_) {

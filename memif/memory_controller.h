@@ -192,8 +192,9 @@ class MemoryController : public hw::Module {
 // buffer and response channel, a module evaluation each; with nothing else on the bank or its
 // path, the cycle of every one of these steps follows from the request's push cycle and the
 // cycles of the requests before it (docs/memif.md "Lanes" derives them), so the lane computes
-// them when the request is pushed, and books the channels', bank's, client's and controller's
-// statistics in the cycles they stand for. The client must take every response in the cycle it
+// them when the request is pushed. The controller's busy and stall cycles are counted as the
+// kernel's time passes them (cycle marks); the channels', bank's and client's statistics are sums
+// over requests, booked at the push. The client must take every response in the cycle it
 // becomes visible (the RGS does: it pops one per cycle and the bank returns at most one).
 class MemoryController::Lane {
  public:
@@ -226,21 +227,16 @@ class MemoryController::Lane {
  private:
   friend class MemoryController;
   Lane(MemoryController& mc, Port& port, int port_index, bool reads);
+  // A read waiting for its response to be taken (the client pops in the cycle it is visible).
   struct Item {
-    std::uint64_t push = 0, accept = 0, start = 0, retire = 0;  // cycles (retire: reads only)
+    std::uint64_t retire = 0;
     std::uint32_t tag = 0;
-    std::uint32_t queued = 0;     // the bank queue's occupancy after this request's intake
-    std::uint32_t occupancy = 0;  // the port's request channel's at the end of the push cycle
-    std::uint32_t offset = 0;
-    std::uint16_t client = 0;
-    std::uint8_t words = 0, counted_bytes = 0;
-    std::array<std::uint32_t, kMaxRequestWords> data{};
   };
   enum class State { kUnbound, kOpen, kClosed };
   Item& item(std::uint64_t k) { return items_[k & item_mask_]; }
   const Item& item(std::uint64_t k) const { return items_[k & item_mask_]; }
   bool bind(const MemRequest& r);  // at the first request: can the lane run?
-  void settle(std::uint64_t to);   // books every step before cycle `to`
+  void settle();                   // hands the statistics booked so far to their counters
 
   MemoryController& mc_;
   Port& port_;
@@ -248,18 +244,26 @@ class MemoryController::Lane {
   bool reads_;
   State state_ = State::kUnbound;
   int bank_ = -1;
-  std::vector<Item> items_;
+  std::vector<Item> items_;  // reads, by request number
   std::uint64_t item_mask_ = 0;
-  // Requests pushed; the first whose push / intake / start / retire / response pop is not yet
-  // booked; the first read not yet taken by the client.
-  std::uint64_t pushed_ = 0, booked_ = 0, accepted_ = 0, started_ = 0, retired_ = 0, taken_ = 0,
-                popped_ = 0;
+  // Requests pushed; the first read whose response the client has not taken.
+  std::uint64_t pushed_ = 0, popped_ = 0;
   // The cycles the recurrences read: the last request's push, intake, start and words; per
   // request the intake and start cycles of the last few (ring by request number), per read the
   // retire cycles of the last few (reads in flight are at most the controller's limit).
   std::uint64_t last_push_ = hw::kNever, last_accept_ = 0, bank_free_ = 0;
+  std::uint8_t last_words_ = 0;
   std::vector<std::uint64_t> accepts_, starts_, retires_;
   std::uint64_t hist_mask_ = 0;
+  // The first request taken in after the last push cycle (the port's request channel holds it
+  // and those after it at the end of that cycle).
+  std::uint64_t channel_front_ = 0;
+  // Statistics of the requests pushed since the last settle(): every cycle of a request is known
+  // when it is pushed, so it is booked then (sums of cycles for the channels' occupancies).
+  struct Booked {
+    std::uint64_t requests = 0, push_cycles = 0, accept_cycles = 0, retire_cycles = 0, words = 0;
+    std::uint64_t most_in_channel = 0, most_queued = 0;
+  } booked_;
   std::uint64_t queue_front_ = 0;  // the first request not yet started at the last intake
 };
 
