@@ -160,6 +160,7 @@ bool MemoryController::Lane::bind(const MemRequest& r) {
   }
   state_ = State::kOpen;
   bank_ = b;
+  bank_words_ = mc_.image_.bank(b).size();
   mc_.lane_banks_ |= 1u << b;
   ++mc_.open_lanes_;
   mc_.intake_[static_cast<std::size_t>(port_index_)] = nullptr;
@@ -172,41 +173,18 @@ bool MemoryController::Lane::bind(const MemRequest& r) {
 
 // The port takes one request per cycle, and only while its channel has room: the cap-th newest
 // request must have been taken in before the cycle.
-bool MemoryController::Lane::can_push() const {
-  return push_ready_cycle() <= mc_.now();
-}
-
-std::uint64_t MemoryController::Lane::push_ready_cycle() const {
-  return next_push_cycle(0);
-}
-
-std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const {
-  std::uint64_t c = std::max(from, last_push_ == hw::kNever ? 0 : last_push_ + 1);
-  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
-  if (pushed_ >= cap) {
-    c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+// The unusual pushes: the lane's first (can it run?), and requests the lane cannot take (model
+// errors), or whose cycles lie beyond its window (book the past first).
+std::uint64_t MemoryController::Lane::push_unusual(const MemRequest& r, std::uint64_t t) {
+  if (state_ == State::kUnbound) {
+    if (!bind(r)) {
+      port_.requests.push(r);
+      return 0;
+    }
+    return push_at(r, t);
   }
-  return c;
-}
-
-bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
-  return state_ == State::kOpen &&
-         cycle + mc_.lane_reach_ - mc_.lane_from_ < (mc_.lane_busy_.window() - 1) / 2;
-}
-
-// The request's cycles, from the stepped model's rules (memory_controller.h): visible at the
-// intake a cycle after its push, one intake per port and cycle, into a bank queue with room after
-// that cycle's start (the depth-th request before it has started); started a cycle after its
-// intake at the earliest, when the bank is free and (reads) fewer than the limit of reads are in
-// flight after that cycle's retire; a read retires at its due cycle (its port's response channel
-// always has room: the client takes each response the cycle it becomes visible).
-std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t t) {
-  if (state_ == State::kUnbound && !bind(r)) {
-    port_.requests.push(r);
-    return 0;
-  }
-  if (r.words < 1 || r.words > kMaxRequestWords || r.bank != bank_ ||
-      static_cast<std::uint64_t>(r.offset) + r.words > mc_.image_.bank(r.bank).size() ||
+  if (state_ != State::kOpen || r.words < 1 || r.words > kMaxRequestWords || r.bank != bank_ ||
+      static_cast<std::uint64_t>(r.offset) + r.words > bank_words_ ||
       r.client >= mc_.clients_.size() || r.write == reads_) {
     throw std::runtime_error("memory controller '" + mc_.name() + "': port " + port_.name +
                              " sent a request outside memory or its lane (bank " +
@@ -214,83 +192,21 @@ std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t
                              ", " + std::to_string(r.words) + " words, client " +
                              std::to_string(r.client) + ")");
   }
-  const std::uint64_t k = pushed_;
   if (t < mc_.now() || (last_push_ != hw::kNever && t <= last_push_)) {
     throw std::logic_error("memory controller: lane " + port_.name + " pushed out of order");
   }
-  if (reads_ && k - popped_ > item_mask_) {
+  if (reads_ && pushed_ - popped_ > item_mask_) {
     throw std::logic_error("memory controller: lane " + port_.name + " holds too many requests");
   }
-  const auto depth = static_cast<std::uint64_t>(mc_.config_.queue_depth);
-  const auto limit = static_cast<std::uint64_t>(mc_.inflight_limit_);
-  const std::uint64_t visible = std::max(t + 1, k == 0 ? 0 : last_accept_ + 1);
-  std::uint64_t accept = visible;
-  if (k >= depth) {
-    accept = std::max(accept, starts_[(k - depth) & hist_mask_]);
+  throw std::logic_error("memory controller: lane " + port_.name + " refused a request it takes");
+}
+
+void MemoryController::Lane::book_beyond_window(std::uint64_t last) {
+  mc_.account_now();
+  if (last - mc_.lane_from_ >= mc_.lane_busy_.window()) {
+    throw std::logic_error("memory controller: lane " + port_.name + "'s cycle " +
+                           std::to_string(last) + " beyond its window");
   }
-  std::uint64_t start = std::max(accept + 1, bank_free_);
-  if (reads_ && k >= limit) {
-    start = std::max(start, retires_[(k - limit) & hist_mask_]);
-  }
-  const std::uint64_t retire =
-      reads_ ? start + r.words - 1 + static_cast<std::uint64_t>(mc_.config_.latency) : 0;
-  // The bank queue after the intake: the requests from the first not started by then on.
-  while (queue_front_ < k && starts_[queue_front_ & hist_mask_] <= accept) {
-    ++queue_front_;
-  }
-  // The port's request channel at the end of this cycle: this request and those taken in later.
-  // Intake cycles increase with the request number and push cycles with each push, so the first
-  // of them only moves forward (the history holds the last hist_mask_ + 1 requests).
-  channel_front_ = std::max(channel_front_, k > hist_mask_ ? k - hist_mask_ : 0);
-  while (channel_front_ < k && accepts_[channel_front_ & hist_mask_] <= t) {
-    ++channel_front_;
-  }
-  const std::uint64_t occupancy = k - channel_front_ + 1;
-  accepts_[k & hist_mask_] = accept;
-  starts_[k & hist_mask_] = start;
-  retires_[k & hist_mask_] = retire;
-  // The statistics of every step (the stepped model books them in the cycles the request takes
-  // each step; the sums are the same, and nothing reads them before the run ends: a lane runs
-  // only without time series and traces).
-  ++booked_.requests;
-  booked_.push_cycles += t;
-  booked_.accept_cycles += accept;
-  booked_.words += r.words;
-  booked_.most_in_channel = std::max(booked_.most_in_channel, occupancy);
-  booked_.most_queued = std::max(booked_.most_queued, k - queue_front_ + 1);
-  *mc_.clients_[r.client].bytes += r.counted_bytes ? r.counted_bytes : 4u * r.words;
-  if (reads_) {
-    booked_.retire_cycles += retire;
-    Item& it = item(k);
-    it.retire = retire;
-    it.tag = r.tag;
-  } else {
-    // Stored at its start in the stepped model; nothing reads a lane's bank before then.
-    std::copy_n(r.data.begin(), r.words, mc_.image_.bank(bank_).data() + r.offset);
-  }
-  // The controller's cycles: progress at the intake, the start and the retire; a stall while the
-  // request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
-  if (std::max(start, retire) - mc_.lane_from_ >= mc_.lane_busy_.window()) {
-    mc_.account_now();
-    if (std::max(start, retire) - mc_.lane_from_ >= mc_.lane_busy_.window()) {
-      throw std::logic_error("memory controller: lane " + port_.name + "'s cycle " +
-                             std::to_string(std::max(start, retire)) + " beyond its window");
-    }
-  }
-  mc_.lane_busy_.mark(accept);
-  mc_.lane_busy_.mark(start);
-  if (reads_) {
-    mc_.lane_busy_.mark(retire);
-  }
-  if (accept > visible) {
-    mc_.mark_lane_stalls(visible, accept);
-  }
-  last_push_ = t;
-  last_accept_ = accept;
-  last_words_ = r.words;
-  bank_free_ = start + r.words;
-  ++pushed_;
-  return reads_ ? retire + 1 : 0;
 }
 
 // (Booked with the lane's other steps: the response is taken in the cycle after its retire.)

@@ -178,6 +178,7 @@ class RaySource : public CycleUnit {
     std::uint64_t last;  // the cycle its last response becomes visible
   };
   void mark_virtual(std::uint64_t cycle);
+  [[noreturn, gnu::cold, gnu::noinline]] void beyond_window() const;
   // A port's request side, through its lane when it has one (docs/memif.md "Lanes").
   static bool can_push(const memif::MemoryController::Port& port) {
     return port.lane != nullptr ? port.lane->can_push() : port.requests.can_push();

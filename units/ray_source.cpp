@@ -143,10 +143,14 @@ int RaySource::receive_shading() {
 }
 
 void RaySource::mark_virtual(std::uint64_t c) {
-  if (c - virtual_from_ >= virtual_.window()) {
-    throw std::logic_error(name() + ": a planned cycle beyond the window");
+  if (c - virtual_from_ >= virtual_.window()) [[unlikely]] {
+    beyond_window();
   }
   virtual_marked_ += virtual_.mark(c) ? 1 : 0;
+}
+
+void RaySource::beyond_window() const {
+  throw std::logic_error(name() + ": a planned cycle beyond the window");
 }
 
 // A cycle in which the stepped RGS would only have pushed a planned request or taken a response
