@@ -114,7 +114,14 @@ void MemoryController::close_lanes() {
 }
 
 MemoryController::Lane::Lane(MemoryController& mc, Port& port, int port_index, bool reads)
-    : mc_(mc), port_(port), port_index_(port_index), reads_(reads) {
+    : mc_(mc),
+      port_(port),
+      port_index_(port_index),
+      reads_(reads),
+      cap_(static_cast<std::uint64_t>(mc.config_.port_capacity)),
+      depth_(static_cast<std::uint64_t>(mc.config_.queue_depth)),
+      limit_(static_cast<std::uint64_t>(mc.inflight_limit_)),
+      latency_(static_cast<std::uint64_t>(mc.config_.latency)) {
   const MemoryControllerConfig& c = mc.config_;
   std::uint64_t n = 1;
   while (n < 4 * (static_cast<std::uint64_t>(c.port_capacity) +
@@ -129,9 +136,7 @@ MemoryController::Lane::Lane(MemoryController& mc, Port& port, int port_index, b
                  std::max({c.port_capacity, c.queue_depth, mc.inflight_limit_}) + 2)) {
     h *= 2;
   }
-  accepts_.assign(h, 0);
-  starts_.assign(h, 0);
-  retires_.assign(h, 0);
+  hist_.resize(h);
   hist_mask_ = h - 1;
 }
 
@@ -161,6 +166,7 @@ bool MemoryController::Lane::bind(const MemRequest& r) {
   state_ = State::kOpen;
   bank_ = b;
   bank_words_ = mc_.image_.bank(b).size();
+  client_count_ = mc_.clients_.size();
   mc_.lane_banks_ |= 1u << b;
   ++mc_.open_lanes_;
   mc_.intake_[static_cast<std::size_t>(port_index_)] = nullptr;
@@ -184,15 +190,15 @@ std::uint64_t MemoryController::Lane::push_unusual(const MemRequest& r, std::uin
     return push_at(r, t);
   }
   if (state_ != State::kOpen || r.words < 1 || r.words > kMaxRequestWords || r.bank != bank_ ||
-      static_cast<std::uint64_t>(r.offset) + r.words > bank_words_ ||
-      r.client >= mc_.clients_.size() || r.write == reads_) {
+      static_cast<std::uint64_t>(r.offset) + r.words > bank_words_ || r.client >= client_count_ ||
+      r.write == reads_) {
     throw std::runtime_error("memory controller '" + mc_.name() + "': port " + port_.name +
                              " sent a request outside memory or its lane (bank " +
                              std::to_string(r.bank) + ", offset " + std::to_string(r.offset) +
                              ", " + std::to_string(r.words) + " words, client " +
                              std::to_string(r.client) + ")");
   }
-  if (t < mc_.now() || (last_push_ != hw::kNever && t <= last_push_)) {
+  if (t < mc_.now() || t < next_push_) {
     throw std::logic_error("memory controller: lane " + port_.name + " pushed out of order");
   }
   if (reads_ && pushed_ - popped_ > item_mask_) {

@@ -251,12 +251,18 @@ class MemoryController::Lane {
   std::uint64_t item_mask_ = 0;
   // Requests pushed; the first read whose response the client has not taken.
   std::uint64_t pushed_ = 0, popped_ = 0;
-  // The cycles the recurrences read: the last request's push, intake, start and words; per
-  // request the intake and start cycles of the last few (ring by request number), per read the
-  // retire cycles of the last few (reads in flight are at most the controller's limit).
-  std::uint64_t last_push_ = hw::kNever, last_accept_ = 0, bank_free_ = 0;
+  // The controller's parameters the recurrences read (port capacity, queue depth, reads in
+  // flight, latency) and its clients when the lane opened.
+  std::uint64_t cap_, depth_, limit_, latency_, client_count_ = 0;
+  // The cycles the recurrences read: the first cycle after the last push, the last request's
+  // intake, the cycle its bank is free, its words; per request the intake, start and (reads)
+  // retire cycles of the last few (ring by request number).
+  std::uint64_t next_push_ = 0, last_accept_ = 0, bank_free_ = 0;
   std::uint8_t last_words_ = 0;
-  std::vector<std::uint64_t> accepts_, starts_, retires_;
+  struct Steps {
+    std::uint64_t accept = 0, start = 0, retire = 0;
+  };
+  std::vector<Steps> hist_;
   std::uint64_t hist_mask_ = 0;
   // The first request taken in after the last push cycle (the port's request channel holds it
   // and those after it at the end of that cycle).
@@ -281,10 +287,9 @@ inline std::uint64_t MemoryController::Lane::push_ready_cycle() const {
 }
 
 inline std::uint64_t MemoryController::Lane::next_push_cycle(std::uint64_t from) const {
-  std::uint64_t c = std::max(from, last_push_ == hw::kNever ? 0 : last_push_ + 1);
-  const auto cap = static_cast<std::uint64_t>(mc_.config_.port_capacity);
-  if (pushed_ >= cap) {
-    c = std::max(c, accepts_[(pushed_ - cap) & hist_mask_] + 1);
+  std::uint64_t c = std::max(from, next_push_);
+  if (pushed_ >= cap_) {
+    c = std::max(c, hist_[(pushed_ - cap_) & hist_mask_].accept + 1);
   }
   return c;
 }
@@ -303,40 +308,35 @@ inline bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
 inline std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t t) {
   const std::uint64_t k = pushed_;
   if (state_ != State::kOpen || r.words < 1 || r.words > kMaxRequestWords || r.bank != bank_ ||
-      static_cast<std::uint64_t>(r.offset) + r.words > bank_words_ ||
-      r.client >= mc_.clients_.size() || r.write == reads_ || t < mc_.now() ||
-      (last_push_ != hw::kNever && t <= last_push_) || (reads_ && k - popped_ > item_mask_))
+      static_cast<std::uint64_t>(r.offset) + r.words > bank_words_ || r.client >= client_count_ ||
+      r.write == reads_ || t < mc_.now() || t < next_push_ || (reads_ && k - popped_ > item_mask_))
       [[unlikely]] {
     return push_unusual(r, t);
   }
-  const auto depth = static_cast<std::uint64_t>(mc_.config_.queue_depth);
-  const auto limit = static_cast<std::uint64_t>(mc_.inflight_limit_);
+  Steps* const hist = hist_.data();
   const std::uint64_t visible = std::max(t + 1, k == 0 ? 0 : last_accept_ + 1);
   std::uint64_t accept = visible;
-  if (k >= depth) {
-    accept = std::max(accept, starts_[(k - depth) & hist_mask_]);
+  if (k >= depth_) {
+    accept = std::max(accept, hist[(k - depth_) & hist_mask_].start);
   }
   std::uint64_t start = std::max(accept + 1, bank_free_);
-  if (reads_ && k >= limit) {
-    start = std::max(start, retires_[(k - limit) & hist_mask_]);
+  if (reads_ && k >= limit_) {
+    start = std::max(start, hist[(k - limit_) & hist_mask_].retire);
   }
-  const std::uint64_t retire =
-      reads_ ? start + r.words - 1 + static_cast<std::uint64_t>(mc_.config_.latency) : 0;
+  const std::uint64_t retire = reads_ ? start + r.words - 1 + latency_ : 0;
   // The bank queue after the intake: the requests from the first not started by then on.
-  while (queue_front_ < k && starts_[queue_front_ & hist_mask_] <= accept) {
+  while (queue_front_ < k && hist[queue_front_ & hist_mask_].start <= accept) {
     ++queue_front_;
   }
   // The port's request channel at the end of this cycle: this request and those taken in later.
   // Intake cycles increase with the request number and push cycles with each push, so the first
   // of them only moves forward (the history holds the last hist_mask_ + 1 requests).
   channel_front_ = std::max(channel_front_, k > hist_mask_ ? k - hist_mask_ : 0);
-  while (channel_front_ < k && accepts_[channel_front_ & hist_mask_] <= t) {
+  while (channel_front_ < k && hist[channel_front_ & hist_mask_].accept <= t) {
     ++channel_front_;
   }
   const std::uint64_t occupancy = k - channel_front_ + 1;
-  accepts_[k & hist_mask_] = accept;
-  starts_[k & hist_mask_] = start;
-  retires_[k & hist_mask_] = retire;
+  hist[k & hist_mask_] = {accept, start, retire};
   // The statistics of every step (the stepped model books them in the cycles the request takes
   // each step; the sums are the same, and nothing reads them before the run ends: a lane runs
   // only without time series and traces).
@@ -369,7 +369,7 @@ inline std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::u
   if (accept > visible) {
     mc_.mark_lane_stalls(visible, accept);
   }
-  last_push_ = t;
+  next_push_ = t + 1;
   last_accept_ = accept;
   last_words_ = r.words;
   bank_free_ = start + r.words;

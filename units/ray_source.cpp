@@ -204,36 +204,41 @@ int RaySource::issue_read() {
   }
   const ThreadToken t = reading_.front();
   Held& h = held(t);
-  const std::uint8_t wave = (*h.access)[h.next].wave;
-  auto wave_sent = [&] { return h.next == h.reads || (*h.access)[h.next].wave != wave; };
-  ++h.outstanding;
+  // The wave: the reads from the next on with its wave number.
+  const std::vector<RgsAccess>& access = *h.access;
+  std::size_t end = h.next + 1;
+  while (end < h.reads && access[end].wave == access[h.next].wave) {
+    ++end;
+  }
+  const std::size_t first = h.next;
   std::uint64_t visible = issue_access(*ports_.shading, ports_.shading_client, t, h, now());
-  ++*reads_;
   if (memif::MemoryController::Lane* lane = ports_.shading->lane) {
     // The rest of the wave (up to kPlan reads) in the cycles the port takes them.
     std::uint64_t last = now();
-    for (int planned = 0; !wave_sent() && planned < kPlan; ++planned) {
+    for (int planned = 0; h.next != end && planned < kPlan; ++planned) {
       const std::uint64_t at = lane->next_push_cycle(last + 1);
       if (!lane->plannable(at)) {
         break;
       }
       mark_virtual(visible);  // a response before the wave's last
       mark_virtual(at);
-      ++h.outstanding;
       visible = issue_access(*ports_.shading, ports_.shading_client, t, h, at);
-      ++*reads_;
       last = at;
     }
     read_free_at_ = last + 1;
-    if (!wave_sent()) {
+  }
+  h.outstanding += static_cast<int>(h.next - first);
+  *reads_ += h.next - first;
+  if (h.next != end) {
+    if (ports_.shading->lane != nullptr) {
       mark_virtual(visible);
-      return 1;
     }
+    return 1;
+  }
+  if (ports_.shading->lane != nullptr) {
     waves_.push_back({t, static_cast<std::uint32_t>(h.outstanding), visible});
   }
-  if (wave_sent()) {
-    reading_.pop_front();
-  }
+  reading_.pop_front();
   return 1;
 }
 
