@@ -177,8 +177,6 @@ bool MemoryController::Lane::bind(const MemRequest& r) {
   return true;
 }
 
-// The port takes one request per cycle, and only while its channel has room: the cap-th newest
-// request must have been taken in before the cycle.
 // The unusual pushes: the lane's first (can it run?), and requests the lane cannot take (model
 // errors), or whose cycles lie beyond its window (book the past first).
 std::uint64_t MemoryController::Lane::push_unusual(const MemRequest& r, std::uint64_t t) {

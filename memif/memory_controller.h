@@ -278,6 +278,8 @@ class MemoryController::Lane {
 
 // ---- The lane's hot path, inline: its client pushes a request in most of the cycles it acts in.
 
+// The port takes one request per cycle, and only while its channel has room: the cap-th newest
+// request must have been taken in before the cycle.
 inline bool MemoryController::Lane::can_push() const {
   return push_ready_cycle() <= mc_.now();
 }
