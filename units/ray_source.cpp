@@ -212,7 +212,8 @@ int RaySource::issue_read() {
   }
   const std::size_t first = h.next;
   std::uint64_t visible = issue_access(*ports_.shading, ports_.shading_client, t, h, now());
-  if (memif::MemoryController::Lane* lane = ports_.shading->lane) {
+  memif::MemoryController::Lane* const lane = ports_.shading->lane;
+  if (lane != nullptr) {
     // The rest of the wave (up to kPlan reads) in the cycles the port takes them.
     std::uint64_t last = now();
     for (int planned = 0; h.next != end && planned < kPlan; ++planned) {
@@ -230,12 +231,12 @@ int RaySource::issue_read() {
   h.outstanding += static_cast<int>(h.next - first);
   *reads_ += h.next - first;
   if (h.next != end) {
-    if (ports_.shading->lane != nullptr) {
+    if (lane != nullptr) {
       mark_virtual(visible);
     }
     return 1;
   }
-  if (ports_.shading->lane != nullptr) {
+  if (lane != nullptr) {
     waves_.push_back({t, static_cast<std::uint32_t>(h.outstanding), visible});
   }
   reading_.pop_front();
