@@ -22,28 +22,29 @@ namespace {
 constexpr std::uint64_t kConfigs = 500;
 constexpr int kChunks = 10;
 
-// The seeds of the campaign: 1..500, or FIRST-LAST from SAARCOR_STRESS_SEEDS.
+// The seeds of the campaign: 1..500, or FIRST-LAST from SAARCOR_STRESS_SEEDS (decimal digits
+// only, at most 12 each, so no sign or overflow slips through; 1 <= FIRST <= LAST).
 std::pair<std::uint64_t, std::uint64_t> campaign_seeds() {
   const char* env = std::getenv("SAARCOR_STRESS_SEEDS");
   if (env == nullptr || *env == '\0') {
     return {1, kConfigs};
   }
   const std::string text(env);
+  const auto number = [](const std::string& w, std::uint64_t& v) {
+    if (w.empty() || w.size() > 12 || w.find_first_not_of("0123456789") != std::string::npos) {
+      return false;
+    }
+    v = std::stoull(w);
+    return true;
+  };
   const std::size_t dash = text.find('-');
-  std::size_t used_first = 0, used_last = 0;
-  try {
-    if (dash == std::string::npos) {
-      throw std::invalid_argument("no dash");
-    }
-    const std::uint64_t first = std::stoull(text.substr(0, dash), &used_first);
-    const std::uint64_t last = std::stoull(text.substr(dash + 1), &used_last);
-    if (used_first == dash && used_last == text.size() - dash - 1 && first >= 1 && first <= last) {
-      return {first, last};
-    }
-  } catch (const std::exception&) {
+  std::uint64_t first = 0, last = 0;
+  if (dash == std::string::npos || !number(text.substr(0, dash), first) ||
+      !number(text.substr(dash + 1), last) || first < 1 || first > last) {
+    throw std::runtime_error("SAARCOR_STRESS_SEEDS=" + text +
+                             ": expected FIRST-LAST, 1 <= FIRST <= LAST");
   }
-  throw std::runtime_error("SAARCOR_STRESS_SEEDS=" + text +
-                           ": expected FIRST-LAST, 1 <= FIRST <= LAST");
+  return {first, last};
 }
 
 class RandomConfigDeep : public ::testing::TestWithParam<int> {};
