@@ -1,4 +1,4 @@
-// The functional fp24 model's frame loop (DESIGN.md section 9, model 2; paper section 3.1: the RGC
+// The functional fp24 model's frame loop (docs/compare.md, model 2; paper section 3.1: the RGC
 // schedules screen-space packets): one thread program, one packet after another, to completion.
 #include "units/functional_model.h"
 
