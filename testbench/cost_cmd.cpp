@@ -248,9 +248,18 @@ int run_cost(const CostOptions& opts) {
   return 0;
 }
 
-int run_paper_cost_table(int table, const std::vector<std::string>& set) {
+int run_paper_cost_table(int table, const std::vector<std::string>& set, const std::string& json,
+                         const std::string& csv) {
+  if (!csv.empty())
+    throw std::runtime_error("bad --csv with --table " + std::to_string(table) +
+                             ": the CSV is Tables 3 and 4's; --json writes Tables 1 and 2");
+  if (!json.empty() && !json.ends_with(".json"))
+    throw std::runtime_error("bad --json '" + json + "': expected a .json file name");
   const CostParams p = cost_params(table == 2 ? "table2" : "prototype", set);
-  std::printf("%s", (table == 1 ? table1_text(p) : table2_text(p)).c_str());
+  const std::string text = table == 1 ? table1_text(p) : table2_text(p);
+  if (!json.empty()) write_text_file(json, cost_json(p, table == 2).dump(2) + "\n");
+  std::printf("%s", text.c_str());
+  if (!json.empty()) std::printf("  json: %s\n", json.c_str());
   return 0;
 }
 

@@ -33,7 +33,9 @@ std::string table2_text(const units::CostParams& params);
 
 // `saarcor cost`: prints the listing, writes --json; returns 0. Bad input throws one line.
 int run_cost(const CostOptions& opts);
-// `saarcor paper --table 1|2` with the user's --set keys (Table 2 on preset table2).
-int run_paper_cost_table(int table, const std::vector<std::string>& set);
+// `saarcor paper --table 1|2` with the user's --set keys (Table 2 on preset table2); `json` as
+// `saarcor cost --json`; a `csv` is refused (the CSV has Tables 3 and 4's columns).
+int run_paper_cost_table(int table, const std::vector<std::string>& set, const std::string& json,
+                         const std::string& csv);
 
 }  // namespace saarcor

@@ -162,6 +162,14 @@ TEST(CostCmd, PaperTables1And2) {
   EXPECT_NE(t2.out.find("Table 2"), std::string::npos);
   EXPECT_NE(t2.out.find("32 threads"), std::string::npos);
   EXPECT_NE(t2.out.find("75.00"), std::string::npos);  // the paper's total
+  const auto dir = scratch_dir("paper_cost");
+  const std::string json = (dir / "t2.json").string();
+  const auto t2j = run_saarcor("paper --table 2 --json " + json);
+  ASSERT_EQ(t2j.status, 0) << t2j.err;
+  std::ifstream f(json);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_DOUBLE_EQ(j["table2"]["total"]["memory_kb"]["paper"].get<double>(), 75.0);
+  expect_one_line_error(run_saarcor("paper --table 1 --csv t.csv"), "--csv");
   expect_one_line_error(run_saarcor("paper --table 5"), "--table");
   expect_one_line_error(run_saarcor("paper --table 2 --set stack=0"), "stack");
 }
