@@ -38,6 +38,9 @@ nlohmann::json unit_json(const UnitCost& u) {
   nlohmann::json j = fp_json(u.fp, u.memory_bits());
   j["name"] = u.name;
   j["memory"] = nlohmann::json::array();
+  j["memory_by_kind"] = nlohmann::json::object();
+  for (const auto& m : u.memory)
+    j["memory_by_kind"][m.kind] = j["memory_by_kind"].value(m.kind, std::int64_t{0}) + m.bits();
   for (const auto& m : u.memory)
     j["memory"].push_back({{"what", m.what},
                            {"kind", m.kind},

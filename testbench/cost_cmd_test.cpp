@@ -120,6 +120,8 @@ TEST(CostCmd, Table2PresetJsonAndText) {
     for (const char* k : {"add", "mul", "div", "cmp", "memory_bits", "memory_kb"})
       EXPECT_TRUE(j["units"][u].contains(k)) << u << "." << k;
   EXPECT_EQ(j["units"]["traversal"]["cmp"].get<int>(), 12);
+  // 64 entries x (21 + 4 + 8 x 24) bits x 32 threads (docs/cost.md).
+  EXPECT_EQ(j["units"]["traversal"]["memory_by_kind"]["stacks"].get<std::int64_t>(), 444'416);
   EXPECT_EQ(j["units"]["transformation"]["mul"].get<int>(), 9);
   EXPECT_EQ(j["total"]["memory_bits"].get<std::int64_t>(), 826'592);
   EXPECT_NEAR(j["total"]["memory_kb"].get<double>(), 100.90, 0.01);
