@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "testbench/cost_cmd.h"
 #include "testbench/cycle_render.h"
 #include "testbench/heartbeat.h"
 #include "testbench/image_io.h"
@@ -443,6 +444,9 @@ std::string thread_curve_text(const nlohmann::json& curve) {
 }
 
 int run_paper(const PaperOptions& opts) {
+  // Tables 1 and 2 count the hardware (testbench/cost_cmd.h); no frame is rendered.
+  if (opts.table == 1 || opts.table == 2)
+    return run_paper_cost_table(opts.table, opts.set, opts.json, opts.csv);
   if (opts.threads) {
     const nlohmann::json curve = run_thread_curve(opts);
     if (!opts.json.empty()) write_text_file(opts.json, curve.dump(2) + "\n");

@@ -10,6 +10,7 @@
 #include "testbench/version.h"
 // [subcommand headers]
 #include "testbench/compare.h"
+#include "testbench/cost_cmd.h"
 #include "testbench/float_tools.h"
 #include "testbench/paper_cmd.h"
 #include "testbench/precision_cmd.h"
@@ -40,6 +41,15 @@ int main(int argc, char** argv) {
     sub->add_option("--bank-mb", scene_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
     sub->add_option("--set", scene_opts.set, "kd-tree builder key kd.KEY=VALUE (repeatable)");
     sub->callback([&] { status = saarcor::run_scene(scene_opts); });
+  }
+  saarcor::CostOptions cost_opts;
+  {
+    auto* sub = app.add_subcommand("cost", "FP units and internal memory per unit (Table 2)");
+    sub->add_option("--preset", cost_opts.preset, "prototype, table2 (beside Table 2), standard")
+        ->capture_default_str();
+    sub->add_option("--set", cost_opts.set, "cycle model key or lights=N KEY=VALUE (repeatable)");
+    sub->add_option("--json", cost_opts.json, "write the figures as JSON");
+    sub->callback([&] { status = saarcor::run_cost(cost_opts); });
   }
   saarcor::FloatInfoOptions float_info_opts;
   {
@@ -157,7 +167,7 @@ int main(int argc, char** argv) {
   {
     auto* sub = app.add_subcommand(
         "paper", "the paper's Tables 3 and 4: each stand-in's cycle-model row beside the paper's");
-    sub->add_option("--table", paper_opts.table, "3 or 4 (default: both)");
+    sub->add_option("--table", paper_opts.table, "1, 2, 3 or 4 (default: 3 and 4)");
     sub->add_flag("--threads", paper_opts.threads,
                   "the room's thread curve 1..64 beside the paper's instead of the tables");
     sub->add_option("--scale", paper_opts.scale, "divide the tables' resolutions (quick looks)")

@@ -1,0 +1,269 @@
+// `saarcor cost` and `saarcor paper --table 1|2` (docs/cost.md).
+#include "testbench/cost_cmd.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "testbench/image_io.h"
+
+namespace saarcor {
+namespace {
+
+using units::ConfigurationCost;
+using units::CostParams;
+using units::FpUnits;
+using units::UnitCost;
+
+double ratio(double model, double paper) {
+  return paper == 0.0 ? 0.0 : model / paper;
+}
+
+const units::PaperTable2Row& paper_row(const std::string& key) {
+  for (const auto& r : units::paper_table2())
+    if (key == r.key) return r;
+  throw std::logic_error("no Table 2 row " + key);
+}
+
+nlohmann::json fp_json(const FpUnits& f, std::int64_t bits) {
+  return {{"add", f.add},
+          {"mul", f.mul},
+          {"div", f.div},
+          {"cmp", f.cmp},
+          {"sqrt", f.sqrt},
+          {"memory_bits", bits},
+          {"memory_kb", static_cast<double>(bits) / 8192.0}};
+}
+
+nlohmann::json unit_json(const UnitCost& u) {
+  nlohmann::json j = fp_json(u.fp, u.memory_bits());
+  j["name"] = u.name;
+  j["memory"] = nlohmann::json::array();
+  j["memory_by_kind"] = nlohmann::json::object();
+  for (const auto& m : u.memory)
+    j["memory_by_kind"][m.kind] = j["memory_by_kind"].value(m.kind, std::int64_t{0}) + m.bits();
+  for (const auto& m : u.memory)
+    j["memory"].push_back({{"what", m.what},
+                           {"kind", m.kind},
+                           {"bits_each", m.bits_each},
+                           {"count", m.count},
+                           {"ports", m.ports},
+                           {"bits", m.bits()}});
+  return j;
+}
+
+nlohmann::json table2_json(const ConfigurationCost& c) {
+  nlohmann::json j;
+  auto row = [&](const std::string& key, const FpUnits& f, double kb) {
+    const auto& p = paper_row(key);
+    const double model[] = {double(f.add), double(f.mul), double(f.div), double(f.cmp), kb};
+    const double paper[] = {double(p.add), double(p.mul), double(p.div), double(p.cmp),
+                            p.memory_kb};
+    const char* keys[] = {"add", "mul", "div", "cmp", "memory_kb"};
+    for (int i = 0; i < 5; ++i)
+      j[key][keys[i]] = {
+          {"model", model[i]}, {"paper", paper[i]}, {"ratio", ratio(model[i], paper[i])}};
+  };
+  for (const UnitCost& u : c.units)
+    row(u.key, u.fp, u.memory_kb());
+  row("total", c.fp_per_pipeline, static_cast<double>(c.memory_bits_per_pipeline) / 8192.0);
+  return j;
+}
+
+std::string fp_cell(int v) {
+  return v == 0 ? "-" : std::to_string(v);
+}
+
+std::string unit_line(const std::string& label, const FpUnits& f, double kb) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10.2f\n", label.c_str(),
+                fp_cell(f.add).c_str(), fp_cell(f.mul).c_str(), fp_cell(f.div).c_str(),
+                fp_cell(f.cmp).c_str(), fp_cell(f.sqrt).c_str(), kb);
+  return buf;
+}
+
+std::string ratio_cell(double model, double paper) {
+  char buf[32];
+  if (paper == 0.0)
+    std::snprintf(buf, sizeof buf, "%s", model == 0.0 ? "-" : "new");
+  else
+    std::snprintf(buf, sizeof buf, "%.2f", model / paper);
+  return buf;
+}
+
+// Table 2's paper line and the ratio line under a model line.
+std::string paper_lines(const std::string& key, const FpUnits& f, double kb) {
+  const auto& p = paper_row(key);
+  std::string s = unit_line("  paper", {p.add, p.mul, p.div, p.cmp, 0}, p.memory_kb);
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10s\n", "  ratio model/paper",
+                ratio_cell(f.add, p.add).c_str(), ratio_cell(f.mul, p.mul).c_str(),
+                ratio_cell(f.div, p.div).c_str(), ratio_cell(f.cmp, p.cmp).c_str(), "",
+                ratio_cell(kb, p.memory_kb).c_str());
+  return s + buf;
+}
+
+std::string heading(const CostParams& p) {
+  const auto& c = p.cycle;
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "%d DynRTP%s, %d threads, %d-ray packets, stack %d, mailboxes %d/%d, caches "
+                "%d/%d/%d items (%d/%d/%d ways), %d lights, %.0f MHz\n",
+                c.pipelines, c.pipelines == 1 ? "" : "s", c.threads, c.packet, c.stack, c.mailbox,
+                c.triangle_mailbox, c.cache[0].items, c.cache[1].items, c.cache[2].items,
+                c.cache[0].ways, c.cache[1].ways, c.cache[2].ways, p.lights, c.clock_mhz);
+  return buf;
+}
+
+std::string column_heads(const char* first) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10s\n", first, "add", "mul", "div",
+                "cmp", "sqrt", "memory KB");
+  return buf;
+}
+
+std::string memory_lines(const UnitCost& u) {
+  std::string s;
+  char buf[400];
+  for (const auto& m : u.memory) {
+    std::snprintf(buf, sizeof buf, "    %9.3f KB  %-13s %s: %lld bits x %lld%s\n",
+                  static_cast<double>(m.bits()) / 8192.0, m.kind.c_str(), m.what.c_str(),
+                  static_cast<long long>(m.bits_each), static_cast<long long>(m.count),
+                  m.ports == 2 ? ", dual-ported (x2)" : "");
+    s += buf;
+  }
+  return s;
+}
+
+std::string total_lines(const ConfigurationCost& c, bool table2) {
+  const double kb1 = static_cast<double>(c.memory_bits_per_pipeline) / 8192.0;
+  std::string s = unit_line("Total (one DynRTP)", c.fp_per_pipeline, kb1);
+  if (table2) s += paper_lines("total", c.fp_per_pipeline, kb1);
+  if (c.pipelines > 1)
+    s += unit_line("Total (" + std::to_string(c.pipelines) + " DynRTPs)", c.fp_total,
+                   c.memory_kb_total());
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "FLOPs: %.3g (%d FP units x %.0f MHz; paper: 4 billion)\n",
+                c.flops, c.fp_total.total(), c.clock_mhz);
+  return s + buf;
+}
+
+}  // namespace
+
+CostParams cost_params(const std::string& preset, const std::vector<std::string>& set) {
+  CostParams p = units::cost_preset(preset);
+  for (const std::string& kv : set)
+    units::apply_cost_setting(p, kv);
+  units::check_cost_params(p);
+  return p;
+}
+
+nlohmann::json cost_json(const CostParams& params, bool table2) {
+  const ConfigurationCost c = units::configuration_cost(params);
+  nlohmann::json j;
+  for (const UnitCost& u : c.units)
+    j["units"][u.key] = unit_json(u);
+  j["total"] = fp_json(c.fp_total, c.memory_bits_total);
+  j["total"]["per_pipeline"] = fp_json(c.fp_per_pipeline, c.memory_bits_per_pipeline);
+  j["pipelines"] = c.pipelines;
+  j["flops"] = c.flops;
+  j["lights"] = params.lights;
+  for (const auto& i : units::describe(params.cycle))
+    j["configuration"][i.name] = i.value;
+  const units::Table1 t1 = units::table1(params);
+  for (const auto& r : t1.ratios)
+    j["table1"][r.key] = {{"without_traversal", r.without_traversal},
+                          {"full", r.full},
+                          {"paper_without_traversal", r.paper_without_traversal},
+                          {"paper_full", r.paper_full}};
+  for (const auto& d : t1.designs)
+    j["table1"]["designs"][d.key] = {{"name", d.name},
+                                     {"parts", d.parts},
+                                     {"without_traversal", d.without_traversal.total()},
+                                     {"full", d.full.total()}};
+  if (table2) j["table2"] = table2_json(c);
+  return j;
+}
+
+std::string cost_text(const CostParams& params, bool table2) {
+  const ConfigurationCost c = units::configuration_cost(params);
+  std::string s = heading(params) + column_heads("unit (one DynRTP)");
+  for (const UnitCost& u : c.units) {
+    s += unit_line(u.name, u.fp, u.memory_kb());
+    if (table2) s += paper_lines(u.key, u.fp, u.memory_kb());
+    s += memory_lines(u);
+  }
+  return s + total_lines(c, table2);
+}
+
+std::string table2_text(const CostParams& params) {
+  const ConfigurationCost c = units::configuration_cost(params);
+  std::string s = "Table 2 (paper: one DynRTP, 32 threads, 512-item caches, 8 lights; model: " +
+                  heading(params).substr(0, heading(params).size() - 1) + ")\n" +
+                  column_heads("unit");
+  for (const UnitCost& u : c.units)
+    s += unit_line(u.name, u.fp, u.memory_kb()) + paper_lines(u.key, u.fp, u.memory_kb());
+  return s + total_lines(c, true) + "the memory items and each difference: saarcor cost --preset " +
+         "table2, docs/cost.md\n";
+}
+
+std::string table1_text(const CostParams& params) {
+  const units::Table1 t = units::table1(params);
+  std::string s =
+      "Table 1 (FP units = add + mul + div + cmp, one per operation of a fully pipelined datapath; "
+      "K = this configuration's traversal unit, " +
+      std::to_string(t.traversal.total()) + " units; docs/cost.md)\n";
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%-12s %-18s %18s %12s\n", "design", "parts", "without traversal",
+                "full design");
+  s += buf;
+  for (const auto& d : t.designs) {
+    std::snprintf(buf, sizeof buf, "%-12s %-18s %18d %12d\n", d.name.c_str(), d.parts.c_str(),
+                  d.without_traversal.total(), d.full.total());
+    s += buf;
+  }
+  std::snprintf(buf, sizeof buf, "%-34s %18s %12s\n", "FP cost ratio", "without traversal",
+                "full design");
+  s += buf;
+  for (const auto& r : t.ratios) {
+    std::snprintf(buf, sizeof buf, "%-34s %17.0f%% %11.0f%%\n", r.name.c_str(),
+                  100 * r.paper_without_traversal, 100 * r.paper_full);
+    s += buf;
+    std::snprintf(buf, sizeof buf, "%-34s %17.1f%% %11.1f%%\n", "  model",
+                  100 * r.without_traversal, 100 * r.full);
+    s += buf;
+    std::snprintf(buf, sizeof buf, "%-34s %18.2f %12.2f\n", "  ratio model/paper",
+                  ratio(r.without_traversal, r.paper_without_traversal),
+                  ratio(r.full, r.paper_full));
+    s += buf;
+  }
+  return s;
+}
+
+int run_cost(const CostOptions& opts) {
+  if (!opts.json.empty() && !opts.json.ends_with(".json"))
+    throw std::runtime_error("bad --json '" + opts.json + "': expected a .json file name");
+  const CostParams p = cost_params(opts.preset, opts.set);
+  const bool table2 = opts.preset == "table2";
+  const std::string text = cost_text(p, table2);  // computed before any file is written
+  if (!opts.json.empty()) write_text_file(opts.json, cost_json(p, table2).dump(2) + "\n");
+  std::printf("%s", text.c_str());
+  if (!opts.json.empty()) std::printf("  json: %s\n", opts.json.c_str());
+  return 0;
+}
+
+int run_paper_cost_table(int table, const std::vector<std::string>& set, const std::string& json,
+                         const std::string& csv) {
+  if (!csv.empty())
+    throw std::runtime_error("bad --csv with --table " + std::to_string(table) +
+                             ": the CSV is Tables 3 and 4's; --json writes Tables 1 and 2");
+  if (!json.empty() && !json.ends_with(".json"))
+    throw std::runtime_error("bad --json '" + json + "': expected a .json file name");
+  const CostParams p = cost_params(table == 2 ? "table2" : "prototype", set);
+  const std::string text = table == 1 ? table1_text(p) : table2_text(p);
+  if (!json.empty()) write_text_file(json, cost_json(p, table == 2).dump(2) + "\n");
+  std::printf("%s", text.c_str());
+  if (!json.empty()) std::printf("  json: %s\n", json.c_str());
+  return 0;
+}
+
+}  // namespace saarcor
