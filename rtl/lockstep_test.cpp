@@ -1,0 +1,131 @@
+// The list unit's RTL (rtl/list_unit.sv) in lockstep with the cycle model (rtl/lockstep.h): 0
+// divergences on the CI scenes and configurations, the injected fault caught at its first wrong
+// event, bad input refused.
+#include "rtl/lockstep.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "units/boundary_list.h"
+
+namespace saarcor::rtl {
+namespace {
+
+using units::BoundaryEvent;
+using units::BoundaryPort;
+
+std::string shared(const std::string& rel) {
+  return std::string(SAARCOR_SHARED_SCENES) + "/" + rel;
+}
+
+// ---- lockstep ----------------------------------------------------------------------------------
+LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, int w = 24,
+                   int h = 18, bool shadows = false, int depth = 0) {
+  LockstepOptions o;
+  o.scene = scene;
+  o.set = std::move(set);
+  o.width = w;
+  o.height = h;
+  o.shadows = shadows;
+  o.depth = depth;
+  return run_lockstep(o);
+}
+
+void expect_agreement(const LockstepResult& r) {
+  EXPECT_FALSE(r.diverged) << r.screen;
+  const auto ev = [&](BoundaryPort p) { return r.events[static_cast<std::size_t>(p)]; };
+  EXPECT_GT(ev(BoundaryPort::kCacheRequest), 0u);
+  EXPECT_EQ(ev(BoundaryPort::kCacheRequest), ev(BoundaryPort::kCacheResponse));
+  EXPECT_EQ(ev(BoundaryPort::kCacheRequest), ev(BoundaryPort::kOutput));
+  std::printf("  %s: %llu cycles, %llu requests, %llu outputs compared\n", r.build.c_str(),
+              static_cast<unsigned long long>(r.cycles),
+              static_cast<unsigned long long>(ev(BoundaryPort::kCacheRequest)),
+              static_cast<unsigned long long>(ev(BoundaryPort::kOutput)));
+}
+
+const std::vector<std::string> kP1 = {"threads=13", "packet=1", "mailbox=1", "triangle_mailbox=1",
+                                      "cache.list.items=8"};
+const std::vector<std::string> kP16 = {"threads=16", "packet=16", "cache.list.items=8"};
+
+TEST(ListLockstep, RoomPrototype) {
+  expect_agreement(run("builtin:room"));
+}
+TEST(ListLockstep, RoomP1ThirteenThreadsMailbox1Cache8) {
+  expect_agreement(run("builtin:room", kP1));
+}
+TEST(ListLockstep, RoomP16Cache8) {
+  expect_agreement(run("builtin:room", kP16, 32, 32));
+}
+TEST(ListLockstep, DynamicShadowsDepth2) {
+  expect_agreement(run("builtin:dynamic", {}, 24, 18, true, 2));
+}
+TEST(ListLockstep, DynamicShadowsDepth2P1) {
+  expect_agreement(run("builtin:dynamic", kP1, 16, 12, true, 2));
+}
+TEST(ListLockstep, SunCorTwoLevels) {
+  expect_agreement(run("builtin:suncor", {}, 24, 18));
+}
+TEST(ListLockstep, DuckGltf) {
+  expect_agreement(run(shared("Duck/Duck.gltf")));
+}
+TEST(ListLockstep, TwoCylinderEngineGltfP16) {
+  expect_agreement(run(shared("2CylinderEngine/2CylinderEngine.gltf"), kP16, 32, 24));
+}
+
+// The injected fault (a mailbox that never hits, list_unit.sv FAULT_MAILBOX_NEVER_HITS) is caught
+// at the first event the mailbox decides: the model's first list output whose rays the mailbox
+// reduced (a skip, or an entry for fewer rays than the list holds).
+TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
+  LockstepOptions o;
+  o.scene = "builtin:room";
+  o.width = 24;
+  o.height = 18;
+  std::map<std::pair<std::uint32_t, std::uint64_t>, std::uint64_t> rays;  // (thread, level)
+  std::uint64_t first = 0;
+  o.model_events = [&](const BoundaryEvent& e) {
+    if (e.port == BoundaryPort::kInput) rays[{e.thread, e.field[1]}] = e.field[4];
+    if (e.port != BoundaryPort::kOutput || first != 0) return;
+    const bool entry = e.field[0] == static_cast<std::uint64_t>(units::ListOut::kEntry);
+    if (!entry || e.field[4] != rays[{e.thread, e.field[1]}]) first = e.cycle;
+  };
+  const LockstepResult healthy = run_lockstep(o);
+  ASSERT_FALSE(healthy.diverged) << healthy.screen;
+  ASSERT_NE(first, 0u) << "the room's lists never hit the mailbox";
+
+  o.model_events = nullptr;
+  o.fault = "mailbox-never-hits";
+  const LockstepResult r = run_lockstep(o);
+  ASSERT_TRUE(r.diverged);
+  EXPECT_EQ(r.divergence.cycle, first) << r.screen;
+  EXPECT_EQ(r.divergence.port, "output");
+  EXPECT_EQ(r.divergence.kind, "payload");
+  EXPECT_NE(r.screen.find("the last 16 events"), std::string::npos);
+}
+
+TEST(ListLockstep, BadInputIsRefusedWithOneLine) {
+  LockstepOptions o;
+  o.scene = "builtin:room";
+  o.units = {"shading"};
+  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  o.units = {"list"};
+  o.set = {"threads=7"};
+  try {
+    run_lockstep(o);
+    ADD_FAILURE() << "threads=7 has no Verilated build";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no Verilated list unit"), std::string::npos);
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+  o.set = {};
+  o.fault = "stack-off-by-one";
+  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace saarcor::rtl
