@@ -102,5 +102,52 @@ TEST(ListUnitRtl, EntryLeavesAfterFetchHitIssueAndDepthThenMailboxSkipPops) {
   EXPECT_EQ(m.out[1].second.next, 102u);
 }
 
+// Input priority (D25; units/dynrtp.cpp: the unit's loop, then the intersection unit, then path
+// c): three threads pushed in the same cycle are accepted one per cycle in that order, each
+// request leaving in its accept cycle.
+TEST(ListUnitRtl, ThreadsArrivingTogetherAreAcceptedInPathPriority) {
+  Mock m;
+  const std::uint64_t pushed = 2;
+  ListInputs& in = m.in[pushed];
+  for (std::size_t path = 0; path < 3; ++path) {
+    in.valid[path] = in.start[path] = true;
+    in.thread[path] = static_cast<std::uint32_t>(10 + path);
+    in.next[path] = static_cast<std::uint32_t>(200 + 10 * path);
+    in.end[path] = in.next[path] + 1;
+    in.mask[path] = 0x1;
+  }
+  m.run(20);
+  ASSERT_EQ(m.req.size(), 3u);
+  for (std::size_t path = 0; path < 3; ++path) {
+    EXPECT_EQ(m.req[path].first, pushed + kPathLatency + path);
+    EXPECT_EQ(m.req[path].second.req_thread, 10 + path);
+    EXPECT_EQ(m.req[path].second.req_item, 200 + 10 * path);
+  }
+}
+
+// A full request queue (req_ready low) holds the fetch: the request leaves in the first cycle the
+// cache takes it, and no other thread is accepted meanwhile.
+TEST(ListUnitRtl, FullCacheQueueHoldsTheRequest) {
+  Mock m;
+  const std::uint64_t pushed = 2, blocked = 4;
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    ListInputs& in = m.in[pushed + k];
+    in.valid[2] = in.start[2] = true;
+    in.thread[2] = k;
+    in.next[2] = 50 + k;
+    in.end[2] = 60;
+    in.mask[2] = 0x1;
+  }
+  const std::uint64_t accepted = pushed + kPathLatency;
+  for (std::uint64_t c = accepted; c < accepted + blocked; ++c)
+    m.in[c].req_ready = false;
+  m.run(20);
+  ASSERT_EQ(m.req.size(), 2u);
+  EXPECT_EQ(m.req[0].first, accepted + blocked);
+  EXPECT_EQ(m.req[0].second.req_thread, 0u);
+  EXPECT_EQ(m.req[1].first, accepted + blocked + 1);
+  EXPECT_EQ(m.req[1].second.req_thread, 1u);
+}
+
 }  // namespace
 }  // namespace saarcor::rtl

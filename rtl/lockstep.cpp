@@ -135,7 +135,10 @@ class Lockstep {
  private:
   void advance_to(std::uint64_t c) {
     while (cur_ < c) {
-      if (o_.until != 0 && cur_ > o_.until) throw Stop{};
+      if (o_.until != 0 && cur_ > o_.until) {  // a replay: both sides are complete up to here
+        compare(o_.until);
+        throw Stop{};
+      }
       step();
       pending_.clear();
       ++cur_;

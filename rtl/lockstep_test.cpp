@@ -106,6 +106,12 @@ TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
   EXPECT_EQ(r.divergence.port, "output");
   EXPECT_EQ(r.divergence.kind, "payload");
   EXPECT_NE(r.screen.find("the last 16 events"), std::string::npos);
+  // The replay (--until the divergence's cycle) stops there with the same divergence.
+  o.until = r.divergence.cycle;
+  const LockstepResult replay = run_lockstep(o);
+  EXPECT_TRUE(replay.diverged);
+  EXPECT_EQ(replay.divergence.cycle, first);
+  EXPECT_EQ(replay.divergence.field, r.divergence.field);
 }
 
 TEST(ListLockstep, BadInputIsRefusedWithOneLine) {

@@ -186,6 +186,12 @@ int lockstep(const std::vector<std::string>& args) {
                   static_cast<unsigned long long>(r.divergence.cycle), w.wave.c_str());
       return 2;
     }
+    if (o.until != 0 && r.cycles <= o.until + 1)
+      std::printf(
+          "saarcor-rtl lockstep: stopped after cycle %llu (--until), no divergence up to "
+          "it; waveform %s (RTL cycles %llu..%llu)\n",
+          static_cast<unsigned long long>(o.until), o.wave.c_str(),
+          static_cast<unsigned long long>(o.wave_from), static_cast<unsigned long long>(o.wave_to));
     static constexpr const char* kPorts[] = {"input",          "side_band",     "cache_request",
                                              "cache_response", "cache_blocked", "output"};
     std::printf(
