@@ -3,12 +3,14 @@
 // table below) and passes the same values to Verilator as -G parameters.
 #include "rtl/list_rtl.h"
 
+#include <algorithm>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 
 #include "rtl_list_builds.h"
+#include "units/boundary_list.h"
 #include "verilated.h"
 #include "verilated_vcd_c.h"
 
@@ -139,6 +141,100 @@ class ListRtlOf final : public ListRtl {
   std::uint64_t cycle_ = 0;
 };
 
+// The list unit's input path (priority order, units/dynrtp.cpp) of a sending unit.
+int input_path(units::UnitId from) {
+  switch (from) {
+    case units::UnitId::kList:
+      return 0;
+    case units::UnitId::kIntersection:
+      return 1;
+    case units::UnitId::kTraversal:
+      return 2;
+    default:
+      throw std::logic_error(std::string("lockstep: a thread reached the list unit from the ") +
+                             units::unit_name(from) + " unit, which has no path to it");
+  }
+}
+
+class ListUnitRtl final : public UnitRtl {
+ public:
+  explicit ListUnitRtl(const ListBuild& b) : rtl_(make_list_rtl(b)) {}
+  units::UnitId unit() const override { return units::UnitId::kList; }
+  void reset() override { rtl_->reset(); }
+  void start_trace(const std::string& path) override { rtl_->start_trace(path); }
+  void stop_trace() override { rtl_->stop_trace(); }
+
+  void cycle(std::uint64_t cycle, const std::vector<units::BoundaryEvent>& inputs,
+             std::vector<units::BoundaryEvent>& outputs) override {
+    using units::BoundaryPort;
+    ListInputs in;
+    int clears = 0;
+    for (const units::BoundaryEvent& e : inputs) {
+      switch (e.port) {
+        case BoundaryPort::kInput: {
+          const auto i = static_cast<std::size_t>(input_path(e.path));
+          if (in.valid[i])
+            throw std::logic_error("lockstep: two threads on one list unit path in a cycle");
+          in.valid[i] = true;
+          in.thread[i] = e.thread;
+          in.start[i] = e.field[0] != 0;
+          in.level[i] = e.field[1] != 0;
+          in.next[i] = static_cast<std::uint32_t>(e.field[2]);
+          in.end[i] = static_cast<std::uint32_t>(e.field[3]);
+          in.mask[i] = e.field[4];
+          break;
+        }
+        case BoundaryPort::kSideBand:
+          if (clears == 2) throw std::logic_error("lockstep: three packet starts in one cycle");
+          in.clear[static_cast<std::size_t>(clears)] = true;
+          in.clear_thread[static_cast<std::size_t>(clears++)] = e.thread;
+          break;
+        case BoundaryPort::kCacheBlocked:
+          in.req_ready = false;
+          break;
+        case BoundaryPort::kCacheResponse:
+          in.resp = true;
+          in.resp_thread = e.thread;
+          in.resp_word = static_cast<std::uint32_t>(e.field[1]);
+          break;
+        default:
+          throw std::logic_error("lockstep: an output event given to the list unit as an input");
+      }
+    }
+    const ListOutputs out = rtl_->cycle(in);
+    if (out.req) {
+      units::BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, out.req_thread);
+      e.fields = 3;
+      e.names = units::kCacheRequestFields;
+      e.field[0] = out.req_item;
+      e.field[1] = static_cast<std::uint64_t>(units::unit_index(units::UnitId::kList));
+      e.field[2] = out.req_thread;
+    }
+    if (out.out) {
+      units::BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kOutput, out.out_thread);
+      constexpr units::UnitId kTo[] = {units::UnitId::kTransformation, units::UnitId::kList,
+                                       units::UnitId::kTraversal};
+      e.path = kTo[std::min<std::uint32_t>(out.kind, 2)];
+      e.fields = 5;
+      e.names = units::kListOutputFields;
+      e.field = {out.kind, out.level, out.next, out.entry, out.mask};
+    }
+  }
+
+ private:
+  static units::BoundaryEvent& event(std::vector<units::BoundaryEvent>& v, std::uint64_t cycle,
+                                     units::BoundaryPort port, std::uint32_t thread) {
+    units::BoundaryEvent& e = v.emplace_back();
+    e.cycle = cycle;
+    e.unit = units::UnitId::kList;
+    e.port = port;
+    e.thread = thread;
+    return e;
+  }
+
+  std::unique_ptr<ListRtl> rtl_;
+};
+
 }  // namespace
 
 const std::vector<ListBuild>& list_builds() {
@@ -157,6 +253,10 @@ std::unique_ptr<ListRtl> make_list_rtl(const ListBuild& build) {
   SAARCOR_LIST_BUILDS(SAARCOR_LIST_BUILD)
 #undef SAARCOR_LIST_BUILD
   throw std::runtime_error("no Verilated list unit build named '" + build.name + "'");
+}
+
+std::unique_ptr<UnitRtl> make_list_unit_rtl(const ListBuild& build) {
+  return std::make_unique<ListUnitRtl>(build);
 }
 
 }  // namespace saarcor::rtl

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "rtl/unit_rtl.h"
+
 namespace saarcor::rtl {
 
 // A Verilated build of list_unit.sv: its SystemVerilog parameters.
@@ -52,5 +54,11 @@ class ListRtl {
 };
 
 std::unique_ptr<ListRtl> make_list_rtl(const ListBuild& build);
+
+// The list unit behind the lockstep's interface: the boundary record's list payloads
+// (units/boundary_list.h) to and from its ports. Inputs: the paths from the list unit itself,
+// the intersection unit and the traversal unit (ports 0, 1, 2), up to two packet starts, the
+// cache response's word, the cache's back-pressure.
+std::unique_ptr<UnitRtl> make_list_unit_rtl(const ListBuild& build);
 
 }  // namespace saarcor::rtl

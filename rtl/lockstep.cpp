@@ -86,32 +86,11 @@ class LockstepThreads final : public units::ThreadTable {
 // reached its cycle: the kernel is left where it stands.
 struct Stop {};
 
-const char* path_name(int path) {
-  constexpr const char* kNames[] = {"the unit's loop", "the intersection unit",
-                                    "the traversal unit"};
-  return kNames[path];
-}
-
-// The list unit's input path (priority order, units/dynrtp.cpp) of a sending unit.
-int input_path(UnitId from) {
-  switch (from) {
-    case UnitId::kList:
-      return 0;
-    case UnitId::kIntersection:
-      return 1;
-    case UnitId::kTraversal:
-      return 2;
-    default:
-      throw std::runtime_error(std::string("lockstep: a thread reached the list unit from the ") +
-                               units::unit_name(from) + " unit, which has no path to it");
-  }
-}
-
 class Lockstep {
  public:
-  Lockstep(ListRtl& rtl, const LockstepOptions& o) : rtl_(rtl), o_(o) { rtl_.reset(); }
+  Lockstep(UnitRtl& rtl, const LockstepOptions& o) : rtl_(rtl), o_(o) { rtl_.reset(); }
 
-  // The model's events of the list unit, in cycle order.
+  // The model's events of the unit, in cycle order.
   void model_event(const BoundaryEvent& e) {
     if (o_.model_events) o_.model_events(e);
     if (e.cycle > cur_) advance_to(e.cycle);
@@ -149,52 +128,16 @@ class Lockstep {
 
   // One RTL cycle: the model's inputs of cycle cur_ in, the RTL's outputs out.
   void step() {
-    ListInputs in;
-    int clears = 0;
-    std::vector<BoundaryEvent> outputs;
+    std::vector<BoundaryEvent> inputs, outputs;
     for (const BoundaryEvent& e : pending_) {
-      if (e.port != BoundaryPort::kCacheRequest && e.port != BoundaryPort::kOutput)
-        ++events_[static_cast<std::size_t>(e.port)];  // driven (the outputs count when compared)
-      switch (e.port) {
-        case BoundaryPort::kInput: {
-          const auto i = static_cast<std::size_t>(input_path(e.path));
-          if (in.valid[i])
-            throw std::logic_error(std::string("lockstep: two threads in one cycle from ") +
-                                   path_name(static_cast<int>(i)));
-          in.valid[i] = true;
-          in.thread[i] = e.thread;
-          in.start[i] = e.field[0] != 0;
-          in.level[i] = e.field[1] != 0;
-          in.next[i] = static_cast<std::uint32_t>(e.field[2]);
-          in.end[i] = static_cast<std::uint32_t>(e.field[3]);
-          in.mask[i] = e.field[4];
-          remember(model_hist_, e);
-          remember(rtl_hist_, e);
-          break;
-        }
-        case BoundaryPort::kSideBand:
-          if (clears == 2) throw std::logic_error("lockstep: three packet starts in one cycle");
-          in.clear[static_cast<std::size_t>(clears)] = true;
-          in.clear_thread[static_cast<std::size_t>(clears++)] = e.thread;
-          remember(model_hist_, e);
-          remember(rtl_hist_, e);
-          break;
-        case BoundaryPort::kCacheBlocked:
-          in.req_ready = false;
-          break;
-        case BoundaryPort::kCacheResponse:
-          in.resp = true;
-          in.resp_thread = e.thread;
-          in.resp_word = static_cast<std::uint32_t>(e.field[1]);
-          remember(model_hist_, e);
-          remember(rtl_hist_, e);
-          break;
-        case BoundaryPort::kCacheRequest:
-        case BoundaryPort::kOutput:
-          outputs.push_back(e);
-          remember(model_hist_, e);
-          break;
+      remember(model_hist_, e);
+      if (e.port == BoundaryPort::kCacheRequest || e.port == BoundaryPort::kOutput) {
+        outputs.push_back(e);
+        continue;
       }
+      ++events_[static_cast<std::size_t>(e.port)];  // driven (the outputs count when compared)
+      inputs.push_back(e);
+      if (e.port != BoundaryPort::kCacheBlocked) remember(rtl_hist_, e);
     }
     // A cycle's outputs in port order (the model's come in the order its modules ran).
     std::stable_sort(
@@ -202,39 +145,15 @@ class Lockstep {
         [](const BoundaryEvent& a, const BoundaryEvent& b) { return a.port < b.port; });
     model_out_.insert(model_out_.end(), outputs.begin(), outputs.end());
     if (o_.write_wave && cur_ == o_.wave_from) rtl_.start_trace(o_.wave);
+    outputs.clear();
     const auto t0 = Clock::now();
-    const ListOutputs out = rtl_.cycle(in);
+    rtl_.cycle(cur_, inputs, outputs);
     rtl_seconds_ += std::chrono::duration<double>(Clock::now() - t0).count();
     if (o_.write_wave && cur_ == o_.wave_to) rtl_.stop_trace();
-    if (out.req) {
-      BoundaryEvent e = rtl_event(BoundaryPort::kCacheRequest, out.req_thread);
-      e.fields = 3;
-      e.names = units::kCacheRequestFields;
-      e.field[0] = out.req_item;
-      e.field[1] = static_cast<std::uint64_t>(units::unit_index(UnitId::kList));
-      e.field[2] = out.req_thread;
+    for (const BoundaryEvent& e : outputs) {
       rtl_out_.push_back(e);
       remember(rtl_hist_, e);
     }
-    if (out.out) {
-      BoundaryEvent e = rtl_event(BoundaryPort::kOutput, out.out_thread);
-      constexpr UnitId kTo[] = {UnitId::kTransformation, UnitId::kList, UnitId::kTraversal};
-      e.path = kTo[std::min<std::uint32_t>(out.kind, 2)];
-      e.fields = 5;
-      e.names = units::kListOutputFields;
-      e.field = {out.kind, out.level, out.next, out.entry, out.mask};
-      rtl_out_.push_back(e);
-      remember(rtl_hist_, e);
-    }
-  }
-
-  BoundaryEvent rtl_event(BoundaryPort port, std::uint32_t thread) const {
-    BoundaryEvent e;
-    e.cycle = cur_;
-    e.unit = UnitId::kList;
-    e.port = port;
-    e.thread = thread;
-    return e;
   }
 
   static void remember(std::deque<BoundaryEvent>& h, const BoundaryEvent& e) {
@@ -287,7 +206,7 @@ class Lockstep {
                             std::uint64_t other) {
     const BoundaryEvent& e = model != nullptr ? *model : *rtl;
     div_.cycle = e.cycle;
-    div_.unit = "list";
+    div_.unit = units::unit_name(rtl_.unit());
     div_.port = units::boundary_port_name(e.port);
     div_.kind = kind;
     div_.other_cycle = other;
@@ -310,8 +229,8 @@ class Lockstep {
       div_.rtl_value = rtl != nullptr ? 1 : 0;
     }
     std::ostringstream s;
-    s << "saarcor-rtl lockstep: DIVERGENCE at cycle " << div_.cycle << ", dynrtp0 list unit, port "
-      << div_.port << ", field " << div_.field << "\n";
+    s << "saarcor-rtl lockstep: DIVERGENCE at cycle " << div_.cycle << ", dynrtp0 " << div_.unit
+      << " unit, port " << div_.port << ", field " << div_.field << "\n";
     s << "  class: " << kind;
     if (div_.kind == "timing")
       s << " (" << (model != nullptr ? "the RTL has it at cycle " : "the model has it at cycle ")
@@ -327,17 +246,18 @@ class Lockstep {
     throw Stop{};
   }
 
-  static void history(std::ostringstream& s, const char* side, const std::deque<BoundaryEvent>& h,
-                      std::uint64_t cycle) {
+  void history(std::ostringstream& s, const char* side, const std::deque<BoundaryEvent>& h,
+               std::uint64_t cycle) const {
     std::vector<const BoundaryEvent*> last;
     for (auto it = h.rbegin(); it != h.rend() && last.size() < 16; ++it)
       if (it->cycle <= cycle) last.push_back(&*it);
-    s << "  the last " << last.size() << " events of the list unit, " << side << ":\n";
+    s << "  the last " << last.size() << " events of the " << units::unit_name(rtl_.unit())
+      << " unit, " << side << ":\n";
     for (auto it = last.rbegin(); it != last.rend(); ++it)
       s << "    " << units::format_boundary(**it) << "\n";
   }
 
-  ListRtl& rtl_;
+  UnitRtl& rtl_;
   const LockstepOptions& o_;
   std::uint64_t cur_ = 0;  // the RTL's next cycle
   std::vector<BoundaryEvent> pending_;
@@ -442,7 +362,7 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   shading.secondary = o.depth > 0;
   shading.max_depth = o.depth > 0 ? o.depth : -1;
 
-  const std::unique_ptr<ListRtl> rtl = make_list_rtl(build);
+  const std::unique_ptr<UnitRtl> rtl = make_list_unit_rtl(build);
   Lockstep ls(*rtl, o);
   const auto t1 = Clock::now();
   try {
