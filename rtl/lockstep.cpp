@@ -99,6 +99,7 @@ class Lockstep {
 
   // The model finished at cycle `end`: the RTL runs the window on and everything is compared.
   void finish(std::uint64_t end) {
+    model_cycles_ = end;
     advance_to(std::max(end, cur_) + static_cast<std::uint64_t>(o_.window) + 1);
     compare(hw::kNever);
     if (o_.write_wave) rtl_.stop_trace();
@@ -110,6 +111,7 @@ class Lockstep {
   const std::array<std::uint64_t, 6>& events() const { return events_; }
   std::uint64_t cycles() const { return cur_; }
   double rtl_seconds() const { return rtl_seconds_; }
+  std::uint64_t model_cycles() const { return model_cycles_; }
 
  private:
   void advance_to(std::uint64_t c) {
@@ -265,6 +267,7 @@ class Lockstep {
   std::deque<BoundaryEvent> model_hist_, rtl_hist_;
   std::array<std::uint64_t, 6> events_{};
   double rtl_seconds_ = 0;
+  std::uint64_t model_cycles_ = 0;
   bool diverged_ = false;
   Divergence div_;
   std::string screen_;
@@ -295,7 +298,7 @@ const ListBuild& choose_build(const units::CycleParams& p, const std::string& fa
 
 template <class F, int kLanes>
 void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
-               const units::FunctionalParams& shading, Lockstep& ls) {
+               const units::FunctionalParams& shading, Lockstep* ls) {
   memif::MemoryImage image = image_in;
   LockstepThreads<F, kLanes> threads(image, units::functional_params(p, shading), p.threads);
   hw::KernelConfig kc;
@@ -309,8 +312,8 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
         return threads.state(t);
       });
   units::BoundaryRecorder rec(threads, p.threads, {UnitId::kList}, payload,
-                              [&](const BoundaryEvent& e) { ls.model_event(e); });
-  d.observe(&rec);
+                              [&](const BoundaryEvent& e) { ls->model_event(e); });
+  if (ls != nullptr) d.observe(&rec);  // (none: the model alone, for the speed beside it)
   const auto done = [&] {
     return rgc.all_handed_out() && d.rgs().idle() && mi.frame_writes_stored();
   };
@@ -318,7 +321,16 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   if (r.status == hw::RunResult::Status::kWatchdog)
     throw std::runtime_error("lockstep: the cycle model's watchdog fired at cycle " +
                              std::to_string(r.cycles));
-  ls.finish(k.now());
+  if (ls != nullptr) ls->finish(k.now());
+}
+
+// The cycle model alone on the same thread table (a program per thread), for its speed.
+template <class F, int kLanes>
+double model_alone(const memif::MemoryImage& image, const units::CycleParams& p,
+                   const units::FunctionalParams& shading) {
+  const auto t0 = Clock::now();
+  run_model<F, kLanes>(image, p, shading, nullptr);
+  return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
 }  // namespace
@@ -368,9 +380,9 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   try {
     using Fp24 = ff::Float<7, 16>;
     if (p.packet <= 4)
-      run_model<Fp24, 4>(built.image, p, shading, ls);
+      run_model<Fp24, 4>(built.image, p, shading, &ls);
     else
-      run_model<Fp24, units::kMaxPacket>(built.image, p, shading, ls);
+      run_model<Fp24, units::kMaxPacket>(built.image, p, shading, &ls);
   } catch (const Stop&) {
   }
   LockstepResult res;
@@ -382,6 +394,13 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   res.events = ls.events();
   res.cycles = ls.cycles();
   res.rtl_seconds = ls.rtl_seconds();
+  res.model_cycles = ls.model_cycles();
+  if (o.bench && !res.diverged) {
+    using Fp24 = ff::Float<7, 16>;
+    res.model_seconds = p.packet <= 4
+                            ? model_alone<Fp24, 4>(built.image, p, shading)
+                            : model_alone<Fp24, units::kMaxPacket>(built.image, p, shading);
+  }
   return res;
 }
 

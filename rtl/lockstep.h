@@ -36,6 +36,7 @@ struct LockstepOptions {
   // The RTL waveform of cycles [wave_from, wave_to] into `wave` (set by the replay).
   std::uint64_t wave_from = 0, wave_to = 0;
   bool write_wave = false;
+  bool bench = false;  // also run the cycle model alone and time it (the speed beside the RTL's)
   // Tests: every event of the model's list unit, as it is recorded.
   std::function<void(const units::BoundaryEvent&)> model_events;
 };
@@ -55,8 +56,10 @@ struct LockstepResult {
   // Per port of the list unit (units::BoundaryPort): events driven into the RTL (inputs) or
   // compared (outputs).
   std::array<std::uint64_t, 6> events{};
-  std::uint64_t cycles = 0;
+  std::uint64_t cycles = 0;        // RTL cycles (the model's and the window after them)
+  std::uint64_t model_cycles = 0;  // the frame's cycles in the model
   double rtl_seconds = 0, seconds = 0;
+  double model_seconds = 0;  // with LockstepOptions::bench: the model alone, the same frame
 };
 
 // Runs the co-simulation. Throws std::runtime_error (one line) for bad input: an unknown unit, a
