@@ -374,7 +374,8 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   shading.secondary = o.depth > 0;
   shading.max_depth = o.depth > 0 ? o.depth : -1;
 
-  const std::unique_ptr<UnitRtl> rtl = make_list_unit_rtl(build);
+  std::unique_ptr<UnitRtl> rtl = make_list_unit_rtl(build);
+  if (o.wrap_rtl) rtl = o.wrap_rtl(std::move(rtl));
   Lockstep ls(*rtl, o);
   const auto t1 = Clock::now();
   try {

@@ -15,9 +15,11 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "rtl/unit_rtl.h"
 #include "units/boundary.h"
 
 namespace saarcor::rtl {
@@ -39,6 +41,8 @@ struct LockstepOptions {
   bool bench = false;  // also run the cycle model alone and time it (the speed beside the RTL's)
   // Tests: every event of the model's list unit, as it is recorded.
   std::function<void(const units::BoundaryEvent&)> model_events;
+  // Tests: wraps the Verilated unit (a fault between its ports and the comparison).
+  std::function<std::unique_ptr<UnitRtl>(std::unique_ptr<UnitRtl>)> wrap_rtl;
 };
 
 struct Divergence {

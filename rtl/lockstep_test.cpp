@@ -114,6 +114,88 @@ TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
   EXPECT_EQ(replay.divergence.field, r.divergence.field);
 }
 
+// The classification, each class provoked between the RTL's ports and the comparison: an output
+// one cycle late (timing), an output lost (missing), an output invented (extra), two threads'
+// outputs swapped (order).
+class Tampered final : public UnitRtl {
+ public:
+  enum class Fault { kLate, kLost, kInvented, kSwapped };
+  // `first`: where the cycle of the event tampered with goes (the wrapper dies with the run).
+  Tampered(std::unique_ptr<UnitRtl> rtl, Fault f, std::uint64_t from, std::uint64_t& first)
+      : first_(first), rtl_(std::move(rtl)), f_(f), from_(from) {}
+  units::UnitId unit() const override { return rtl_->unit(); }
+  void reset() override { rtl_->reset(); }
+  void start_trace(const std::string& p) override { rtl_->start_trace(p); }
+  void stop_trace() override { rtl_->stop_trace(); }
+  void cycle(std::uint64_t c, const std::vector<BoundaryEvent>& in,
+             std::vector<BoundaryEvent>& out) override {
+    std::vector<BoundaryEvent> got;
+    rtl_->cycle(c, in, got);
+    for (BoundaryEvent& e : held_) {
+      e.cycle = c;
+      out.push_back(e);
+    }
+    held_.clear();
+    for (BoundaryEvent& e : got) {
+      const bool hit = !done_ && c >= from_ && e.port == BoundaryPort::kOutput;
+      if (hit) done_ = true;
+      if (hit && f_ == Fault::kLate) {
+        held_.push_back(e);
+      } else if (hit && f_ == Fault::kLost) {
+      } else if (hit && f_ == Fault::kInvented) {
+        out.push_back(e);
+        BoundaryEvent x = e;
+        x.port = BoundaryPort::kCacheRequest;
+        x.fields = 3;
+        x.names = units::kCacheRequestFields;
+        x.field = {0xdead, 3, e.thread};
+        out.insert(out.end() - 1, x);
+      } else if (hit && f_ == Fault::kSwapped) {
+        e.thread ^= 1;
+        out.push_back(e);
+      } else {
+        out.push_back(e);
+      }
+      if (hit) first_ = c;
+    }
+  }
+  std::uint64_t& first_;
+
+ private:
+  std::unique_ptr<UnitRtl> rtl_;
+  Fault f_;
+  std::uint64_t from_;
+  bool done_ = false;
+  std::vector<BoundaryEvent> held_;
+};
+
+TEST(ListLockstep, DivergencesAreClassified) {
+  const std::pair<Tampered::Fault, const char*> cases[] = {{Tampered::Fault::kLate, "timing"},
+                                                           {Tampered::Fault::kLost, "missing"},
+                                                           {Tampered::Fault::kInvented, "extra"},
+                                                           {Tampered::Fault::kSwapped, "order"}};
+  for (const auto& [fault, kind] : cases) {
+    SCOPED_TRACE(kind);
+    LockstepOptions o;
+    o.scene = "builtin:room";
+    o.width = 16;
+    o.height = 12;
+    std::uint64_t first = 0;
+    o.wrap_rtl = [&](std::unique_ptr<UnitRtl> rtl) {
+      return std::unique_ptr<UnitRtl>(
+          std::make_unique<Tampered>(std::move(rtl), fault, 500, first));
+    };
+    const LockstepResult r = run_lockstep(o);
+    ASSERT_TRUE(r.diverged);
+    ASSERT_NE(first, 0u);
+    EXPECT_EQ(r.divergence.kind, kind) << r.screen;
+    EXPECT_EQ(r.divergence.cycle, first) << r.screen;
+    if (fault == Tampered::Fault::kLate) {
+      EXPECT_EQ(r.divergence.other_cycle, first + 1);
+    }
+  }
+}
+
 TEST(ListLockstep, BadInputIsRefusedWithOneLine) {
   LockstepOptions o;
   o.scene = "builtin:room";
