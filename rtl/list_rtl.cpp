@@ -240,7 +240,7 @@ class ListUnitRtl final : public UnitRtl {
 const std::vector<ListBuild>& list_builds() {
   static const std::vector<ListBuild> b = {
 #define SAARCOR_LIST_BUILD(id, cls, threads, packet, mb, tmb, depth, fault) \
-  {#id, threads, packet, mb, tmb, depth, fault != 0},
+  {#id, threads, packet, mb, tmb, depth, fault},
       SAARCOR_LIST_BUILDS(SAARCOR_LIST_BUILD)
 #undef SAARCOR_LIST_BUILD
   };

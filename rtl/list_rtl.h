@@ -17,7 +17,7 @@ namespace saarcor::rtl {
 struct ListBuild {
   std::string name;
   int threads = 0, packet = 0, mailbox = 0, triangle_mailbox = 0, depth = 0;
-  bool fault_mailbox_never_hits = false;  // the injected fault (tests only)
+  int fault = 0;  // the injected fault (tests only): 1 mailbox never hits, 2 priorities swapped
 };
 const std::vector<ListBuild>& list_builds();
 

@@ -20,6 +20,7 @@ module list_unit #(
     parameter int TMB     = 8,
     parameter int DEPTH   = 1,
     parameter bit FAULT_MAILBOX_NEVER_HITS = 1'b0,
+    parameter bit FAULT_PRIORITY_SWAP = 1'b0,  // the loop and the intersection path swapped
     parameter int TW      = THREADS > 1 ? $clog2(THREADS) : 1
 ) (
     input  logic                 clk,
@@ -81,7 +82,8 @@ module list_unit #(
   logic [TW-1:0] acc_thread, iss_thread;
   logic [PW-1:0] iss_payload, out_payload;
   unit_threads #(
-      .THREADS(THREADS), .INPUTS(3), .DEPTH(DEPTH), .PW(PW), .IW(32), .CW(1), .SW(1)
+      .THREADS(THREADS), .INPUTS(3), .DEPTH(DEPTH), .PW(PW), .IW(32), .CW(1), .SW(1),
+      .FAULT_PRIORITY_SWAP(FAULT_PRIORITY_SWAP)
   ) threads (
       .clk, .rst, .in_valid, .in_thread,
       .acc_valid, .acc_thread,

@@ -27,7 +27,7 @@ TEST(ListBuilds, PrototypeBuildIsTheModelsDefaults) {
   EXPECT_EQ(b.mailbox, p.mailbox);
   EXPECT_EQ(b.triangle_mailbox, p.triangle_mailbox);
   EXPECT_EQ(b.depth, p.list_depth());
-  EXPECT_FALSE(b.fault_mailbox_never_hits);
+  EXPECT_EQ(b.fault, 0);
 }
 
 // ---- the RTL alone, mock neighbours ------------------------------------------------------------

@@ -274,16 +274,21 @@ class Lockstep {
 };
 
 const ListBuild& choose_build(const units::CycleParams& p, const std::string& fault) {
-  const bool faulty = fault == "mailbox-never-hits";
-  if (!fault.empty() && !faulty)
-    throw std::runtime_error("lockstep: unknown fault '" + fault + "' (known: mailbox-never-hits)");
+  int faulty = 0;  // ListBuild::fault
+  if (fault == "mailbox-never-hits")
+    faulty = 1;
+  else if (fault == "priorities-swapped")
+    faulty = 2;
+  else if (!fault.empty())
+    throw std::runtime_error("lockstep: unknown fault '" + fault +
+                             "' (known: mailbox-never-hits, priorities-swapped)");
   std::string built;
   for (const ListBuild& b : list_builds()) {
-    if (b.fault_mailbox_never_hits == faulty && b.threads == p.threads && b.packet == p.packet &&
+    if (b.fault == faulty && b.threads == p.threads && b.packet == p.packet &&
         b.mailbox == p.mailbox && b.triangle_mailbox == p.triangle_mailbox &&
         b.depth == p.list_depth())
       return b;
-    if (b.fault_mailbox_never_hits == faulty)
+    if (b.fault == faulty)
       built += " [threads=" + std::to_string(b.threads) + " packet=" + std::to_string(b.packet) +
                " mailbox=" + std::to_string(b.mailbox) +
                " triangle_mailbox=" + std::to_string(b.triangle_mailbox) +

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -112,6 +114,47 @@ TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
   EXPECT_TRUE(replay.diverged);
   EXPECT_EQ(replay.divergence.cycle, first);
   EXPECT_EQ(replay.divergence.field, r.divergence.field);
+}
+
+// The injected fault "the loop's and the intersection path's priorities swapped"
+// (unit_threads.sv FAULT_PRIORITY_SWAP) is caught at the first accept where both held a thread:
+// the model's cache request for the loop's thread, the RTL's for the other (class order).
+TEST(ListLockstep, SwappedPrioritiesAreCaughtAtTheirFirstWrongEvent) {
+  LockstepOptions o;
+  o.scene = "builtin:dynamic";
+  o.width = 24;
+  o.height = 18;
+  o.shadows = true;
+  std::array<std::deque<std::pair<std::uint32_t, std::uint64_t>>, 3> path;  // thread, push cycle
+  std::uint64_t first = 0;
+  o.model_events = [&](const BoundaryEvent& e) {
+    if (e.port == BoundaryPort::kInput) {
+      const std::size_t p = e.path == units::UnitId::kList           ? 0
+                            : e.path == units::UnitId::kIntersection ? 1
+                                                                     : 2;
+      path[p].emplace_back(e.thread, e.cycle);
+    }
+    if (e.port != BoundaryPort::kCacheRequest) return;
+    for (std::size_t p = 0; p < 3; ++p)
+      for (auto it = path[p].begin(); it != path[p].end(); ++it)
+        if (it->first == e.thread) {
+          path[p].erase(it);
+          if (p == 0 && first == 0 && !path[1].empty() && path[1].front().second < e.cycle)
+            first = e.cycle;
+          return;
+        }
+  };
+  const LockstepResult healthy = run_lockstep(o);
+  ASSERT_FALSE(healthy.diverged) << healthy.screen;
+  ASSERT_NE(first, 0u) << "the loop and the intersection path never held threads together";
+
+  o.model_events = nullptr;
+  o.fault = "priorities-swapped";
+  const LockstepResult r = run_lockstep(o);
+  ASSERT_TRUE(r.diverged);
+  EXPECT_EQ(r.divergence.cycle, first) << r.screen;
+  EXPECT_EQ(r.divergence.port, "cache_request");
+  EXPECT_EQ(r.divergence.kind, "order");
 }
 
 // The classification, each class provoked between the RTL's ports and the comparison: an output
