@@ -36,21 +36,11 @@
 
 #include "hw/kernel.h"
 #include "hw/ring.h"
+#include "memif/config.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
 namespace saarcor::memif {
-
-struct CacheConfig {
-  int items = 512;       // lines (DESIGN.md section 6)
-  int ways = 1;          // associativity; items must be a multiple
-  int hit_latency = 2;   // cycles from the unit's push to the response being poppable (>= 2)
-  int max_misses = 8;    // outstanding misses (D20)
-  int max_targets = 16;  // requests waiting on one miss (the first included)
-  int ports = 1;         // request/response channel pairs (one per requesting unit)
-  int request_capacity = 4;
-  int memory_capacity = 2;  // capacity of the memory request and fill channels
-};
 
 class Cache : public hw::Module {
  public:

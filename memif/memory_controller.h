@@ -34,22 +34,11 @@
 #include "hw/cycle_marks.h"
 #include "hw/kernel.h"
 #include "hw/ring.h"
+#include "memif/config.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
 namespace saarcor::memif {
-
-struct MemoryControllerConfig {
-  int queue_depth = 8;     // per-bank request queue (D23)
-  int latency = 4;         // cycles from a word's read slot to its data (D21: SRAM + pads)
-  int switch_penalty = 1;  // cycles lost when a shared path starts another bank (D21)
-  int max_burst = 8;       // consecutive starts on the open bank while other banks wait
-  bool reorder = true;     // prefer the open bank (D23); false: oldest request first
-  // Issue path of each bank; banks with the same number share one issue stage.
-  std::vector<int> bank_path = {0, 1, 2, 3, 3, 3};
-  int port_capacity = 4;     // request and response channel capacity per port
-  double clock_hz = 90.0e6;  // modelled clock, for MB/s (D39)
-};
 
 class MemoryController : public hw::Module {
  public:
