@@ -114,6 +114,12 @@ class Cache : public hw::Module {
   int accept_fill();           // a returning fill is written into its line
   int deliver();               // one waiting request of a filled miss, if any
   int lookup(bool port_free);  // the next request: hit, merge or miss
+  // The lookup's steps (each returns 1 when the request was served, 0 when it must wait).
+  int next_request_port() const;
+  int hit(const CacheRequest& req, int port, std::size_t line, bool port_free);
+  int merge(const CacheRequest& req, int port, std::size_t line);
+  int miss(const CacheRequest& req, int port, std::size_t first);
+  std::size_t allocate(std::size_t first, std::uint32_t item, int mshr);
 
   // What every evaluation reads first, together.
   hw::Channel<CacheRequest>* request0_;  // port 0's request channel
