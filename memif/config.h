@@ -1,4 +1,4 @@
-// The memory interface's parameters and their defaults (docs/memif.md "Knobs"; DIGEST D20-D23,
+// The memory interface's parameters and their defaults (docs/memif.md "Knobs"; decisions D20-D23,
 // D39, D40, D44), apart from the modules they configure so that a parameter table can take its
 // defaults from here without the modules' headers: each default is declared once, here, and the
 // cycle model's configuration keys (units/cycle_params.h) start from these values.
@@ -14,7 +14,7 @@ inline constexpr double kDefaultClockHz = 90.0e6;
 
 // A per-type item cache (memif/cache.h).
 struct CacheConfig {
-  int items = 512;       // lines (DESIGN.md section 6)
+  int items = 512;       // lines (docs/memif.md)
   int ways = 1;          // associativity; items must be a multiple
   int hit_latency = 2;   // cycles from the unit's push to the response being poppable (>= 2)
   int max_misses = 8;    // outstanding misses (D20)

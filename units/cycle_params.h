@@ -1,10 +1,10 @@
-// The cycle model's parameters (DESIGN.md sections 5, 6 and 10; DIGEST D7, D20-D33): one
-// parameter table (hw/param_table.h) declares every key once with its type, unit, range and help,
-// bound to a field of CycleParams, whose default member initialiser is the key's default: the
-// paper's prototype (one DynRTP, 64 threads of 4-ray packets, 512-item direct-mapped caches,
-// 90 MHz). The memory interface's keys start from memif's own defaults (memif/config.h) and the
-// watchdog from the kernel's, so neither is declared twice. Presets are data (named sets of
-// overrides); `--set KEY=VALUE` goes through the same table.
+// The cycle model's parameters (docs/cycle-model.md, docs/memif.md and docs/fidelity.md; decisions
+// D7, D20-D33): one parameter table (hw/param_table.h) declares every key once with its type,
+// unit, range and help, bound to a field of CycleParams, whose default member initialiser is the
+// key's default: the paper's prototype (one DynRTP, 64 threads of 4-ray packets, 512-item
+// direct-mapped caches, 90 MHz). The memory interface's keys start from memif's own defaults
+// (memif/config.h) and the watchdog from the kernel's, so neither is declared twice. Presets are
+// data (named sets of overrides); `--set KEY=VALUE` goes through the same table.
 #pragma once
 
 #include <cstdint>
