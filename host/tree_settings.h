@@ -1,23 +1,20 @@
 // The kd-tree builder's parameters as configuration keys (`--set kd.KEY=VALUE`): the trees are the
 // hardware's input, so an architect sweeps tree construction against the units like any other
-// parameter (docs/kdtree.md "Configuration keys"). Same shape as the cycle model's table: every
-// key declared once with its default, unit, help and range.
+// parameter (docs/kdtree.md "Configuration keys"). One parameter table (hw/param_table.h), as the
+// cycle model's: every key declared once with its type, unit, range and help, bound to a field of
+// ImageParams, whose default member initialiser is the key's default.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "host/image_builder.h"
+#include "hw/param_table.h"
 
 namespace saarcor::host {
 
-struct TreeSettingInfo {
-  std::string name;  // "kd.max_depth"
-  double value;      // the default (tree_setting_table) or the current value (describe)
-  std::string unit;
-  std::string help;
-  double min, max;
-};
+// A key as declared (hw::ParamInfo: name, value, unit, help, range, type).
+using TreeSettingInfo = hw::ParamInfo;
 
 // Every tree key with its default (ImageParams{}'s values).
 std::vector<TreeSettingInfo> tree_setting_table();

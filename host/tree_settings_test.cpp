@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -79,7 +82,8 @@ TEST(TreeSettings, BadValuesAreOneLineErrors) {
   EXPECT_EQ(error_of(p, "kd.max_depth=2.5"), "bad --set kd.max_depth=2.5: expected an integer");
   EXPECT_EQ(error_of(p, "kd.max_depth=-2"), "bad --set kd.max_depth=-2: expected -1..1000 levels");
   EXPECT_EQ(error_of(p, "kd.stack=1"), "bad --set kd.stack=1: expected 2..4096 entries");
-  EXPECT_EQ(error_of(p, "kd.empty_chains=3"), "bad --set kd.empty_chains=3: expected 0..2 rule");
+  EXPECT_EQ(error_of(p, "kd.empty_chains=3"),
+            "bad --set kd.empty_chains=3: expected 0, 1 or 2 rule");
   EXPECT_EQ(error_of(p, "image.camera=-2"),
             "bad --set image.camera=-2: expected -1..1000000 index");
   EXPECT_EQ(error_of(p, "kd.traversal_cost=nan"), "bad --set kd.traversal_cost=nan: not a number");
@@ -88,6 +92,37 @@ TEST(TreeSettings, BadValuesAreOneLineErrors) {
       error_of(p, "kd.leaves=3").rfind("unknown --set key 'kd.leaves' (known kd-tree keys: ", 0),
       0u);
   EXPECT_EQ(p.kd.max_depth, KdBuildParams::kAutoDepth);  // nothing half-applied
+}
+
+// Each key's declared type: the costs and factors are real, the rules choices, the switches bool.
+TEST(TreeSettings, EachKeyHasItsDeclaredType) {
+  for (const TreeSettingInfo& t : tree_setting_table()) {
+    const bool real = t.name.find("cost") != std::string::npos || t.name == "kd.empty_bonus" ||
+                      t.name == "kd.nodes_per_item" || t.name == "kd.objective_ratio";
+    EXPECT_EQ(t.type == hw::ParamType::kReal, real) << t.name;
+    EXPECT_EQ(t.type == hw::ParamType::kBoolean, t.unit == "bool") << t.name;
+  }
+  ImageParams p;
+  EXPECT_EQ(error_of(p, "kd.objective=2"), "bad --set kd.objective=2: expected 0 or 1 enum");
+  EXPECT_EQ(error_of(p, "kd.face_slabs=2"), "bad --set kd.face_slabs=2: expected 0 or 1");
+  EXPECT_EQ(error_of(p, "kd.nodes_per_item=2.5"), "");
+  EXPECT_EQ(p.kd.max_nodes_per_item, 2.5f);
+}
+
+// README names every key with its default: "`kd.KEY` (DEFAULT".
+TEST(TreeSettings, ReadmeGivesEveryKeysDefault) {
+  std::ifstream f(std::string(SAARCOR_SOURCE_DIR) + "/README.md");
+  std::stringstream s;
+  s << f.rdbuf();
+  const std::string readme = s.str();
+  for (const TreeSettingInfo& t : tree_setting_table()) {
+    const std::string at = "`" + t.name + "` (";
+    const auto pos = readme.find(at);
+    ASSERT_NE(pos, std::string::npos) << t.name << " missing from README";
+    char* end = nullptr;
+    const double v = std::strtod(readme.c_str() + pos + at.size(), &end);
+    EXPECT_EQ(v, t.value) << t.name;
+  }
 }
 
 }  // namespace

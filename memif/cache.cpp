@@ -144,71 +144,80 @@ int Cache::deliver() {
   return 1;
 }
 
+// The lookup stage as a script: pick a request (round robin among ports), find its item in its
+// set, then hit, merge into the pending fill, or miss; an accepted request leaves its channel.
 int Cache::lookup(bool port_free) {
-  int port = 0;
-  hw::Channel<CacheRequest>* in = request0_;
-  if (!one_port_) {
-    const int ports = static_cast<int>(requests_.size());
-    port = -1;
-    for (int k = 0; k < ports; ++k) {
-      const int p = (next_port_ + k) % ports;
-      if (requests_[static_cast<std::size_t>(p)]->can_pop()) {
-        port = p;
-        break;
-      }
-    }
-    if (port < 0) return 0;
-    in = requests_[static_cast<std::size_t>(port)].get();
-  } else if (!in->can_pop()) {
-    return 0;
-  }
-  const CacheRequest& req = in->peek();
+  const int port = one_port_ ? (request0_->can_pop() ? 0 : -1) : next_request_port();
+  if (port < 0) return 0;
+  hw::Channel<CacheRequest>& in =
+      one_port_ ? *request0_ : *requests_[static_cast<std::size_t>(port)];
+  const CacheRequest& req = in.peek();
   const std::uint32_t index = req.index;
-  auto accepted = [&] {
-    if (accept_log_) accept_log_->push_back(index);
-    ++*requests_stat_;
-    if (!one_port_) next_port_ = port + 1 == static_cast<int>(requests_.size()) ? 0 : port + 1;
-    in->drop();  // last: `req` refers to the channel's slot
-  };
   const std::size_t set =
       set_mask_ != 0 || sets_ == 1 ? index & set_mask_ : index % static_cast<std::uint32_t>(sets_);
   const std::size_t first = set * static_cast<std::size_t>(ways_);
-  std::size_t li = first;
   const std::size_t end = first + static_cast<std::size_t>(ways_);
+  std::size_t li = first;
   while (li < end && (lines_[li].item != index || lines_[li].state == kEmpty))
     ++li;
-  if (li < end) {
-    Line& t = lines_[li];
-    if (t.state == kValid) {  // hit
-      hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(port)];
-      if (!port_free || !out.can_push()) {
-        stall();
-        return 0;
-      }
-      CacheResponse& r = out.push_slot();
-      r.index = index;
-      r.label = req.label;
-      r.words = t.words;
-      r.count = words_;
-      if (ways_ > 1) lru_[li] = ++use_clock_;
-      ++*hits_;
-      accepted();
-      return 1;
-    }
-    Mshr& m = mshrs_[static_cast<std::size_t>(t.state)];  // merge into the pending fill
-    if (static_cast<int>(m.targets.size()) >= config_.max_targets) {
-      stall();
-      return 0;
-    }
-    Mshr::Target& target = m.targets.push_slot();
-    target.label = req.label;
-    target.port = port;
-    if (ways_ > 1) lru_[li] = ++use_clock_;
-    ++*merges_;
-    accepted();
-    return 1;
+  int done;
+  if (li == end) {
+    done = miss(req, port, first);
+  } else if (lines_[li].state == kValid) {
+    done = hit(req, port, li, port_free);
+  } else {
+    done = merge(req, port, li);
   }
-  // Miss: needs a free MSHR (the lowest numbered) and room towards memory.
+  if (done == 0) {
+    stall();
+    return 0;
+  }
+  if (accept_log_) accept_log_->push_back(index);
+  ++*requests_stat_;
+  if (!one_port_) next_port_ = port + 1 == static_cast<int>(requests_.size()) ? 0 : port + 1;
+  in.drop();  // last: `req` refers to the channel's slot
+  return 1;
+}
+
+// The first port from next_port_ on with a request, or -1.
+int Cache::next_request_port() const {
+  const int ports = static_cast<int>(requests_.size());
+  for (int k = 0; k < ports; ++k) {
+    const int p = (next_port_ + k) % ports;
+    if (requests_[static_cast<std::size_t>(p)]->can_pop()) return p;
+  }
+  return -1;
+}
+
+// A present line answers through the port's response channel, if the port is free this cycle.
+int Cache::hit(const CacheRequest& req, int port, std::size_t li, bool port_free) {
+  hw::Channel<CacheResponse>& out = *responses_[static_cast<std::size_t>(port)];
+  if (!port_free || !out.can_push()) return 0;
+  CacheResponse& r = out.push_slot();
+  r.index = req.index;
+  r.label = req.label;
+  r.words = lines_[li].words;
+  r.count = words_;
+  if (ways_ > 1) lru_[li] = ++use_clock_;
+  ++*hits_;
+  return 1;
+}
+
+// A secondary miss waits with the MSHR whose fill is on its way (a full MSHR holds the cache).
+int Cache::merge(const CacheRequest& req, int port, std::size_t li) {
+  Mshr& m = mshrs_[static_cast<std::size_t>(lines_[li].state)];
+  if (static_cast<int>(m.targets.size()) >= config_.max_targets) return 0;
+  Mshr::Target& target = m.targets.push_slot();
+  target.label = req.label;
+  target.port = port;
+  if (ways_ > 1) lru_[li] = ++use_clock_;
+  ++*merges_;
+  return 1;
+}
+
+// A miss needs a free MSHR (the lowest numbered) and room towards memory; it allocates a victim
+// line of the set and sends one memory request for the item.
+int Cache::miss(const CacheRequest& req, int port, std::size_t first) {
   int id = -1;
   for (std::size_t w = 0; w < free_mshrs_.size(); ++w) {
     if (free_mshrs_[w] != 0) {
@@ -216,13 +225,38 @@ int Cache::lookup(bool port_free) {
       break;
     }
   }
-  if (id < 0 || !mem_requests_.can_push()) {
-    stall();
-    return 0;
-  }
-  // The victim: the first empty way, else the least recently used one (one way: that one).
+  if (id < 0 || !mem_requests_.can_push()) return 0;
+  const std::size_t victim = allocate(first, req.index, id);
+  Mshr& m = mshrs_[static_cast<std::size_t>(id)];
+  m.busy = true;
+  m.filled = false;
+  m.item = req.index;
+  m.line = static_cast<int>(victim);
+  m.targets.clear();
+  Mshr::Target& target = m.targets.push_slot();
+  target.label = req.label;
+  target.port = port;
+  free_mshrs_[static_cast<std::size_t>(id) / 64] &= ~(std::uint64_t{1} << (id % 64));
+  const WordLocation loc = image_.locate(type_, req.index, 0);
+  MemRequest& mr = mem_requests_.push_slot();  // the cache's own channel: written in place
+  mr.client = client_;
+  mr.tag = static_cast<std::uint32_t>(id);
+  mr.bank = static_cast<std::uint8_t>(loc.bank);
+  mr.words = static_cast<std::uint8_t>(words_);
+  mr.write = false;
+  mr.counted_bytes = 0;
+  mr.offset = loc.offset;
+  ++*misses_;
+  return 1;
+}
+
+// The victim of the set starting at `first`: the first empty way, else the least recently used
+// one (one way: that one). It now waits for MSHR `id`'s fill of `item`; a fill still on its way
+// into it is no longer kept.
+std::size_t Cache::allocate(std::size_t first, std::uint32_t item, int id) {
   std::size_t victim = first;
   if (ways_ > 1) {
+    const std::size_t end = first + static_cast<std::size_t>(ways_);
     for (std::size_t w = first; w < end; ++w) {
       if (lines_[w].state == kEmpty) {
         victim = w;
@@ -233,31 +267,10 @@ int Cache::lookup(bool port_free) {
     lru_[victim] = ++use_clock_;
   }
   Line& l = lines_[victim];
-  if (l.state >= 0) mshrs_[static_cast<std::size_t>(l.state)].line = -1;  // fill no longer kept
-  l.item = index;
+  if (l.state >= 0) mshrs_[static_cast<std::size_t>(l.state)].line = -1;
+  l.item = item;
   l.state = id;
-  Mshr& m = mshrs_[static_cast<std::size_t>(id)];
-  m.busy = true;
-  m.filled = false;
-  m.item = index;
-  m.line = static_cast<int>(victim);
-  m.targets.clear();
-  Mshr::Target& target = m.targets.push_slot();
-  target.label = req.label;
-  target.port = port;
-  free_mshrs_[static_cast<std::size_t>(id) / 64] &= ~(std::uint64_t{1} << (id % 64));
-  const WordLocation loc = image_.locate(type_, index, 0);
-  MemRequest& mr = mem_requests_.push_slot();  // the cache's own channel: written in place
-  mr.client = client_;
-  mr.tag = static_cast<std::uint32_t>(id);
-  mr.bank = static_cast<std::uint8_t>(loc.bank);
-  mr.words = static_cast<std::uint8_t>(words_);
-  mr.write = false;
-  mr.counted_bytes = 0;
-  mr.offset = loc.offset;
-  ++*misses_;
-  accepted();
-  return 1;
+  return victim;
 }
 
 int Cache::accept_fill() {

@@ -36,21 +36,11 @@
 
 #include "hw/kernel.h"
 #include "hw/ring.h"
+#include "memif/config.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
 namespace saarcor::memif {
-
-struct CacheConfig {
-  int items = 512;       // lines (docs/memif.md)
-  int ways = 1;          // associativity; items must be a multiple
-  int hit_latency = 2;   // cycles from the unit's push to the response being poppable (>= 2)
-  int max_misses = 8;    // outstanding misses (D20)
-  int max_targets = 16;  // requests waiting on one miss (the first included)
-  int ports = 1;         // request/response channel pairs (one per requesting unit)
-  int request_capacity = 4;
-  int memory_capacity = 2;  // capacity of the memory request and fill channels
-};
 
 class Cache : public hw::Module {
  public:
@@ -124,6 +114,12 @@ class Cache : public hw::Module {
   int accept_fill();           // a returning fill is written into its line
   int deliver();               // one waiting request of a filled miss, if any
   int lookup(bool port_free);  // the next request: hit, merge or miss
+  // The lookup's steps (each returns 1 when the request was served, 0 when it must wait).
+  int next_request_port() const;
+  int hit(const CacheRequest& req, int port, std::size_t line, bool port_free);
+  int merge(const CacheRequest& req, int port, std::size_t line);
+  int miss(const CacheRequest& req, int port, std::size_t first);
+  std::size_t allocate(std::size_t first, std::uint32_t item, int mshr);
 
   // What every evaluation reads first, together.
   hw::Channel<CacheRequest>* request0_;  // port 0's request channel

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "hw/kernel.h"
+#include "memif/config.h"
 #include "memif/memory_controller.h"
 
 namespace saarcor::memif {
@@ -39,12 +40,6 @@ struct HostUpload {
     return n;
   }
   std::uint64_t bytes() const { return sram_bytes() + 4ull * register_words; }
-};
-
-struct HostBusConfig {
-  double mb_per_s = 132.0;   // MB = 2^20 bytes (D39)
-  double clock_hz = 90.0e6;  // the modelled core clock
-  int burst_words = 4;       // 1..kMaxRequestWords
 };
 
 class HostBus : public hw::Module {

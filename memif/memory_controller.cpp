@@ -483,40 +483,7 @@ int MemoryController::issue() {
     Path& path = paths_[static_cast<std::size_t>(std::countr_zero(active))];
     const unsigned waiting = path.banks & queued_;
     if (waiting == 0 || path.free_at > now()) continue;
-    auto startable = [&](int b) {
-      const Bank& bank = banks_[static_cast<std::size_t>(b)];
-      return (queued_ >> b & 1u) != 0 && free_at_[static_cast<std::size_t>(b)] <= now() &&
-             static_cast<int>(bank.inflight.size()) < inflight_limit_;
-    };
-    auto older = [&](int b, int than) {
-      return than < 0 ||
-             oldest_[static_cast<std::size_t>(b)] < oldest_[static_cast<std::size_t>(than)];
-    };
-    int oldest_any = -1, oldest_startable = -1, others_waiting = 0;
-    for (unsigned bits = waiting; bits != 0; bits &= bits - 1) {
-      const int b = std::countr_zero(bits);
-      if (b != path.open) ++others_waiting;
-      if (older(b, oldest_any)) oldest_any = b;
-      if (startable(b) && older(b, oldest_startable)) oldest_startable = b;
-    }
-    int chosen = -1;
-    if (config_.reorder) {
-      // Stay on the open bank while it has work and the burst limit allows, waiting for it when
-      // it becomes free no later than a switch would let another bank start: such a switch
-      // would be needless. Otherwise switch to the free bank with the oldest request.
-      const bool open_wanted = path.open >= 0 && (queued_ >> path.open & 1u) != 0 &&
-                               (path.burst < config_.max_burst || others_waiting == 0);
-      if (open_wanted && startable(path.open)) {
-        chosen = path.open;
-      } else if (open_wanted && free_at_[static_cast<std::size_t>(path.open)] <=
-                                    now() + static_cast<std::uint64_t>(config_.switch_penalty)) {
-        chosen = -1;  // wait for the open bank
-      } else {
-        chosen = oldest_startable;
-      }
-    } else if (oldest_any >= 0 && startable(oldest_any)) {
-      chosen = oldest_any;
-    }
+    const int chosen = choose(path, waiting);
     if (chosen < 0) continue;
     std::uint64_t when = now();
     if (chosen != path.open) {
@@ -533,6 +500,39 @@ int MemoryController::issue() {
     ++started;
   }
   return started;
+}
+
+// The bank a path with queued banks `waiting` starts this cycle, or -1 (the bank reordering of
+// D23): with reorder, the open bank while it has work and the burst allows, else the free bank
+// with the oldest request; without, the path's oldest request when its bank is free.
+int MemoryController::choose(const Path& path, unsigned waiting) const {
+  auto startable = [&](int b) {
+    const Bank& bank = banks_[static_cast<std::size_t>(b)];
+    return (queued_ >> b & 1u) != 0 && free_at_[static_cast<std::size_t>(b)] <= now() &&
+           static_cast<int>(bank.inflight.size()) < inflight_limit_;
+  };
+  auto older = [&](int b, int than) {
+    return than < 0 ||
+           oldest_[static_cast<std::size_t>(b)] < oldest_[static_cast<std::size_t>(than)];
+  };
+  int oldest_any = -1, oldest_startable = -1, others_waiting = 0;
+  for (unsigned bits = waiting; bits != 0; bits &= bits - 1) {
+    const int b = std::countr_zero(bits);
+    if (b != path.open) ++others_waiting;
+    if (older(b, oldest_any)) oldest_any = b;
+    if (startable(b) && older(b, oldest_startable)) oldest_startable = b;
+  }
+  if (!config_.reorder) return oldest_any >= 0 && startable(oldest_any) ? oldest_any : -1;
+  // Stay on the open bank while it has work and the burst limit allows, waiting for it when it
+  // becomes free no later than a switch would let another bank start: such a switch would be
+  // needless. Otherwise switch to the free bank with the oldest request.
+  const bool open_wanted = path.open >= 0 && (queued_ >> path.open & 1u) != 0 &&
+                           (path.burst < config_.max_burst || others_waiting == 0);
+  if (open_wanted && startable(path.open)) return path.open;
+  if (open_wanted && free_at_[static_cast<std::size_t>(path.open)] <=
+                         now() + static_cast<std::uint64_t>(config_.switch_penalty))
+    return -1;  // wait for the open bank
+  return oldest_startable;
 }
 
 int MemoryController::accept_requests() {

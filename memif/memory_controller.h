@@ -34,22 +34,11 @@
 #include "hw/cycle_marks.h"
 #include "hw/kernel.h"
 #include "hw/ring.h"
+#include "memif/config.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 
 namespace saarcor::memif {
-
-struct MemoryControllerConfig {
-  int queue_depth = 8;     // per-bank request queue (D23)
-  int latency = 4;         // cycles from a word's read slot to its data (D21: SRAM + pads)
-  int switch_penalty = 1;  // cycles lost when a shared path starts another bank (D21)
-  int max_burst = 8;       // consecutive starts on the open bank while other banks wait
-  bool reorder = true;     // prefer the open bank (D23); false: oldest request first
-  // Issue path of each bank; banks with the same number share one issue stage.
-  std::vector<int> bank_path = {0, 1, 2, 3, 3, 3};
-  int port_capacity = 4;     // request and response channel capacity per port
-  double clock_hz = 90.0e6;  // modelled clock, for MB/s (D39)
-};
 
 class MemoryController : public hw::Module {
  public:
@@ -146,6 +135,7 @@ class MemoryController : public hw::Module {
   // The cycle, as a script.
   int retire_responses();
   int issue();
+  int choose(const Path& path, unsigned waiting) const;  // the bank a path starts, or -1
   int accept_requests();
   void start(int bank, std::uint64_t when);
 
@@ -264,6 +254,11 @@ class MemoryController::Lane {
   };
   std::vector<Steps> hist_;
   std::uint64_t hist_mask_ = 0;
+  // push_at's steps: the closed form's precondition, the request's statistics, the controller's
+  // busy and stall cycles.
+  bool usual(const MemRequest& r, std::uint64_t t) const;
+  void book(const MemRequest& r, std::uint64_t t, const Steps& s);
+  void mark(const Steps& s, std::uint64_t visible);
   // The first request taken in after the last push cycle (the port's request channel holds it
   // and those after it at the end of that cycle).
   std::uint64_t channel_front_ = 0;
@@ -301,6 +296,16 @@ inline bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
          cycle + mc_.lane_reach_ - mc_.lane_from_ < (mc_.lane_busy_.window() - 1) / 2;
 }
 
+// A request the closed form covers: the lane open, the request one of its kind into its bank and
+// within it, from a known client, pushed in cycle order, and (a read) with room among the
+// responses not yet taken.
+inline bool MemoryController::Lane::usual(const MemRequest& r, std::uint64_t t) const {
+  return state_ == State::kOpen && r.words >= 1 && r.words <= kMaxRequestWords && r.bank == bank_ &&
+         static_cast<std::uint64_t>(r.offset) + r.words <= bank_words_ &&
+         r.client < client_count_ && r.write != reads_ && t >= mc_.now() && t >= next_push_ &&
+         !(reads_ && pushed_ - popped_ > item_mask_);
+}
+
 // The request's cycles, from the stepped model's rules (memory_controller.h): visible at the
 // intake a cycle after its push, one intake per port and cycle, into a bank queue with room after
 // that cycle's start (the depth-th request before it has started); started a cycle after its
@@ -308,26 +313,40 @@ inline bool MemoryController::Lane::plannable(std::uint64_t cycle) const {
 // flight after that cycle's retire; a read retires at its due cycle (its port's response channel
 // always has room: the client takes each response the cycle it becomes visible).
 inline std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::uint64_t t) {
-  const std::uint64_t k = pushed_;
-  if (state_ != State::kOpen || r.words < 1 || r.words > kMaxRequestWords || r.bank != bank_ ||
-      static_cast<std::uint64_t>(r.offset) + r.words > bank_words_ || r.client >= client_count_ ||
-      r.write == reads_ || t < mc_.now() || t < next_push_ || (reads_ && k - popped_ > item_mask_))
-      [[unlikely]] {
+  if (!usual(r, t)) [[unlikely]] {
     return push_unusual(r, t);
   }
-  Steps* const hist = hist_.data();
+  const std::uint64_t k = pushed_;
   const std::uint64_t visible = std::max(t + 1, k == 0 ? 0 : last_accept_ + 1);
-  std::uint64_t accept = visible;
+  const Steps* const hist = hist_.data();
+  Steps s{visible, 0, 0};
   if (k >= depth_) {
-    accept = std::max(accept, hist[(k - depth_) & hist_mask_].start);
+    s.accept = std::max(s.accept, hist[(k - depth_) & hist_mask_].start);
   }
-  std::uint64_t start = std::max(accept + 1, bank_free_);
+  s.start = std::max(s.accept + 1, bank_free_);
   if (reads_ && k >= limit_) {
-    start = std::max(start, hist[(k - limit_) & hist_mask_].retire);
+    s.start = std::max(s.start, hist[(k - limit_) & hist_mask_].retire);
   }
-  const std::uint64_t retire = reads_ ? start + r.words - 1 + latency_ : 0;
+  s.retire = reads_ ? s.start + r.words - 1 + latency_ : 0;
+  book(r, t, s);
+  mark(s, visible);
+  next_push_ = t + 1;
+  last_accept_ = s.accept;
+  last_words_ = r.words;
+  bank_free_ = s.start + r.words;
+  ++pushed_;
+  return reads_ ? s.retire + 1 : 0;
+}
+
+// The statistics of every step of request pushed_, pushed in cycle t (the stepped model books
+// them in the cycles the request takes each step; the sums are the same, and nothing reads them
+// before the run ends: a lane runs only without time series and traces); a read's response
+// waits among the items, a write is stored.
+inline void MemoryController::Lane::book(const MemRequest& r, std::uint64_t t, const Steps& s) {
+  const std::uint64_t k = pushed_;
+  const Steps* const hist = hist_.data();
   // The bank queue after the intake: the requests from the first not started by then on.
-  while (queue_front_ < k && hist[queue_front_ & hist_mask_].start <= accept) {
+  while (queue_front_ < k && hist[queue_front_ & hist_mask_].start <= s.accept) {
     ++queue_front_;
   }
   // The port's request channel at the end of this cycle: this request and those taken in later.
@@ -338,45 +357,39 @@ inline std::uint64_t MemoryController::Lane::push_at(const MemRequest& r, std::u
     ++channel_front_;
   }
   const std::uint64_t occupancy = k - channel_front_ + 1;
-  hist[k & hist_mask_] = {accept, start, retire};
-  // The statistics of every step (the stepped model books them in the cycles the request takes
-  // each step; the sums are the same, and nothing reads them before the run ends: a lane runs
-  // only without time series and traces).
+  hist_[k & hist_mask_] = s;
   ++booked_.requests;
   booked_.push_cycles += t;
-  booked_.accept_cycles += accept;
+  booked_.accept_cycles += s.accept;
   booked_.words += r.words;
   booked_.most_in_channel = std::max(booked_.most_in_channel, occupancy);
   booked_.most_queued = std::max(booked_.most_queued, k - queue_front_ + 1);
   *mc_.clients_[r.client].bytes += r.counted_bytes ? r.counted_bytes : 4u * r.words;
   if (reads_) {
-    booked_.retire_cycles += retire;
+    booked_.retire_cycles += s.retire;
     Item& it = item(k);
-    it.retire = retire;
+    it.retire = s.retire;
     it.tag = r.tag;
   } else {
     // Stored at its start in the stepped model; nothing reads a lane's bank before then.
     std::copy_n(r.data.begin(), r.words, mc_.image_.bank(bank_).data() + r.offset);
   }
-  // The controller's cycles: progress at the intake, the start and the retire; a stall while the
-  // request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
-  if (std::max(start, retire) - mc_.lane_from_ >= mc_.lane_busy_.window()) [[unlikely]] {
-    book_beyond_window(std::max(start, retire));
+}
+
+// The controller's cycles: progress at the intake, the start and the retire; a stall while the
+// request is visible and its bank queue full. (Cycles beyond the window: book the past first.)
+inline void MemoryController::Lane::mark(const Steps& s, std::uint64_t visible) {
+  if (std::max(s.start, s.retire) - mc_.lane_from_ >= mc_.lane_busy_.window()) [[unlikely]] {
+    book_beyond_window(std::max(s.start, s.retire));
   }
-  mc_.lane_busy_.mark(accept);
-  mc_.lane_busy_.mark(start);
+  mc_.lane_busy_.mark(s.accept);
+  mc_.lane_busy_.mark(s.start);
   if (reads_) {
-    mc_.lane_busy_.mark(retire);
+    mc_.lane_busy_.mark(s.retire);
   }
-  if (accept > visible) {
-    mc_.mark_lane_stalls(visible, accept);
+  if (s.accept > visible) {
+    mc_.mark_lane_stalls(visible, s.accept);
   }
-  next_push_ = t + 1;
-  last_accept_ = accept;
-  last_words_ = r.words;
-  bank_free_ = start + r.words;
-  ++pushed_;
-  return reads_ ? retire + 1 : 0;
 }
 
 }  // namespace saarcor::memif

@@ -330,6 +330,61 @@ struct LaneRun {
   std::string stats;
 };
 
+using Script = std::vector<std::pair<std::uint64_t, MemRequest>>;
+
+// The three ports' requests: shading-like reads of bank 2, frame-like writes of bank 0 and other
+// reads of the shared banks, in bursts that fill the queues and gaps to skip.
+struct LaneScripts {
+  Script reads, writes, others;
+};
+LaneScripts lane_scripts(std::uint16_t cs, std::uint16_t cf, std::uint16_t co, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  auto script = [&](int n, auto make) {
+    Script s;
+    std::uint64_t at = 0;
+    for (int i = 0; i < n; ++i) {
+      at += rng() % 8 == 0 ? rng() % 60 : 0;  // bursts that fill the queues, gaps to skip
+      s.emplace_back(at, make(i));
+    }
+    return s;
+  };
+  LaneScripts out;
+  out.reads = script(300, [&](int i) {
+    return read(cs, static_cast<std::uint32_t>(i), 2, static_cast<std::uint32_t>(rng() % 4000),
+                1 + static_cast<int>(rng() % 4));
+  });
+  out.writes = script(200, [&](int i) {
+    MemRequest w = read(cf, 0, 0, static_cast<std::uint32_t>(i), 1);
+    w.write = true;
+    w.counted_bytes = 3;
+    w.data[0] = 0xABC000u + static_cast<std::uint32_t>(i);
+    return w;
+  });
+  out.others = script(150, [&](int i) {
+    return read(co, static_cast<std::uint32_t>(i), 3 + static_cast<int>(rng() % 3),
+                static_cast<std::uint32_t>(rng() % 4000), 1 + static_cast<int>(rng() % 3));
+  });
+  return out;
+}
+
+// The next due request of `list` into `port`, through its lane when it has one (the RGS's way
+// with its ports: one request per cycle when the port takes it).
+int push_due(std::uint64_t now, MemoryController::Port& port, const Script& list,
+             std::size_t& next) {
+  if (next >= list.size() || list[next].first > now) {
+    return 0;
+  }
+  if (!(port.lane != nullptr ? port.lane->can_push() : port.requests.can_push())) {
+    return 0;
+  }
+  if (port.lane != nullptr) {
+    port.lane->push(list[next++].second);
+  } else {
+    port.requests.push(list[next++].second);
+  }
+  return 1;
+}
+
 LaneRun run_lanes(bool lanes, MemoryControllerConfig cfg, std::uint64_t seed) {
   MemoryImage img = numbered_image();
   hw::Kernel k;
@@ -344,62 +399,17 @@ LaneRun run_lanes(bool lanes, MemoryControllerConfig cfg, std::uint64_t seed) {
     mc.add_lane(shading, true);
     mc.add_lane(frame, false);
   }
-  std::mt19937_64 rng(seed);
-  auto script = [&](int n, auto make) {
-    std::vector<std::pair<std::uint64_t, MemRequest>> s;
-    std::uint64_t at = 0;
-    for (int i = 0; i < n; ++i) {
-      at += rng() % 8 == 0 ? rng() % 60 : 0;  // bursts that fill the queues, gaps to skip
-      s.emplace_back(at, make(i));
-    }
-    return s;
-  };
-  const auto reads = script(300, [&](int i) {
-    return read(cs, static_cast<std::uint32_t>(i), 2, static_cast<std::uint32_t>(rng() % 4000),
-                1 + static_cast<int>(rng() % 4));
-  });
-  const auto writes = script(200, [&](int i) {
-    MemRequest w = read(cf, 0, 0, static_cast<std::uint32_t>(i), 1);
-    w.write = true;
-    w.counted_bytes = 3;
-    w.data[0] = 0xABC000u + static_cast<std::uint32_t>(i);
-    return w;
-  });
-  const auto others = script(150, [&](int i) {
-    return read(co, static_cast<std::uint32_t>(i), 3 + static_cast<int>(rng() % 3),
-                static_cast<std::uint32_t>(rng() % 4000), 1 + static_cast<int>(rng() % 3));
-  });
+  const LaneScripts s = lane_scripts(cs, cf, co, seed);
   LaneRun out;
   std::size_t next_read = 0, next_write = 0, next_other = 0;
-  // The RGS's way with its ports: one request per cycle when the port takes it, every response
-  // taken the cycle it becomes visible.
-  // The next due request of `list` into `port`, through its lane when it has one.
-  auto push_due = [&](MemoryController::Port& port,
-                      const std::vector<std::pair<std::uint64_t, MemRequest>>& list,
-                      std::size_t& next) {
-    if (next >= list.size() || list[next].first > k.now()) {
-      return 0;
-    }
-    if (!(port.lane != nullptr ? port.lane->can_push() : port.requests.can_push())) {
-      return 0;
-    }
-    if (port.lane != nullptr) {
-      port.lane->push(list[next++].second);
-    } else {
-      port.requests.push(list[next++].second);
-    }
-    return 1;
-  };
+  // Every response is taken the cycle it becomes visible.
   FnModule client(k, "client", [&] {
-    int p = push_due(shading, reads, next_read) + push_due(frame, writes, next_write);
+    int p = push_due(k.now(), shading, s.reads, next_read) +
+            push_due(k.now(), frame, s.writes, next_write) +
+            push_due(k.now(), other, s.others, next_other);
     if (shading.lane != nullptr ? shading.lane->can_pop() : shading.responses.can_pop()) {
       out.shading.emplace_back(
           k.now(), shading.lane != nullptr ? shading.lane->pop() : shading.responses.pop().tag);
-      ++p;
-    }
-    if (next_other < others.size() && others[next_other].first <= k.now() &&
-        other.requests.can_push()) {
-      other.requests.push(others[next_other++].second);
       ++p;
     }
     if (other.responses.can_pop()) {
@@ -410,8 +420,8 @@ LaneRun run_lanes(bool lanes, MemoryControllerConfig cfg, std::uint64_t seed) {
   });
   out.cycles = k.run_to_completion(
       [&] {
-        return out.shading.size() == reads.size() && out.other.size() == others.size() &&
-               next_write == writes.size() && mc.port_idle(frame) && mc.idle();
+        return out.shading.size() == s.reads.size() && out.other.size() == s.others.size() &&
+               next_write == s.writes.size() && mc.port_idle(frame) && mc.idle();
       },
       1000000);
   for (std::uint32_t o = 0; o < 200; ++o)

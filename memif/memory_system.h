@@ -18,22 +18,12 @@
 
 #include "hw/kernel.h"
 #include "memif/cache.h"
+#include "memif/config.h"
 #include "memif/host_bus.h"
 #include "memif/memory_controller.h"
 #include "memif/routing.h"
 
 namespace saarcor::memif {
-
-struct MemorySystemConfig {
-  int pipelines = 1;  // DynRTPs sharing the controller (D44)
-  CacheConfig node_cache{};
-  CacheConfig list_cache{};
-  CacheConfig row_cache{};
-  MemoryControllerConfig controller{};
-  int responses_per_cycle = 1;  // labelled broadcast width of the simple routing (and of the
-                                // controller's response channel to it)
-  HostBusConfig host{};
-};
 
 class MemorySystem {
  public:

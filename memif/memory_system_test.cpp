@@ -115,14 +115,13 @@ struct Result {
   std::string stats;
 };
 
-Result run_scenario(const Scenario& sc, hw::KernelConfig kc, unsigned seed) {
-  MemoryImage img = testing::random_scene_image(sc.format, seed);
-  const MemoryImage ref = img;
-  hw::Kernel k(kc);
-  MemorySystem mi(k, img, sc.mi);
+// One requester per cache port, each logging the requests its cache accepted into `accepted`
+// (by pipeline and item type).
+std::vector<std::unique_ptr<Requester>> make_requesters(
+    hw::Kernel& k, MemorySystem& mi, const MemoryImage& ref, const Scenario& sc, unsigned seed,
+    std::vector<std::vector<std::uint32_t>>& accepted) {
   std::vector<std::unique_ptr<Requester>> reqs;
-  std::vector<std::vector<std::uint32_t>> accepted(
-      static_cast<std::size_t>(mi.pipelines() * kItemTypes));
+  accepted.assign(static_cast<std::size_t>(mi.pipelines() * kItemTypes), {});
   for (int p = 0; p < mi.pipelines(); ++p) {
     for (int t = 0; t < kItemTypes; ++t) {
       const auto type = static_cast<ItemType>(t);
@@ -138,24 +137,13 @@ Result run_scenario(const Scenario& sc, hw::KernelConfig kc, unsigned seed) {
       }
     }
   }
-  ShadingReader shading(k, mi, ref, 300);
-  FrameWriter frame(k, mi, 400);
-  std::vector<std::uint32_t> upload(1000);
-  for (std::size_t i = 0; i < upload.size(); ++i)
-    upload[i] = 0xB0000000u + static_cast<std::uint32_t>(i);
-  mi.host().upload(kFrameBank1, 100, upload);
-  const std::uint64_t cycles = k.run_to_completion(
-      [&] {
-        for (auto& r : reqs) {
-          if (!r->done()) return false;
-        }
-        return shading.done() && frame.done() && mi.idle();
-      },
-      2000000);
-  // Scoreboard: every request answered exactly once (duplicates and inventions fail inside).
-  for (auto& r : reqs)
-    EXPECT_EQ(r->answered, sc.req.requests) << r->name();
-  // Hit rates against the reference simulation on the accepted request sequence.
+  return reqs;
+}
+
+// Hit rates against the reference simulation on each cache's accepted request sequence, and
+// every miss's item fetched once.
+void check_caches(MemorySystem& mi, const MemoryImage& ref, const Scenario& sc,
+                  const std::vector<std::vector<std::uint32_t>>& accepted) {
   for (int p = 0; p < mi.pipelines(); ++p) {
     for (int t = 0; t < kItemTypes; ++t) {
       const auto type = static_cast<ItemType>(t);
@@ -181,6 +169,33 @@ Result run_scenario(const Scenario& sc, hw::KernelConfig kc, unsigned seed) {
           << c.name();
     }
   }
+}
+
+Result run_scenario(const Scenario& sc, hw::KernelConfig kc, unsigned seed) {
+  MemoryImage img = testing::random_scene_image(sc.format, seed);
+  const MemoryImage ref = img;
+  hw::Kernel k(kc);
+  MemorySystem mi(k, img, sc.mi);
+  std::vector<std::vector<std::uint32_t>> accepted;
+  const auto reqs = make_requesters(k, mi, ref, sc, seed, accepted);
+  ShadingReader shading(k, mi, ref, 300);
+  FrameWriter frame(k, mi, 400);
+  std::vector<std::uint32_t> upload(1000);
+  for (std::size_t i = 0; i < upload.size(); ++i)
+    upload[i] = 0xB0000000u + static_cast<std::uint32_t>(i);
+  mi.host().upload(kFrameBank1, 100, upload);
+  const std::uint64_t cycles = k.run_to_completion(
+      [&] {
+        for (auto& r : reqs) {
+          if (!r->done()) return false;
+        }
+        return shading.done() && frame.done() && mi.idle();
+      },
+      2000000);
+  // Scoreboard: every request answered exactly once (duplicates and inventions fail inside).
+  for (auto& r : reqs)
+    EXPECT_EQ(r->answered, sc.req.requests) << r->name();
+  check_caches(mi, ref, sc, accepted);
   // Frame-buffer and host writes arrived; scene banks untouched.
   for (int i = 0; i < 400; ++i) {
     EXPECT_EQ(img.word(kFrameBank0, static_cast<std::uint32_t>(i)),

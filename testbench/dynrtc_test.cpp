@@ -615,39 +615,6 @@ double stat(const CycleFrame& c, const std::string& name) {
   return std::strtod(c.stats_json.c_str() + v + 9, nullptr);
 }
 
-// The memory interface's keys (docs/memif.md "Knobs"): the table's defaults are memif's own, so
-// the prototype builds the memory system it built before the keys existed.
-TEST(DynRtc, MemoryKeysDefaultToTheMemifDefaults) {
-  const memif::MemorySystemConfig d;
-  const memif::MemorySystemConfig m = memory_system_config(prototype_params());
-  EXPECT_EQ(m.pipelines, d.pipelines);
-  for (const memif::CacheConfig* c : {&m.node_cache, &m.list_cache, &m.row_cache}) {
-    EXPECT_EQ(c->items, d.node_cache.items);
-    EXPECT_EQ(c->ways, d.node_cache.ways);
-    EXPECT_EQ(c->hit_latency, d.node_cache.hit_latency);
-    EXPECT_EQ(c->max_misses, d.node_cache.max_misses);
-    EXPECT_EQ(c->max_targets, d.node_cache.max_targets);
-    EXPECT_EQ(c->ports, d.node_cache.ports);
-    EXPECT_EQ(c->request_capacity, d.node_cache.request_capacity);
-    EXPECT_EQ(c->memory_capacity, d.node_cache.memory_capacity);
-  }
-  EXPECT_EQ(m.controller.queue_depth, d.controller.queue_depth);
-  EXPECT_EQ(m.controller.latency, d.controller.latency);
-  EXPECT_EQ(m.controller.switch_penalty, d.controller.switch_penalty);
-  EXPECT_EQ(m.controller.max_burst, d.controller.max_burst);
-  EXPECT_EQ(m.controller.reorder, d.controller.reorder);
-  EXPECT_EQ(m.controller.bank_path, (std::vector<int>{0, 1, 2, 3, 4, 5}));  // mem.scene_paths=3
-  EXPECT_EQ(m.controller.port_capacity, d.controller.port_capacity);
-  EXPECT_EQ(m.controller.clock_hz, d.controller.clock_hz);
-  EXPECT_EQ(m.responses_per_cycle, d.responses_per_cycle);
-  EXPECT_EQ(m.host.mb_per_s, d.host.mb_per_s);
-  EXPECT_EQ(m.host.burst_words, d.host.burst_words);
-  EXPECT_EQ(m.host.clock_hz, d.host.clock_hz);
-  CycleParams one = prototype_params();
-  apply_cycle_setting(one, "mem.scene_paths=1");
-  EXPECT_EQ(memory_system_config(one).controller.bank_path, d.controller.bank_path);
-}
-
 // Each memory-interface key moves a small frame in the expected direction, and the statistics
 // show why; the hits stay bit-exact (the timing changes, never the result).
 TEST(DynRtc, MemoryKeysMoveTheFrame) {
