@@ -201,8 +201,10 @@ void Builder::partition_binned(const Box& box, const BinnedSplit& best, std::siz
   items_.ensure(rb + best.right + 1);  // + 1: the slot the branch-free write below may fill
   BinItem* all = items_.data();
   const std::uint8_t planar_side = best.planar_left ? kLeft : kRight;
-  nl = 0;
-  nr = 0;
+  // The cursors in locals (written back at the end): the items written in the loop may alias
+  // what a reference names.
+  std::uint32_t l = 0;
+  std::uint32_t r = 0;
   for (std::uint32_t i = 0; i < n; ++i) {
     // The split axis's fields read from the list, not from the copy: indexed by k, the copy
     // would be kept on the stack and read back.
@@ -217,17 +219,19 @@ void Builder::partition_binned(const Box& box, const BinnedSplit& best, std::siz
       // Written to both lists, kept by the cursor of its side: which side is unpredictable,
       // so no branch on it (the right slot written for a left item is above the stack top, the
       // left one for a right item at or below the slot just read).
-      all[lb + nl] = it;
-      all[rb + nr] = it;
-      nl += left;
-      nr += right;
+      all[lb + l] = it;
+      all[rb + r] = it;
+      l += left;
+      r += right;
       continue;
     }
     // Perfect split of a straddler, with the exact stage's rules.
     Pieces pc = straddler_pieces(it.id, box, k, split);
-    if (pc.in_left) set_clipped_bin_item(all[lb + nl++], it.id, pc.llo, pc.lhi);
-    if (pc.in_right) set_clipped_bin_item(all[rb + nr++], it.id, pc.rlo, pc.rhi);
+    if (pc.in_left) set_clipped_bin_item(all[lb + l++], it.id, pc.llo, pc.lhi);
+    if (pc.in_right) set_clipped_bin_item(all[rb + r++], it.id, pc.rlo, pc.rhi);
   }
+  nl = l;
+  nr = r;
 }
 
 void Builder::bin_node(std::uint32_t node, int depth, const Box& box, std::size_t b,

@@ -233,6 +233,9 @@ void Builder::classify(int k, std::size_t b, std::size_t e, std::uint32_t s, boo
   both_.resize(e - b);
   std::uint32_t* both = both_.data();
   std::size_t nb = 0;
+  // Counted in locals: the side bytes written in the loop may alias anything a reference names.
+  std::uint32_t nl = n_left;
+  std::uint32_t nr = n_right;
   for (std::size_t i = b; i < e; ++i) {
     const Key key = ev[i];
     const std::uint32_t id = key_id(key);
@@ -245,11 +248,13 @@ void Builder::classify(int k, std::size_t b, std::size_t e, std::uint32_t s, boo
     const std::uint8_t v = t == kStart ? v_start : t == kEnd ? v_end : v_planar;
     side[id] = v;
     const bool last = t != kStart;
-    n_left += last & (v == kLeft);
-    n_right += last & (v == kRight);
+    nl += last & (v == kLeft);
+    nr += last & (v == kRight);
     both[nb] = id;
     nb += last & (v == kBoth);
   }
+  n_left = nl;
+  n_right = nr;
   both_.resize(nb);
 }
 
