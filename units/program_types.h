@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "fixedfloat/float.h"
+#include "hw/huge_pages.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 #include "units/datapath.h"
-#include "hw/huge_pages.h"
 #include "units/unit_fp.h"
 
 namespace saarcor::units {
