@@ -384,80 +384,8 @@ class Parser {
     std::vector<int> open;  // lines of the transform blocks still open
     while (pos_ < src_.tokens.size()) {
       const Token kw = src_.tokens[pos_++];
-      const std::string_view k = kw.text;
-      if (k == "v") {
-        out.emplace_back(view(kw.line));
-      } else if (k == "l" || k == "la") {
-        out.emplace_back(light(kw.line, k == "la"));
-      } else if (k == "b") {
-        triple("background colour");  // no background colour in Scene: parsed and ignored
-      } else if (k == "am") {
-        triple("ambient light colour");  // the project's shader has its own ambient term
-      } else if (k == "f") {
-        out.emplace_back(nff_material(kw.line));
-      } else if (k == "fm") {
-        out.emplace_back(fm_material(kw.line));
-      } else if (k == "c") {
-        for (int i = 0; i < 8; ++i)
-          number("cone base/apex and radius");
-        out.emplace_back(SkippedSt{"cone/cylinder (c)", kw.line});
-      } else if (k == "s") {
-        for (int i = 0; i < 4; ++i)
-          number("sphere centre and radius");
-        out.emplace_back(SkippedSt{"sphere (s)", kw.line});
-      } else if (k == "p" || k == "pp") {
-        out.emplace_back(polygon(kw.line, k == "pp"));
-      } else if (k == "tt" || k == "ttp") {
-        out.emplace_back(textured_triangle(kw.line, k == "ttp"));
-      } else if (k == "tpa") {
-        animated_triangle();
-        out.emplace_back(SkippedSt{"animated triangle (tpa)", kw.line});
-      } else if (k == "i") {
-        IncludeSt inc;
-        inc.line = kw.line;
-        inc.detail = integer("include detail level", true);
-        inc.name = std::string(word("include file name").text);
-        out.emplace_back(std::move(inc));
-      } else if (k == "d") {
-        out.emplace_back(DetailSt{integer("detail level", true)});
-      } else if (k == "xs") {
-        StaticXformSt x;
-        x.line = kw.line;
-        x.scale = triple("static transform scale");
-        x.axis = triple("static transform rotation axis");
-        x.degrees = number("static transform rotation angle");
-        x.translation = triple("static transform translation");
-        expect("{", "'{' after the static transform");
-        open.push_back(kw.line);
-        out.emplace_back(x);
-      } else if (k == "x") {
-        AnimXformSt x;
-        x.line = kw.line;
-        x.name = std::string(word("transform name").text);
-        expect("{", "'{' after the transform name");
-        open.push_back(kw.line);
-        out.emplace_back(std::move(x));
-      } else if (k == "}") {
-        if (open.empty()) fail(kw.line, "'}' without an open transform block");
-        open.pop_back();
-        out.emplace_back(CloseSt{kw.line});
-      } else if (k == "a") {
-        AnimParamsSt a;
-        a.line = kw.line;
-        a.start = number("animation start time");
-        a.end = number("animation end time");
-        a.frames = integer("animation frame count", true);
-        if (a.end < a.start) fail(kw.line, "animation end time is before its start time");
-        out.emplace_back(a);
-      } else if (k == "k") {
-        out.emplace_back(keyframes(kw.line));
-      } else if (k == "m") {
-        out.emplace_back(mesh(kw.line));
-      } else if (k == "{") {
-        fail(kw.line, "'{' without a transform (xs or x) before it");
-      } else {
-        fail(kw.line, "unknown keyword " + quoted(k));
-      }
+      if (!scene_statement(kw, out) && !structure_statement(kw, out, open))
+        fail(kw.line, "unknown keyword " + quoted(kw.text));
     }
     if (!open.empty())
       fail(src_.last_line, "unexpected end of file: the transform block opened at line " +
@@ -466,6 +394,102 @@ class Parser {
   }
 
  private:
+  // The view, lights, materials and geometry; false for any other keyword.
+  bool scene_statement(const Token& kw, std::vector<Statement>& out) {
+    const std::string_view k = kw.text;
+    if (k == "v") {
+      out.emplace_back(view(kw.line));
+    } else if (k == "l" || k == "la") {
+      out.emplace_back(light(kw.line, k == "la"));
+    } else if (k == "b") {
+      triple("background colour");  // no background colour in Scene: parsed and ignored
+    } else if (k == "am") {
+      triple("ambient light colour");  // the project's shader has its own ambient term
+    } else if (k == "f") {
+      out.emplace_back(nff_material(kw.line));
+    } else if (k == "fm") {
+      out.emplace_back(fm_material(kw.line));
+    } else if (k == "c") {
+      for (int i = 0; i < 8; ++i)
+        number("cone base/apex and radius");
+      out.emplace_back(SkippedSt{"cone/cylinder (c)", kw.line});
+    } else if (k == "s") {
+      for (int i = 0; i < 4; ++i)
+        number("sphere centre and radius");
+      out.emplace_back(SkippedSt{"sphere (s)", kw.line});
+    } else if (k == "p" || k == "pp") {
+      out.emplace_back(polygon(kw.line, k == "pp"));
+    } else if (k == "tt" || k == "ttp") {
+      out.emplace_back(textured_triangle(kw.line, k == "ttp"));
+    } else if (k == "tpa") {
+      animated_triangle();
+      out.emplace_back(SkippedSt{"animated triangle (tpa)", kw.line});
+    } else if (k == "m") {
+      out.emplace_back(mesh(kw.line));
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  // Includes, detail levels, transform blocks and animation; false for any other keyword.
+  bool structure_statement(const Token& kw, std::vector<Statement>& out, std::vector<int>& open) {
+    const std::string_view k = kw.text;
+    if (k == "i") {
+      IncludeSt inc;
+      inc.line = kw.line;
+      inc.detail = integer("include detail level", true);
+      inc.name = std::string(word("include file name").text);
+      out.emplace_back(std::move(inc));
+    } else if (k == "d") {
+      out.emplace_back(DetailSt{integer("detail level", true)});
+    } else if (k == "xs") {
+      out.emplace_back(static_transform(kw.line));
+      open.push_back(kw.line);
+    } else if (k == "x") {
+      AnimXformSt x;
+      x.line = kw.line;
+      x.name = std::string(word("transform name").text);
+      expect("{", "'{' after the transform name");
+      open.push_back(kw.line);
+      out.emplace_back(std::move(x));
+    } else if (k == "}") {
+      if (open.empty()) fail(kw.line, "'}' without an open transform block");
+      open.pop_back();
+      out.emplace_back(CloseSt{kw.line});
+    } else if (k == "a") {
+      out.emplace_back(animation_params(kw.line));
+    } else if (k == "k") {
+      out.emplace_back(keyframes(kw.line));
+    } else if (k == "{") {
+      fail(kw.line, "'{' without a transform (xs or x) before it");
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  StaticXformSt static_transform(int line) {
+    StaticXformSt x;
+    x.line = line;
+    x.scale = triple("static transform scale");
+    x.axis = triple("static transform rotation axis");
+    x.degrees = number("static transform rotation angle");
+    x.translation = triple("static transform translation");
+    expect("{", "'{' after the static transform");
+    return x;
+  }
+
+  AnimParamsSt animation_params(int line) {
+    AnimParamsSt a;
+    a.line = line;
+    a.start = number("animation start time");
+    a.end = number("animation end time");
+    a.frames = integer("animation frame count", true);
+    if (a.end < a.start) fail(line, "animation end time is before its start time");
+    return a;
+  }
+
   [[noreturn]] void fail(int line, const std::string& what) const {
     throw std::runtime_error(src_.path + ":" + std::to_string(line) + ": " + what);
   }
@@ -692,6 +716,13 @@ class Parser {
                                     : has_normals ? "'texturecoords' or 'triangles'"
                                                   : "'normals', 'texturecoords' or 'triangles'") +
                         " in the mesh, got " + quoted(t->text));
+    read_mesh_triangles(g, has_normals, has_uvs);
+    return g;
+  }
+
+  // The mesh's triangles: per triangle three vertex indices, then three normal and three texture
+  // coordinate indices where the mesh has them, each below its list's length.
+  void read_mesh_triangles(GeometrySt& g, bool has_normals, bool has_uvs) {
     const std::size_t per = 3 * (1 + (has_normals ? 1 : 0) + (has_uvs ? 1 : 0));
     const std::size_t nt = count("mesh triangle count", per);
     g.pos_idx.reserve(nt);
@@ -718,7 +749,6 @@ class Parser {
         g.uv_idx.push_back(u);
       }
     }
-    return g;
   }
 
   KeysSt keyframes(int line) {
@@ -1254,69 +1284,71 @@ class Loader {
     return e;
   }
 
-  void build_animation() {
-    std::map<std::string, bool> used;
-    for (const auto& [name, k] : keys_)
-      used[name] = false;
-    // Camera: `v` gives the static view; `k camera` animates position (transl) and orientation
-    // (rot) of a node that looks along its local -Z with +Y up (BART's GetCamera).
-    const KeysSt* cam_keys = nullptr;
-    if (auto it = keys_.find("camera"); it != keys_.end()) {
-      cam_keys = it->second;
-      used["camera"] = true;
-    }
+  // The animation's end: the `a` line's, else the last key of any spline that drives something.
+  double animation_end(const KeysSt* cam_keys) const {
+    if (anim_) return std::max(anim_->end, 0.0);
     double end = 0.0;
-    if (anim_) {
-      end = std::max(anim_->end, 0.0);
-    } else {
-      for (const AnimatedNode& a : animated_)
-        if (auto it = keys_.find(a.name); it != keys_.end())
-          end = std::max(end, spline_end(*it->second));
-      for (const auto& [light, name] : light_names_)
-        if (auto it = keys_.find(name); it != keys_.end())
-          end = std::max(end, spline_end(*it->second));
-      if (cam_keys) end = std::max(end, spline_end(*cam_keys));
-    }
+    for (const AnimatedNode& a : animated_)
+      if (auto it = keys_.find(a.name); it != keys_.end())
+        end = std::max(end, spline_end(*it->second));
+    for (const auto& [light, name] : light_names_)
+      if (auto it = keys_.find(name); it != keys_.end())
+        end = std::max(end, spline_end(*it->second));
+    if (cam_keys) end = std::max(end, spline_end(*cam_keys));
+    return end;
+  }
 
-    if (view_ || cam_keys) {
-      Camera cam;
-      cam.name = "camera";
-      const ViewSt v = view_ ? *view_ : ViewSt{};
-      glm::dvec3 f = v.at - v.from;
-      if (!(glm::length(f) > 0.0)) {
-        scene_.warn("viewpoint: 'from' equals 'at': looking along -Z");
-        f = {0.0, 0.0, -1.0};
-      }
-      f = glm::normalize(f);
-      glm::dvec3 u = v.up - f * glm::dot(v.up, f);
-      if (!(glm::length(u) > 1e-12 * glm::length(v.up)) || !(glm::length(u) > 0.0)) {
-        scene_.warn("viewpoint: 'up' is parallel to the view direction: another up is used");
-        u = std::abs(f.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0);
-        u = u - f * glm::dot(u, f);
-      }
-      u = glm::normalize(u);
-      cam.position = glm::vec3(v.from);
-      cam.forward = glm::vec3(f);
-      cam.up = glm::vec3(u);
-      cam.yfov = static_cast<float>(glm::radians(v.angle));  // AFF: vertical field of view
-      if (cam_keys && (!cam_keys->transl.empty() || !cam_keys->rot.empty())) {
-        const int n = new_node("camera", -1);
-        scene_.roots.push_back(n);
-        Node& node = scene_.nodes[static_cast<std::size_t>(n)];
-        node.translation = v.from;
-        // Columns: right, up, -forward (the camera looks down its local -Z).
-        node.rotation = glm::normalize(glm::quat_cast(glm::dmat3(glm::cross(f, u), u, -f)));
-        node.camera = static_cast<int>(scene_.cameras.size());
-        cam.node = n;
-        if (!cam_keys->transl.empty())
-          add_channel(position_channel(n, AnimPath::kTranslation, cam_keys->transl, end));
-        if (!cam_keys->rot.empty()) add_channel(rotation_channel(n, cam_keys->rot, end));
-        if (!cam_keys->scale.empty())
-          scene_.warn("keyframes 'camera': scale keys are ignored for the camera");
-      }
-      scene_.cameras.push_back(cam);
+  // The view's orthonormal frame: forward f and up u (a degenerate view is repaired with a
+  // warning).
+  void view_frame(const ViewSt& v, glm::dvec3& f, glm::dvec3& u) {
+    f = v.at - v.from;
+    if (!(glm::length(f) > 0.0)) {
+      scene_.warn("viewpoint: 'from' equals 'at': looking along -Z");
+      f = {0.0, 0.0, -1.0};
     }
+    f = glm::normalize(f);
+    u = v.up - f * glm::dot(v.up, f);
+    if (!(glm::length(u) > 1e-12 * glm::length(v.up)) || !(glm::length(u) > 0.0)) {
+      scene_.warn("viewpoint: 'up' is parallel to the view direction: another up is used");
+      u = std::abs(f.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0);
+      u = u - f * glm::dot(u, f);
+    }
+    u = glm::normalize(u);
+  }
 
+  // Camera: `v` gives the static view; `k camera` animates position (transl) and orientation
+  // (rot) of a node that looks along its local -Z with +Y up (BART's GetCamera).
+  void build_camera(const KeysSt* cam_keys, double end) {
+    Camera cam;
+    cam.name = "camera";
+    const ViewSt v = view_ ? *view_ : ViewSt{};
+    glm::dvec3 f;
+    glm::dvec3 u;
+    view_frame(v, f, u);
+    cam.position = glm::vec3(v.from);
+    cam.forward = glm::vec3(f);
+    cam.up = glm::vec3(u);
+    cam.yfov = static_cast<float>(glm::radians(v.angle));  // AFF: vertical field of view
+    if (cam_keys && (!cam_keys->transl.empty() || !cam_keys->rot.empty())) {
+      const int n = new_node("camera", -1);
+      scene_.roots.push_back(n);
+      Node& node = scene_.nodes[static_cast<std::size_t>(n)];
+      node.translation = v.from;
+      // Columns: right, up, -forward (the camera looks down its local -Z).
+      node.rotation = glm::normalize(glm::quat_cast(glm::dmat3(glm::cross(f, u), u, -f)));
+      node.camera = static_cast<int>(scene_.cameras.size());
+      cam.node = n;
+      if (!cam_keys->transl.empty())
+        add_channel(position_channel(n, AnimPath::kTranslation, cam_keys->transl, end));
+      if (!cam_keys->rot.empty()) add_channel(rotation_channel(n, cam_keys->rot, end));
+      if (!cam_keys->scale.empty())
+        scene_.warn("keyframes 'camera': scale keys are ignored for the camera");
+    }
+    scene_.cameras.push_back(cam);
+  }
+
+  // Each `x NAME` transform driven by `k NAME`.
+  void animate_transforms(double end, std::map<std::string, bool>& used) {
     for (const AnimatedNode& a : animated_) {
       const auto it = keys_.find(a.name);
       if (it == keys_.end()) {
@@ -1331,8 +1363,10 @@ class Loader {
       if (!k.rot.empty()) add_channel(rotation_channel(a.node, k.rot, end));
       if (!k.scale.empty()) add_channel(position_channel(a.node, AnimPath::kScale, k.scale, end));
     }
+  }
 
-    // Animated lights (`la NAME`): their position follows the translation keys of NAME.
+  // Animated lights (`la NAME`): their position follows the translation keys of NAME.
+  void animate_lights(double end, std::map<std::string, bool>& used) {
     for (const auto& [light, name] : light_names_) {
       const auto it = keys_.find(name);
       if (it == keys_.end() || it->second->transl.empty()) {
@@ -1348,11 +1382,10 @@ class Loader {
       scene_.lights[static_cast<std::size_t>(light)].node = n;
       add_channel(position_channel(n, AnimPath::kTranslation, it->second->transl, end));
     }
-    for (const auto& [name, u] : used)
-      if (!u) scene_.warn("keyframes '" + name + "' animate nothing: ignored");
+  }
 
-    scene_.animation_seconds = scene_.animations.empty() ? 0.0 : end;
-    // Animated flags: targeted nodes and everything below them.
+  // Animated flags: targeted nodes and everything below them.
+  void mark_animated_nodes() {
     std::vector<std::uint8_t> targeted(scene_.nodes.size(), 0);
     for (const AnimChannel& ch : scene_.animations)
       targeted[static_cast<std::size_t>(ch.node)] = 1;
@@ -1367,6 +1400,25 @@ class Loader {
       for (int c : node.children)
         stack.emplace_back(c, node.animated);
     }
+  }
+
+  void build_animation() {
+    std::map<std::string, bool> used;
+    for (const auto& [name, k] : keys_)
+      used[name] = false;
+    const KeysSt* cam_keys = nullptr;
+    if (auto it = keys_.find("camera"); it != keys_.end()) {
+      cam_keys = it->second;
+      used["camera"] = true;
+    }
+    const double end = animation_end(cam_keys);
+    if (view_ || cam_keys) build_camera(cam_keys, end);
+    animate_transforms(end, used);
+    animate_lights(end, used);
+    for (const auto& [name, u] : used)
+      if (!u) scene_.warn("keyframes '" + name + "' animate nothing: ignored");
+    scene_.animation_seconds = scene_.animations.empty() ? 0.0 : end;
+    mark_animated_nodes();
   }
 
   void add_channel(AnimChannel ch) { scene_.animations.push_back(std::move(ch)); }

@@ -548,6 +548,20 @@ TEST_F(AffFiles, MaterialStateDecidesWhetherAnIncludeIsShared) {
   EXPECT_EQ(colours, (std::set<std::pair<float, float>>{{1.0f, 0.0f}, {0.0f, 1.0f}}));
 }
 
+// The view and lights of MeshWithNormalsTextureCameraAndLights' file.
+void expect_view_and_lights(const Scene& s) {
+  ASSERT_EQ(s.cameras.size(), 1u);
+  const Camera& c = s.cameras[0];
+  expect_near3(glm::dvec3(c.position), {0, 0, 10}, 0.0);
+  expect_near3(glm::dvec3(c.forward), {0, 0, -1}, 1e-7);
+  expect_near3(glm::dvec3(c.up), {0, 1, 0}, 1e-7);  // orthogonalised
+  EXPECT_NEAR(c.yfov, glm::radians(30.0f), 1e-7);
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].color, glm::vec3(1.0f));               // colour optional, white
+  EXPECT_EQ(s.lights[1].color, glm::vec3(0.5f, 0.25f, 1.0f));  // clamped to 1
+  EXPECT_EQ(s.lights[1].position, glm::vec3(4, 5, 6));
+}
+
 TEST_F(AffFiles, MeshWithNormalsTextureCameraAndLights) {
   // A 2x1 binary PPM: red, green. BART keeps textures in ../TextureFiles.
   write("TextureFiles/rg.ppm",
@@ -598,16 +612,7 @@ TEST_F(AffFiles, MeshWithNormalsTextureCameraAndLights) {
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[0].texture, 0);
   EXPECT_FLOAT_EQ(s.materials[0].base_color.r, 1.0f);  // the texture replaces the diffuse colour
-  ASSERT_EQ(s.cameras.size(), 1u);
-  const Camera& c = s.cameras[0];
-  expect_near3(glm::dvec3(c.position), {0, 0, 10}, 0.0);
-  expect_near3(glm::dvec3(c.forward), {0, 0, -1}, 1e-7);
-  expect_near3(glm::dvec3(c.up), {0, 1, 0}, 1e-7);  // orthogonalised
-  EXPECT_NEAR(c.yfov, glm::radians(30.0f), 1e-7);
-  ASSERT_EQ(s.lights.size(), 2u);
-  EXPECT_EQ(s.lights[0].color, glm::vec3(1.0f));               // colour optional, white
-  EXPECT_EQ(s.lights[1].color, glm::vec3(0.5f, 0.25f, 1.0f));  // clamped to 1
-  EXPECT_EQ(s.lights[1].position, glm::vec3(4, 5, 6));
+  expect_view_and_lights(s);
 }
 
 TEST_F(AffFiles, AnimatedLightAndCameraKeys) {

@@ -381,15 +381,10 @@ Scene make_room() {
 
 // ---- builtin:suncor (5,622 sunflowers of 33,288 triangles = 187,145,136) ----------------------
 
-Object make_sunflower(std::uint32_t seed_m, std::uint32_t petal_m, std::uint32_t stem_m,
-                      std::uint32_t leaf_m) {
-  MeshBuilder b("sunflower");
-  const glm::dvec3 head(0.0, 1.6, 0.06);
-  const glm::dvec3 facing = glm::normalize(glm::dvec3(0.0, 0.3, 1.0));
-  glm::dvec3 e1, e2;
-  basis(facing, e1, e2);
-  const double radius = 0.3;
-  // Seeds on Fermat's spiral at the golden angle, each a four-sided pyramid: 7,506 x 4 = 30,024.
+// Seeds on Fermat's spiral at the golden angle, each a four-sided pyramid: 7,506 x 4 = 30,024,
+// on the head at `head` facing `facing` (e1, e2 spanning its plane).
+void add_seeds(MeshBuilder& b, const glm::dvec3& head, const glm::dvec3& facing,
+               const glm::dvec3& e1, const glm::dvec3& e2, double radius, std::uint32_t seed_m) {
   const int seeds = 7506;
   const double golden = kPi * (3.0 - std::sqrt(5.0));
   const double half = 0.45 * radius * std::sqrt(kPi / seeds);
@@ -411,6 +406,17 @@ Object make_sunflower(std::uint32_t seed_m, std::uint32_t petal_m, std::uint32_t
     for (int k = 0; k < 4; ++k)
       b.tri(corner[k], corner[(k + 1) % 4], top, seed_m);
   }
+}
+
+Object make_sunflower(std::uint32_t seed_m, std::uint32_t petal_m, std::uint32_t stem_m,
+                      std::uint32_t leaf_m) {
+  MeshBuilder b("sunflower");
+  const glm::dvec3 head(0.0, 1.6, 0.06);
+  const glm::dvec3 facing = glm::normalize(glm::dvec3(0.0, 0.3, 1.0));
+  glm::dvec3 e1, e2;
+  basis(facing, e1, e2);
+  const double radius = 0.3;
+  add_seeds(b, head, facing, e1, e2, radius, seed_m);
   // Back of the head: a shallow cone (64).
   b.disc(head - facing * 0.005, -facing, radius * 1.05, 64, stem_m, -facing * 0.08);
   // 34 petals of 4 x 8 quads (2,176).
@@ -602,17 +608,8 @@ Object make_tree(int kind, int leaves, std::uint32_t bark_m, std::uint32_t leaf_
   return b.finish();
 }
 
-Scene make_terrain() {
-  Scene s;
-  const int grass = add_texture(s, "grass", 64, [](int x, int y) {
-    const double n =
-        value_noise(x * 0.25, y * 0.25, 0x6A55ull) * 0.6 + value_noise(x, y, 0x6A56ull) * 0.4;
-    return glm::dvec3(0.18 + 0.15 * n, 0.35 + 0.25 * n, 0.10 + 0.08 * n);
-  });
-  const std::uint32_t ground_m = add_material(s, "ground", {1, 1, 1}, 0.0f, 1.0f, grass);
-  const std::uint32_t bark_m = add_material(s, "bark", {0.35f, 0.25f, 0.15f}, 0.0f, 1.0f);
-  const std::uint32_t leaf_m = add_material(s, "foliage", {0.12f, 0.40f, 0.10f}, 0.0f, 0.8f);
-  // 1000 x 500 cells of 2 m: 1,000,000 triangles.
+// The terrain's ground: 1000 x 500 cells of 2 m, 1,000,000 triangles.
+Object make_heightfield(std::uint32_t ground_m) {
   const int nx = 1000, nz = 500;
   const double cell = 2.0;
   // Heights once per grid vertex; normals from central differences of the grid itself.
@@ -643,7 +640,20 @@ Scene make_terrain() {
       ground.tri(v00, v00 + row + 1, v00 + row, ground_m);
     }
   }
-  s.objects.push_back(ground.finish());
+  return ground.finish();
+}
+
+Scene make_terrain() {
+  Scene s;
+  const int grass = add_texture(s, "grass", 64, [](int x, int y) {
+    const double n =
+        value_noise(x * 0.25, y * 0.25, 0x6A55ull) * 0.6 + value_noise(x, y, 0x6A56ull) * 0.4;
+    return glm::dvec3(0.18 + 0.15 * n, 0.35 + 0.25 * n, 0.10 + 0.08 * n);
+  });
+  const std::uint32_t ground_m = add_material(s, "ground", {1, 1, 1}, 0.0f, 1.0f, grass);
+  const std::uint32_t bark_m = add_material(s, "bark", {0.35f, 0.25f, 0.15f}, 0.0f, 1.0f);
+  const std::uint32_t leaf_m = add_material(s, "foliage", {0.12f, 0.40f, 0.10f}, 0.0f, 0.8f);
+  s.objects.push_back(make_heightfield(ground_m));
   add_instance(s, 0, glm::dmat4(1.0), "heightfield");
   // Three tree kinds of 36,006 / 36,008 / 36,010 triangles, 169 + 44 + 50 = 263 instances:
   // 9,469,866 tree triangles, 10,469,866 in all (Table 3's Terrain).
@@ -702,23 +712,9 @@ Object make_monster(std::uint32_t hide_m, std::uint32_t horn_m) {
   return b.finish();  // 840
 }
 
-Scene make_dynamic() {
-  Scene s;
-  const int crate_tex = add_texture(s, "crate", 64, [](int x, int y) {
-    const bool frame = x < 6 || y < 6 || x > 57 || y > 57 || std::abs(x - y) < 4;
-    const double g = 0.06 * std::sin(y * 0.9) + 0.03 * std::sin(x * 2.3);
-    return frame ? glm::dvec3(0.35 + g, 0.22 + g, 0.10) : glm::dvec3(0.60 + g, 0.45 + g, 0.25);
-  });
-  const std::uint32_t floor_m = add_material(s, "floor", {0.45f, 0.45f, 0.48f}, 0.0f, 0.7f);
-  const std::uint32_t wall_m = add_material(s, "wall", {0.55f, 0.50f, 0.42f}, 0.0f, 0.9f);
-  const std::uint32_t pillar_m = add_material(s, "pillar", {0.70f, 0.68f, 0.62f}, 0.2f, 0.3f);
-  const std::uint32_t crate_m = add_material(s, "crate", {1, 1, 1}, 0.0f, 0.8f, crate_tex);
-  const std::uint32_t body_m = add_material(s, "armour", {0.20f, 0.30f, 0.60f}, 0.6f, 0.3f);
-  const std::uint32_t skin_m = add_material(s, "skin", {0.85f, 0.65f, 0.50f}, 0.0f, 0.8f);
-  const std::uint32_t hide_m = add_material(s, "hide", {0.35f, 0.50f, 0.20f}, 0.0f, 0.9f);
-  const std::uint32_t horn_m = add_material(s, "horn", {0.90f, 0.88f, 0.80f}, 0.0f, 0.4f);
-
-  // The level: 39,414 triangles (52,790 - 16 movers of 832 and 840).
+// The arena level: 39,414 triangles (52,790 - 16 movers of 832 and 840).
+Object make_arena(std::uint32_t floor_m, std::uint32_t wall_m, std::uint32_t pillar_m,
+                  std::uint32_t crate_m) {
   MeshBuilder level("arena");
   const double w = 20.0, h = 8.0;
   level.grid({-w, 0, w}, {2 * w, 0, 0}, {0, 0, -2 * w}, 80, 80, floor_m, {10, 10});  // 12,800
@@ -753,7 +749,71 @@ Scene make_dynamic() {
   if (rest > 0)
     level.grid({-4.0, 5.0, -w + 0.05}, {8.0, 0, 0}, {0, 1.5, 0}, static_cast<int>(rest), 1,
                pillar_m);
-  s.objects.push_back(level.finish());
+  return level.finish();
+}
+
+// Mover i (a player for even i, a monster for odd i) on its closed loop between the pillars:
+// translation and rotation keys over one lap of `lap` seconds, and its dynamic instance.
+void add_mover(Scene& s, int i, double lap, int keys) {
+  const std::uint32_t object = (i % 2) ? 2 : 1;
+  Node node;
+  node.name = (object == 1 ? "player" : "monster") + std::to_string(i / 2);
+  node.object = static_cast<int>(object);
+  node.use_trs = true;
+  node.animated = true;
+  const int index = static_cast<int>(s.nodes.size());
+  const double r = 4.0 + 0.4 * i;
+  const double dir = (i % 2) ? 1.0 : -1.0;
+  const double phase = 2.0 * kPi * i / 16.0;
+  const double wobble = 1.0 + 0.15 * (i % 3);
+  AnimChannel tr, rot;
+  tr.node = rot.node = index;
+  tr.path = AnimPath::kTranslation;
+  rot.path = AnimPath::kRotation;
+  for (int k = 0; k < keys; ++k) {
+    const double t = lap * k / (keys - 1);
+    const double a = phase + dir * 2.0 * kPi * t / lap;
+    const glm::dvec3 p(std::cos(a) * r * wobble, 0.0, std::sin(a) * r);
+    const glm::dvec3 v(-std::sin(a) * r * wobble * dir, 0.0,
+                       std::cos(a) * r * dir);  // velocity direction
+    const double yaw = std::atan2(v.x, v.z);    // objects face +Z
+    const glm::dquat q = glm::angleAxis(yaw, glm::dvec3(0.0, 1.0, 0.0));
+    // Keys are binary32 values, as a glTF file stores them: export and re-load are exact.
+    tr.times.push_back(t);
+    tr.values.emplace_back(glm::dvec4(glm::vec4(glm::dvec4(p, 0.0))));
+    rot.times.push_back(t);
+    rot.values.emplace_back(glm::dvec4(glm::vec4(glm::dvec4(q.x, q.y, q.z, q.w))));
+  }
+  node.translation = glm::dvec3(tr.values[0]);
+  node.rotation = glm::dquat(rot.values[0].w, rot.values[0].x, rot.values[0].y, rot.values[0].z);
+  s.nodes.push_back(node);
+  s.roots.push_back(index);
+  s.animations.push_back(std::move(tr));
+  s.animations.push_back(std::move(rot));
+  Instance inst;
+  inst.object = object;
+  inst.id = static_cast<std::uint32_t>(index);
+  inst.dynamic = true;
+  s.instances.push_back(inst);
+}
+
+Scene make_dynamic() {
+  Scene s;
+  const int crate_tex = add_texture(s, "crate", 64, [](int x, int y) {
+    const bool frame = x < 6 || y < 6 || x > 57 || y > 57 || std::abs(x - y) < 4;
+    const double g = 0.06 * std::sin(y * 0.9) + 0.03 * std::sin(x * 2.3);
+    return frame ? glm::dvec3(0.35 + g, 0.22 + g, 0.10) : glm::dvec3(0.60 + g, 0.45 + g, 0.25);
+  });
+  const std::uint32_t floor_m = add_material(s, "floor", {0.45f, 0.45f, 0.48f}, 0.0f, 0.7f);
+  const std::uint32_t wall_m = add_material(s, "wall", {0.55f, 0.50f, 0.42f}, 0.0f, 0.9f);
+  const std::uint32_t pillar_m = add_material(s, "pillar", {0.70f, 0.68f, 0.62f}, 0.2f, 0.3f);
+  const std::uint32_t crate_m = add_material(s, "crate", {1, 1, 1}, 0.0f, 0.8f, crate_tex);
+  const std::uint32_t body_m = add_material(s, "armour", {0.20f, 0.30f, 0.60f}, 0.6f, 0.3f);
+  const std::uint32_t skin_m = add_material(s, "skin", {0.85f, 0.65f, 0.50f}, 0.0f, 0.8f);
+  const std::uint32_t hide_m = add_material(s, "hide", {0.35f, 0.50f, 0.20f}, 0.0f, 0.9f);
+  const std::uint32_t horn_m = add_material(s, "horn", {0.90f, 0.88f, 0.80f}, 0.0f, 0.4f);
+
+  s.objects.push_back(make_arena(floor_m, wall_m, pillar_m, crate_m));
   s.objects.push_back(make_player(body_m, skin_m));
   s.objects.push_back(make_monster(hide_m, horn_m));
   add_instance(s, 0, glm::dmat4(1.0), "arena");
@@ -761,48 +821,8 @@ Scene make_dynamic() {
   // 16 movers on closed loops between the pillars; one lap takes 10 s.
   const double lap = 10.0;
   const int keys = 41;
-  for (int i = 0; i < 16; ++i) {
-    const std::uint32_t object = (i % 2) ? 2 : 1;
-    Node node;
-    node.name = (object == 1 ? "player" : "monster") + std::to_string(i / 2);
-    node.object = static_cast<int>(object);
-    node.use_trs = true;
-    node.animated = true;
-    const int index = static_cast<int>(s.nodes.size());
-    const double r = 4.0 + 0.4 * i;
-    const double dir = (i % 2) ? 1.0 : -1.0;
-    const double phase = 2.0 * kPi * i / 16.0;
-    const double wobble = 1.0 + 0.15 * (i % 3);
-    AnimChannel tr, rot;
-    tr.node = rot.node = index;
-    tr.path = AnimPath::kTranslation;
-    rot.path = AnimPath::kRotation;
-    for (int k = 0; k < keys; ++k) {
-      const double t = lap * k / (keys - 1);
-      const double a = phase + dir * 2.0 * kPi * t / lap;
-      const glm::dvec3 p(std::cos(a) * r * wobble, 0.0, std::sin(a) * r);
-      const glm::dvec3 v(-std::sin(a) * r * wobble * dir, 0.0,
-                         std::cos(a) * r * dir);  // velocity direction
-      const double yaw = std::atan2(v.x, v.z);    // objects face +Z
-      const glm::dquat q = glm::angleAxis(yaw, glm::dvec3(0.0, 1.0, 0.0));
-      // Keys are binary32 values, as a glTF file stores them: export and re-load are exact.
-      tr.times.push_back(t);
-      tr.values.emplace_back(glm::dvec4(glm::vec4(glm::dvec4(p, 0.0))));
-      rot.times.push_back(t);
-      rot.values.emplace_back(glm::dvec4(glm::vec4(glm::dvec4(q.x, q.y, q.z, q.w))));
-    }
-    node.translation = glm::dvec3(tr.values[0]);
-    node.rotation = glm::dquat(rot.values[0].w, rot.values[0].x, rot.values[0].y, rot.values[0].z);
-    s.nodes.push_back(node);
-    s.roots.push_back(index);
-    s.animations.push_back(std::move(tr));
-    s.animations.push_back(std::move(rot));
-    Instance inst;
-    inst.object = object;
-    inst.id = static_cast<std::uint32_t>(index);
-    inst.dynamic = true;
-    s.instances.push_back(inst);
-  }
+  for (int i = 0; i < 16; ++i)
+    add_mover(s, i, lap, keys);
   s.animation_seconds = lap;
   s.cameras.push_back(look_at({0.0, 6.0, 19.0}, {0.0, 1.0, 0.0}, "gallery"));
   s.lights.push_back(light_at({0.0, 7.5, 0.0}, {0.8, 0.8, 0.75}));

@@ -165,6 +165,33 @@ TEST(BuiltinScenes, SuncorWindMovesEveryInstanceAboutItsBase) {
   EXPECT_GT(largest, 0.11);
 }
 
+// Instances of a reloaded scene b: the same ids, objects, dynamic flags and transforms as a's.
+void expect_same_instances(const Scene& a, const Scene& b) {
+  for (std::size_t i = 0; i < a.instances.size(); ++i) {
+    EXPECT_EQ(b.instances[i].id, a.instances[i].id);
+    EXPECT_EQ(b.instances[i].object, a.instances[i].object);
+    EXPECT_EQ(b.instances[i].dynamic, a.instances[i].dynamic);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        ASSERT_NEAR(b.instances[i].object_to_world[c][r], a.instances[i].object_to_world[c][r],
+                    1e-12);
+  }
+}
+
+// The animation survives a round trip: the same transforms at another time.
+void expect_same_animation(const Scene& a, const Scene& b) {
+  if (a.animation_seconds <= 0.0) return;
+  Scene a2 = a;
+  Scene b2 = b;
+  a2.set_time(3.3);
+  b2.set_time(3.3);
+  for (std::size_t i = 0; i < a2.instances.size(); ++i)
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        ASSERT_NEAR(b2.instances[i].object_to_world[c][r], a2.instances[i].object_to_world[c][r],
+                    1e-6);
+}
+
 class BuiltinExport : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(BuiltinExport, ExportThenReloadGivesTheSameScene) {
@@ -199,15 +226,7 @@ TEST_P(BuiltinExport, ExportThenReloadGivesTheSameScene) {
     EXPECT_EQ(b.objects[o].triangles, a.objects[o].triangles);
     EXPECT_EQ(b.objects[o].texcoords, a.objects[o].texcoords);
   }
-  for (std::size_t i = 0; i < a.instances.size(); ++i) {
-    EXPECT_EQ(b.instances[i].id, a.instances[i].id);
-    EXPECT_EQ(b.instances[i].object, a.instances[i].object);
-    EXPECT_EQ(b.instances[i].dynamic, a.instances[i].dynamic);
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r)
-        ASSERT_NEAR(b.instances[i].object_to_world[c][r], a.instances[i].object_to_world[c][r],
-                    1e-12);
-  }
+  expect_same_instances(a, b);
   for (std::size_t c = 0; c < a.cameras.size(); ++c) {
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(b.cameras[c].position[k], a.cameras[c].position[k], 1e-5f);
@@ -217,17 +236,7 @@ TEST_P(BuiltinExport, ExportThenReloadGivesTheSameScene) {
   }
   for (std::size_t t = 0; t < a.textures.size(); ++t)
     EXPECT_EQ(b.textures[t].rgba, a.textures[t].rgba);
-  if (a.animation_seconds > 0.0) {  // the animation survives: same transforms at another time
-    Scene a2 = a;
-    Scene b2 = b;
-    a2.set_time(3.3);
-    b2.set_time(3.3);
-    for (std::size_t i = 0; i < a2.instances.size(); ++i)
-      for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r)
-          ASSERT_NEAR(b2.instances[i].object_to_world[c][r], a2.instances[i].object_to_world[c][r],
-                      1e-6);
-  }
+  expect_same_animation(a, b);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BuiltinExport,

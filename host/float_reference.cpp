@@ -477,19 +477,8 @@ class Shader {
     return bank_[address];
   }
 
-  void shade_ray(const PendingRay& p, const FloatHit& hit, std::uint32_t sum[3]) {
-    if (!hit.hit()) {
-      for (int c = 0; c < 3; ++c)
-        sum[c] += p.weight * channel(regs_.background_rgb, c);
-      return;
-    }
-    const FloatInstance& inst = scene_.instances()[hit.instance];
-    const FloatObject& obj = scene_.objects()[inst.object];
-    const glm::vec3& O = p.ray.origin;
-    const glm::vec3& D = p.ray.direction;
-    const float t = hit.t;
-
-    // Section 4: the world normal M^T * n_o, facing the ray.
+  // Section 4: the world normal M^T * n_o, facing the ray.
+  glm::vec3 world_normal(const FloatInstance& inst, const FloatHit& hit) const {
     const Affine32& td = scene_.t_delta(inst.object, hit.triangle);
     const glm::vec3 n_o(td.rows[2][0], td.rows[2][1], td.rows[2][2]);
     const auto& m = inst.world_to_object32.rows;  // shading stays binary32
@@ -499,9 +488,11 @@ class Shader {
       n[r] = (m[0][rr] * n_o.x + m[1][rr] * n_o.y) + (m[2][rr] * n_o.z + 0.0f);
     }
     if (hit.cos > 0.0f) n = -n;
-    const float nn = dot_t(n, n);
+    return n;
+  }
 
-    // Section 5: material and base colour.
+  // Section 5: the hit triangle's material and base colour (texture modulated).
+  MaterialRecord material(const FloatObject& obj, const FloatHit& hit, std::uint32_t base[3]) {
     const std::uint32_t record =
         regs_.shading_record_base + memif::kShadingRecordWords * (obj.shading_base + hit.triangle);
     const std::uint32_t rec_words[4] = {word(record), word(record + 1), word(record + 2),
@@ -512,7 +503,6 @@ class Shader {
     for (std::uint32_t i = 0; i < memif::kMaterialWords; ++i)
       mat_words[i] = word(maddr + i);
     const MaterialRecord mat = memif::decode_material(mat_words);
-    std::uint32_t base[3];
     for (int c = 0; c < 3; ++c)
       base[c] = channel(mat.diffuse_rgba, c);
     if (mat.texture != memif::kNone) {
@@ -520,52 +510,110 @@ class Shader {
       for (int c = 0; c < 3; ++c)
         base[c] = mul8(base[c], channel(texel, c));
     }
+    return mat;
+  }
+
+  // The hit point's geometry for section 6: ray origin O, direction D, distance t, normal n
+  // (n.n = nn) and the reflection direction.
+  struct HitFrame {
+    glm::vec3 O;
+    glm::vec3 D;
+    float t;
+    glm::vec3 n;
+    float nn;
+    glm::vec3 refl;
+  };
+
+  // Section 6: one light's diffuse (+ specular) term added to acc; none where the light is behind
+  // the surface or, with shadows, occluded.
+  void shade_light(const HitFrame& h, const ShadeLight& light, const MaterialRecord& mat,
+                   const std::uint32_t base[3], std::uint32_t acc[3]) {
+    glm::vec3 S;
+    for (int r = 0; r < 3; ++r)
+      S[r] = (light.position[r] * (-1.0f) + h.O[r] * 1.0f) + (h.D[r] * h.t + 0.0f);
+    const float nS = dot_t(h.n, S);
+    if (!(nS < 0.0f)) return;
+    const float SS = dot_t(S, S);
+    const float cos_d = (-nS) / std::sqrt(h.nn * SS);
+    if (params_.shadows) {
+      constexpr float kShadowEnd = 1.0f - 1.0f / 512.0f;
+      // Origin step of R' = ((1, 0, 0), ...): (L*1 + O*0) + (D*0 + 0).
+      glm::vec3 origin;
+      for (int r = 0; r < 3; ++r)
+        origin[r] = (light.position[r] * 1.0f + h.O[r] * 0.0f) + (h.D[r] * 0.0f + 0.0f);
+      if (scene_.trace(FloatRay{origin, S}, 0.0f, kShadowEnd, true).hit()) return;
+    }
+    const std::uint32_t wd = fix8(cos_d);
+    for (int c = 0; c < 3; ++c)
+      acc[c] += (mul8(base[c], channel(light.rgb, c)) * wd) >> 8;
+    const std::uint32_t spec_rgb = mat.specular_rgb_shininess & 0xFFFFFFu;
+    const std::uint32_t shininess = mat.specular_rgb_shininess >> 24;
+    if (spec_rgb == 0 || shininess < 1) return;
+    const float rL = dot_t(h.refl, S);
+    if (!(rL < 0.0f)) return;
+    const float rr = dot_t(h.refl, h.refl);
+    const float cos_s = (-rL) / std::sqrt(rr * SS);
+    const std::uint32_t ws = fix8(cos_s);
+    std::uint32_t pw = 256;
+    for (std::uint32_t i = 0; i < shininess; ++i)
+      pw = (pw * ws + 128u) >> 8;
+    for (int c = 0; c < 3; ++c)
+      acc[c] += (mul8(channel(spec_rgb, c), channel(light.rgb, c)) * pw) >> 8;
+  }
+
+  // Section 7: the refraction, reflection and transparency children of a hit, by weight.
+  void spawn_children(const PendingRay& p, const FloatHit& hit, const MaterialRecord& mat,
+                      const HitFrame& h) {
+    std::uint32_t wr = mul8(p.weight, mat.reflectivity);
+    const std::uint32_t wt = mul8(p.weight, mat.transparency);
+    const std::uint32_t wf = mul8(p.weight, mat.refraction);
+    const float e = epsilon_;
+    if (wf > 0) {
+      // The material's eta for the side the ray comes from: the back of a triangle is inside.
+      const float eta = to_float(hit.cos > 0.0f ? mat.eta_leave : mat.eta_enter);
+      FloatRay child;
+      if (refract_float(h.D, h.n, eta, child.direction)) {
+        child.origin = child_origin(h.D, h.n, h.O, h.t, e);  // R'_o = (t, 0, e)
+        pending_.push_back(PendingRay{child, wf, p.depth + 1});
+      } else {
+        wr = std::min(255u, wr + wf);  // total internal reflection: the reflection ray takes it
+      }
+    }
+    if (wr > 0)
+      pending_.push_back(
+          PendingRay{FloatRay{child_origin(h.D, h.n, h.O, -e, h.t), h.refl}, wr, p.depth + 1});
+    if (wt > 0) {
+      FloatRay child;
+      child.origin = child_origin(h.D, h.n, h.O, e, h.t);
+      for (int r = 0; r < 3; ++r)
+        child.direction[r] = (h.D[r] * 1.0f + h.n[r] * 0.0f) + (h.D[r] * 0.0f + 0.0f);
+      pending_.push_back(PendingRay{child, wt, p.depth + 1});
+    }
+  }
+
+  void shade_ray(const PendingRay& p, const FloatHit& hit, std::uint32_t sum[3]) {
+    if (!hit.hit()) {
+      for (int c = 0; c < 3; ++c)
+        sum[c] += p.weight * channel(regs_.background_rgb, c);
+      return;
+    }
+    const FloatInstance& inst = scene_.instances()[hit.instance];
+    const FloatObject& obj = scene_.objects()[inst.object];
+    HitFrame h{p.ray.origin, p.ray.direction, hit.t, world_normal(inst, hit), 0.0f, {}};
+    h.nn = dot_t(h.n, h.n);
+    std::uint32_t base[3];
+    const MaterialRecord mat = material(obj, hit, base);
 
     // Section 6: ambient + diffuse (+ specular) per light.
     std::uint32_t acc[3];
     for (int c = 0; c < 3; ++c)
       acc[c] = mul8(base[c], channel(regs_.ambient_rgb, c));
-    const float k = dot_t(D, n) / nn;
+    const float k = dot_t(h.D, h.n) / h.nn;
     const float kk = k + k;
-    const std::uint32_t spec_rgb = mat.specular_rgb_shininess & 0xFFFFFFu;
-    const std::uint32_t shininess = mat.specular_rgb_shininess >> 24;
-    const bool specular = spec_rgb != 0 && shininess >= 1;
-    glm::vec3 refl;
     for (int r = 0; r < 3; ++r)
-      refl[r] = (D[r] * 1.0f + n[r] * (-kk)) + (D[r] * 0.0f + 0.0f);
-    for (const ShadeLight& light : lights_) {
-      glm::vec3 S;
-      for (int r = 0; r < 3; ++r)
-        S[r] = (light.position[r] * (-1.0f) + O[r] * 1.0f) + (D[r] * t + 0.0f);
-      const float nS = dot_t(n, S);
-      if (!(nS < 0.0f)) continue;
-      const float SS = dot_t(S, S);
-      const float cos_d = (-nS) / std::sqrt(nn * SS);
-      if (params_.shadows) {
-        constexpr float kShadowEnd = 1.0f - 1.0f / 512.0f;
-        // Origin step of R' = ((1, 0, 0), ...): (L*1 + O*0) + (D*0 + 0).
-        glm::vec3 origin;
-        for (int r = 0; r < 3; ++r)
-          origin[r] = (light.position[r] * 1.0f + O[r] * 0.0f) + (D[r] * 0.0f + 0.0f);
-        if (scene_.trace(FloatRay{origin, S}, 0.0f, kShadowEnd, true).hit()) continue;
-      }
-      const std::uint32_t wd = fix8(cos_d);
-      for (int c = 0; c < 3; ++c)
-        acc[c] += (mul8(base[c], channel(light.rgb, c)) * wd) >> 8;
-      if (specular) {
-        const float rL = dot_t(refl, S);
-        if (rL < 0.0f) {
-          const float rr = dot_t(refl, refl);
-          const float cos_s = (-rL) / std::sqrt(rr * SS);
-          const std::uint32_t ws = fix8(cos_s);
-          std::uint32_t pw = 256;
-          for (std::uint32_t i = 0; i < shininess; ++i)
-            pw = (pw * ws + 128u) >> 8;
-          for (int c = 0; c < 3; ++c)
-            acc[c] += (mul8(channel(spec_rgb, c), channel(light.rgb, c)) * pw) >> 8;
-        }
-      }
-    }
+      h.refl[r] = (h.D[r] * 1.0f + h.n[r] * (-kk)) + (h.D[r] * 0.0f + 0.0f);
+    for (const ShadeLight& light : lights_)
+      shade_light(h, light, mat, base, acc);
 
     // Section 7: weights and children.
     const std::uint32_t kr = mat.reflectivity;
@@ -576,30 +624,7 @@ class Shader {
     for (int c = 0; c < 3; ++c)
       sum[c] += wl * std::min(255u, acc[c]);
     if (!params_.secondary || p.depth >= max_depth_) return;
-    std::uint32_t wr = mul8(p.weight, kr);
-    const std::uint32_t wt = mul8(p.weight, kt);
-    const std::uint32_t wf = mul8(p.weight, kf);
-    const float e = epsilon_;
-    if (wf > 0) {
-      // The material's eta for the side the ray comes from: the back of a triangle is inside.
-      const float eta = to_float(hit.cos > 0.0f ? mat.eta_leave : mat.eta_enter);
-      FloatRay child;
-      if (refract_float(D, n, eta, child.direction)) {
-        child.origin = child_origin(D, n, O, t, e);  // R'_o = (t, 0, e)
-        pending_.push_back(PendingRay{child, wf, p.depth + 1});
-      } else {
-        wr = std::min(255u, wr + wf);  // total internal reflection: the reflection ray takes it
-      }
-    }
-    if (wr > 0)
-      pending_.push_back(PendingRay{FloatRay{child_origin(D, n, O, -e, t), refl}, wr, p.depth + 1});
-    if (wt > 0) {
-      FloatRay child;
-      child.origin = child_origin(D, n, O, e, t);
-      for (int r = 0; r < 3; ++r)
-        child.direction[r] = (D[r] * 1.0f + n[r] * 0.0f) + (D[r] * 0.0f + 0.0f);
-      pending_.push_back(PendingRay{child, wt, p.depth + 1});
-    }
+    spawn_children(p, hit, mat, h);
   }
 
   float to_float(std::uint32_t bits) const {

@@ -75,6 +75,30 @@ bool in_reads(int bank, std::uint32_t w, const std::vector<memif::BankRange>& re
   return false;
 }
 
+// The words a rebuild changed: none in the shading bank or in what the frame in flight reads,
+// no more than the upload counts, and applied to the old image they give the new one.
+void expect_runs_outside_reads(const memif::MemoryImage& before, const BuiltImage& b,
+                               const std::vector<memif::BankRange>& reads, const UploadDelta& d,
+                               int frame) {
+  const std::vector<memif::UploadRun> runs = changed_words(before, b.image);
+  ASSERT_FALSE(runs.empty());
+  EXPECT_FALSE(overlaps(runs, reads)) << "frame " << frame;
+  std::uint64_t words = 0;
+  for (const memif::UploadRun& r : runs) {
+    EXPECT_NE(r.bank, memif::kShadingBank);
+    words += r.words.size();
+    for (std::uint32_t k = 0; k < r.words.size(); ++k)
+      EXPECT_FALSE(in_reads(r.bank, r.offset + k, reads));
+  }
+  EXPECT_LE(4 * words, d.total());
+  // The runs applied to the old image give the new one.
+  memif::MemoryImage patched = before;
+  for (const memif::UploadRun& r : runs)
+    std::copy(r.words.begin(), r.words.end(), patched.bank(r.bank).begin() + r.offset);
+  for (int bank = 0; bank < memif::kNumBanks; ++bank)
+    EXPECT_EQ(patched.bank(bank), b.image.bank(bank)) << "bank " << bank;
+}
+
 TEST(FrameUpload, TwoTopLevelCopiesAlternateAndLeaveTheCopyInFlightAlone) {
   Scene s = movers();
   BuiltImage b = build_image(s, two_copies());
@@ -115,23 +139,7 @@ TEST(FrameUpload, TwoTopLevelCopiesAlternateAndLeaveTheCopyInFlightAlone) {
     EXPECT_EQ(d.instance_row_bytes, 3u * 36u);
     EXPECT_EQ(b.stats.top_level_builds, 1u + static_cast<std::uint64_t>(frame));
     EXPECT_EQ(b.stats.bottom_level_builds, 2u);  // never rebuilt
-    const std::vector<memif::UploadRun> runs = changed_words(before, b.image);
-    ASSERT_FALSE(runs.empty());
-    EXPECT_FALSE(overlaps(runs, reads)) << "frame " << frame;
-    std::uint64_t words = 0;
-    for (const memif::UploadRun& r : runs) {
-      EXPECT_NE(r.bank, memif::kShadingBank);
-      words += r.words.size();
-      for (std::uint32_t k = 0; k < r.words.size(); ++k)
-        EXPECT_FALSE(in_reads(r.bank, r.offset + k, reads));
-    }
-    EXPECT_LE(4 * words, d.total());
-    // The runs applied to the old image give the new one.
-    memif::MemoryImage patched = before;
-    for (const memif::UploadRun& r : runs)
-      std::copy(r.words.begin(), r.words.end(), patched.bank(r.bank).begin() + r.offset);
-    for (int bank = 0; bank < memif::kNumBanks; ++bank)
-      EXPECT_EQ(patched.bank(bank), b.image.bank(bank)) << "bank " << bank;
+    expect_runs_outside_reads(before, b, reads, d, frame);
     // And the image read through the registers is the new frame's.
     const DecodedImage dec = decode_image(b.image);
     for (std::size_t i = 0; i < 5; ++i)

@@ -126,15 +126,11 @@ std::vector<unsigned char> encode_png(const Texture& texture) {
   return out;
 }
 
-void export_gltf(const Scene& scene, const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  const bool binary = ext == ".glb" || ext == ".GLB";
-  ModelWriter w;
-  tinygltf::Model& model = w.model();
-  model.asset.version = "2.0";
-  model.asset.generator = "saarcor-model";
+namespace {
 
-  // Textures: PNG images inside the buffer, one sampler (repeat, bilinear).
+// Textures: PNG images inside the buffer, one sampler (repeat, bilinear).
+void export_textures(const Scene& scene, ModelWriter& w) {
+  tinygltf::Model& model = w.model();
   if (!scene.textures.empty()) {
     tinygltf::Sampler sampler;
     sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
@@ -155,6 +151,9 @@ void export_gltf(const Scene& scene, const std::string& path) {
     tex.source = static_cast<int>(t);
     model.textures.push_back(tex);
   }
+}
+
+void export_materials(const Scene& scene, tinygltf::Model& model) {
   bool transmission_used = false, ior_used = false;
   for (const Material& m : scene.materials) {
     tinygltf::Material gm;
@@ -183,67 +182,89 @@ void export_gltf(const Scene& scene, const std::string& path) {
   }
   if (transmission_used) model.extensionsUsed.push_back("KHR_materials_transmission");
   if (ior_used) model.extensionsUsed.push_back("KHR_materials_ior");
+}
 
+// The object's vertex accessors: POSITION (with its bounds; one vertex at the origin for an
+// object without any) and, where the object has them, NORMAL and TEXCOORD_0 (else -1).
+struct VertexAccessors {
+  int position;
+  int normal = -1;
+  int texcoord = -1;
+};
+
+VertexAccessors export_vertices(const Object& o, ModelWriter& w) {
+  std::vector<double> lo(3, 0.0), hi(3, 0.0);
+  if (!o.positions.empty()) {
+    glm::vec3 a = o.positions[0], b = o.positions[0];
+    for (const glm::vec3& p : o.positions) {
+      a = glm::min(a, p);
+      b = glm::max(b, p);
+    }
+    lo = {a.x, a.y, a.z};
+    hi = {b.x, b.y, b.z};
+  }
+  const std::size_t nv = std::max<std::size_t>(o.positions.size(), 1);
+  std::vector<glm::vec3> pos = o.positions;
+  if (pos.empty()) pos.emplace_back(0.0f);
+  VertexAccessors va{w.accessor(pos.data(), nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                TINYGLTF_TARGET_ARRAY_BUFFER, lo, hi)};
+  if (!o.normals.empty())
+    va.normal = w.accessor(o.normals.data(), o.normals.size(), TINYGLTF_TYPE_VEC3,
+                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  if (!o.texcoords.empty())
+    va.texcoord = w.accessor(o.texcoords.data(), o.texcoords.size(), TINYGLTF_TYPE_VEC2,
+                             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  return va;
+}
+
+// Triangles [begin, end) of one material as a primitive over the shared vertex accessors.
+tinygltf::Primitive triangle_run(const Object& o, std::size_t begin, std::size_t end,
+                                 const VertexAccessors& va, ModelWriter& w) {
+  std::vector<std::uint32_t> idx;
+  idx.reserve((end - begin) * 3);
+  for (std::size_t t = begin; t < end; ++t)
+    for (int k = 0; k < 3; ++k)
+      idx.push_back(o.triangles[t][k]);
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  prim.attributes["POSITION"] = va.position;
+  if (va.normal >= 0) prim.attributes["NORMAL"] = va.normal;
+  if (va.texcoord >= 0) prim.attributes["TEXCOORD_0"] = va.texcoord;
+  prim.material = static_cast<int>(o.material[begin]);
+  prim.indices =
+      w.accessor(idx.data(), idx.size(), TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                 TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  return prim;
+}
+
+// One mesh per object: one primitive per run of equal material, all sharing the vertex
+// accessors.
+void export_meshes(const Scene& scene, ModelWriter& w) {
   for (const Object& o : scene.objects) {
     tinygltf::Mesh mesh;
     mesh.name = o.name;
-    std::vector<double> lo(3, 0.0), hi(3, 0.0);
-    if (!o.positions.empty()) {
-      glm::vec3 a = o.positions[0], b = o.positions[0];
-      for (const glm::vec3& p : o.positions) {
-        a = glm::min(a, p);
-        b = glm::max(b, p);
-      }
-      lo = {a.x, a.y, a.z};
-      hi = {b.x, b.y, b.z};
-    }
-    const std::size_t nv = std::max<std::size_t>(o.positions.size(), 1);
-    std::vector<glm::vec3> pos = o.positions;
-    if (pos.empty()) pos.emplace_back(0.0f);
-    const int pos_acc =
-        w.accessor(pos.data(), nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                   TINYGLTF_TARGET_ARRAY_BUFFER, lo, hi);
-    int nrm_acc = -1, uv_acc = -1;
-    if (!o.normals.empty())
-      nrm_acc = w.accessor(o.normals.data(), o.normals.size(), TINYGLTF_TYPE_VEC3,
-                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    if (!o.texcoords.empty())
-      uv_acc = w.accessor(o.texcoords.data(), o.texcoords.size(), TINYGLTF_TYPE_VEC2,
-                          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    // One primitive per run of equal material; all share the vertex accessors.
+    const VertexAccessors va = export_vertices(o, w);
     std::size_t begin = 0;
     while (begin < o.triangles.size()) {
       std::size_t end = begin + 1;
       while (end < o.triangles.size() && o.material[end] == o.material[begin])
         ++end;
-      std::vector<std::uint32_t> idx;
-      idx.reserve((end - begin) * 3);
-      for (std::size_t t = begin; t < end; ++t)
-        for (int k = 0; k < 3; ++k)
-          idx.push_back(o.triangles[t][k]);
-      tinygltf::Primitive prim;
-      prim.mode = TINYGLTF_MODE_TRIANGLES;
-      prim.attributes["POSITION"] = pos_acc;
-      if (nrm_acc >= 0) prim.attributes["NORMAL"] = nrm_acc;
-      if (uv_acc >= 0) prim.attributes["TEXCOORD_0"] = uv_acc;
-      prim.material = static_cast<int>(o.material[begin]);
-      prim.indices =
-          w.accessor(idx.data(), idx.size(), TINYGLTF_TYPE_SCALAR,
-                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-      mesh.primitives.push_back(prim);
+      mesh.primitives.push_back(triangle_run(o, begin, end, va, w));
       begin = end;
     }
     if (mesh.primitives.empty()) {
       // glTF requires a primitive: an object without triangles keeps its slot as points.
       tinygltf::Primitive prim;
       prim.mode = TINYGLTF_MODE_POINTS;
-      prim.attributes["POSITION"] = pos_acc;
+      prim.attributes["POSITION"] = va.position;
       mesh.primitives.push_back(prim);
     }
-    model.meshes.push_back(mesh);
+    w.model().meshes.push_back(mesh);
   }
+}
 
-  // Nodes keep their indices, so instance ids survive a round trip.
+// Nodes keep their indices, so instance ids survive a round trip.
+void export_nodes(const Scene& scene, tinygltf::Model& model) {
   for (const Node& n : scene.nodes) {
     tinygltf::Node gn;
     gn.name = n.name;
@@ -260,11 +281,11 @@ void export_gltf(const Scene& scene, const std::string& path) {
     }
     model.nodes.push_back(gn);
   }
-  tinygltf::Scene gs;
-  gs.name = scene.source;
-  gs.nodes = scene.roots;
-  for (std::size_t c = 0; c < scene.cameras.size(); ++c) {
-    const Camera& cam = scene.cameras[c];
+}
+
+// Cameras on their nodes; a camera without one gets a root node of its own.
+void export_cameras(const Scene& scene, tinygltf::Model& model, tinygltf::Scene& gs) {
+  for (const Camera& cam : scene.cameras) {
     tinygltf::Camera gc;
     gc.type = "perspective";
     gc.name = cam.name;
@@ -284,66 +305,98 @@ void export_gltf(const Scene& scene, const std::string& path) {
       gs.nodes.push_back(static_cast<int>(model.nodes.size() - 1));
     }
   }
-  if (!scene.light_defaulted) {
-    for (std::size_t l = 0; l < scene.lights.size(); ++l) {
-      const Light& light = scene.lights[l];
-      tinygltf::Light gl;
-      gl.type = "point";
-      gl.color = {light.color.r, light.color.g, light.color.b};
-      gl.intensity = 1.0;
-      model.lights.push_back(gl);
-      tinygltf::Value::Object ext;
-      ext["light"] = tinygltf::Value(static_cast<int>(model.lights.size() - 1));
-      if (light.node >= 0) {
-        model.nodes[static_cast<std::size_t>(light.node)].extensions["KHR_lights_punctual"] =
-            tinygltf::Value(ext);
-      } else {
-        tinygltf::Node gn;
-        gn.name = "light" + std::to_string(l);
-        gn.translation = {light.position.x, light.position.y, light.position.z};
-        gn.extensions["KHR_lights_punctual"] = tinygltf::Value(ext);
-        model.nodes.push_back(gn);
-        gs.nodes.push_back(static_cast<int>(model.nodes.size() - 1));
-      }
+}
+
+// Point lights (KHR_lights_punctual) on their nodes, or on root nodes of their own; a light the
+// loader added by default is not written.
+void export_lights(const Scene& scene, tinygltf::Model& model, tinygltf::Scene& gs) {
+  if (scene.light_defaulted) return;
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    const Light& light = scene.lights[l];
+    tinygltf::Light gl;
+    gl.type = "point";
+    gl.color = {light.color.r, light.color.g, light.color.b};
+    gl.intensity = 1.0;
+    model.lights.push_back(gl);
+    tinygltf::Value::Object ext;
+    ext["light"] = tinygltf::Value(static_cast<int>(model.lights.size() - 1));
+    if (light.node >= 0) {
+      model.nodes[static_cast<std::size_t>(light.node)].extensions["KHR_lights_punctual"] =
+          tinygltf::Value(ext);
+    } else {
+      tinygltf::Node gn;
+      gn.name = "light" + std::to_string(l);
+      gn.translation = {light.position.x, light.position.y, light.position.z};
+      gn.extensions["KHR_lights_punctual"] = tinygltf::Value(ext);
+      model.nodes.push_back(gn);
+      gs.nodes.push_back(static_cast<int>(model.nodes.size() - 1));
     }
-    if (!model.lights.empty()) model.extensionsUsed.push_back("KHR_lights_punctual");
   }
+  if (!model.lights.empty()) model.extensionsUsed.push_back("KHR_lights_punctual");
+}
+
+// One channel's sampler (key times and values as floats) appended to anim; returns its index.
+int export_sampler(const AnimChannel& ch, ModelWriter& w, tinygltf::Animation& anim) {
+  std::vector<float> times(ch.times.begin(), ch.times.end());
+  const bool rot = ch.path == AnimPath::kRotation;
+  std::vector<float> values;
+  for (const glm::dvec4& v : ch.values) {
+    values.push_back(static_cast<float>(v.x));
+    values.push_back(static_cast<float>(v.y));
+    values.push_back(static_cast<float>(v.z));
+    if (rot) values.push_back(static_cast<float>(v.w));
+  }
+  const float tmin = times.empty() ? 0.0f : times.front();
+  const float tmax = times.empty() ? 0.0f : times.back();
+  tinygltf::AnimationSampler smp;
+  smp.input = w.accessor(times.data(), times.size(), TINYGLTF_TYPE_SCALAR,
+                         TINYGLTF_COMPONENT_TYPE_FLOAT, 0, {tmin}, {tmax});
+  smp.output =
+      w.accessor(values.data(), ch.values.size(), rot ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3,
+                 TINYGLTF_COMPONENT_TYPE_FLOAT, 0);
+  smp.interpolation = ch.interpolation == AnimInterpolation::kStep ? "STEP" : "LINEAR";
+  anim.samplers.push_back(smp);
+  return static_cast<int>(anim.samplers.size() - 1);
+}
+
+// Every channel in one animation (the loader plays all clips together).
+void export_animations(const Scene& scene, ModelWriter& w) {
+  if (scene.animations.empty()) return;
+  tinygltf::Animation anim;
+  anim.name = "animation";
+  for (const AnimChannel& ch : scene.animations) {
+    tinygltf::AnimationChannel gc;
+    gc.sampler = export_sampler(ch, w, anim);
+    gc.target_node = ch.node;
+    gc.target_path = ch.path == AnimPath::kTranslation ? "translation"
+                     : ch.path == AnimPath::kRotation  ? "rotation"
+                                                       : "scale";
+    anim.channels.push_back(gc);
+  }
+  w.model().animations.push_back(anim);
+}
+
+}  // namespace
+
+void export_gltf(const Scene& scene, const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  const bool binary = ext == ".glb" || ext == ".GLB";
+  ModelWriter w;
+  tinygltf::Model& model = w.model();
+  model.asset.version = "2.0";
+  model.asset.generator = "saarcor-model";
+  export_textures(scene, w);
+  export_materials(scene, model);
+  export_meshes(scene, w);
+  export_nodes(scene, model);
+  tinygltf::Scene gs;
+  gs.name = scene.source;
+  gs.nodes = scene.roots;
+  export_cameras(scene, model, gs);
+  export_lights(scene, model, gs);
   model.scenes.push_back(gs);
   model.defaultScene = 0;
-
-  if (!scene.animations.empty()) {
-    tinygltf::Animation anim;
-    anim.name = "animation";
-    for (const AnimChannel& ch : scene.animations) {
-      std::vector<float> times(ch.times.begin(), ch.times.end());
-      const bool rot = ch.path == AnimPath::kRotation;
-      std::vector<float> values;
-      for (const glm::dvec4& v : ch.values) {
-        values.push_back(static_cast<float>(v.x));
-        values.push_back(static_cast<float>(v.y));
-        values.push_back(static_cast<float>(v.z));
-        if (rot) values.push_back(static_cast<float>(v.w));
-      }
-      const float tmin = times.empty() ? 0.0f : times.front();
-      const float tmax = times.empty() ? 0.0f : times.back();
-      tinygltf::AnimationSampler smp;
-      smp.input = w.accessor(times.data(), times.size(), TINYGLTF_TYPE_SCALAR,
-                             TINYGLTF_COMPONENT_TYPE_FLOAT, 0, {tmin}, {tmax});
-      smp.output =
-          w.accessor(values.data(), ch.values.size(), rot ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3,
-                     TINYGLTF_COMPONENT_TYPE_FLOAT, 0);
-      smp.interpolation = ch.interpolation == AnimInterpolation::kStep ? "STEP" : "LINEAR";
-      anim.samplers.push_back(smp);
-      tinygltf::AnimationChannel gc;
-      gc.sampler = static_cast<int>(anim.samplers.size() - 1);
-      gc.target_node = ch.node;
-      gc.target_path = ch.path == AnimPath::kTranslation ? "translation"
-                       : rot                             ? "rotation"
-                                                         : "scale";
-      anim.channels.push_back(gc);
-    }
-    model.animations.push_back(anim);
-  }
+  export_animations(scene, w);
   model.buffers[0].name = "scene";
 
   tinygltf::TinyGLTF gltf;

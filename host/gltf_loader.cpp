@@ -324,129 +324,191 @@ void read_glass(const tinygltf::Material& gm, Material& mat, Scene& scene) {
   }
 }
 
+// One mesh being converted: the object and, per vertex, whether its primitive had texture
+// coordinates and normals. Primitives that share their vertex accessors (a common exporter
+// pattern) share vertices: vertex_base maps (POSITION, TEXCOORD_0, NORMAL) to the first vertex.
+struct MeshBuild {
+  Object obj;
+  bool any_uv = false;
+  bool any_normal = false;
+  bool morph = false;
+  std::vector<std::uint8_t> uv_present;
+  std::vector<std::uint8_t> normal_present;
+  std::map<std::tuple<int, int, int>, std::uint32_t> vertex_base;
+};
+
+// The attributes of one primitive: accessor indices, -1 where absent.
+struct PrimitiveAccessors {
+  int position;
+  int texcoord;
+  int normal;
+};
+
+// Only triangles are ray traced: a primitive of points or lines is skipped with a warning.
+bool is_triangle_primitive(const tinygltf::Primitive& prim, const std::string& label, std::size_t p,
+                           Scene& scene) {
+  if (prim.mode == TINYGLTF_MODE_TRIANGLES || prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+      prim.mode == TINYGLTF_MODE_TRIANGLE_FAN)
+    return true;
+  ++scene.skipped_primitives;
+  scene.warn(label + ": primitive " + std::to_string(p) + " has mode " + std::to_string(prim.mode) +
+             " (points or lines): skipped, only triangles are ray traced");
+  return false;
+}
+
+// Positions must be finite binary32 values.
+AccessorData read_positions(const Reader& reader, int acc, const std::string& label,
+                            const std::string& plabel) {
+  const AccessorData pos = reader.read(acc, plabel + " POSITION");
+  if (pos.components != 3) reader.fail(plabel + " POSITION: not a VEC3 accessor");
+  for (std::size_t i = 0; i < pos.values.size(); ++i) {
+    if (!std::isfinite(pos.values[i]) ||
+        std::abs(pos.values[i]) > static_cast<double>(std::numeric_limits<float>::max()))
+      reader.fail(label + ": accessor " + std::to_string(acc) +
+                  " (POSITION) has a non-finite value at vertex " + std::to_string(i / 3));
+  }
+  return pos;
+}
+
+// TEXCOORD_0 of `count` new vertices (zeros where the primitive has none).
+void read_texcoords(const Reader& reader, int acc, std::size_t count, const std::string& plabel,
+                    MeshBuild& mb) {
+  if (acc < 0) {
+    mb.obj.texcoords.insert(mb.obj.texcoords.end(), count, glm::vec2(0.0f));
+    mb.uv_present.insert(mb.uv_present.end(), count, 0);
+    return;
+  }
+  const AccessorData uv = reader.read(acc, plabel + " TEXCOORD_0");
+  if (uv.components != 2 || uv.count != count)
+    reader.fail(plabel + " TEXCOORD_0: not a VEC2 accessor with one entry per vertex");
+  mb.any_uv = true;
+  for (std::size_t i = 0; i < uv.count; ++i)
+    mb.obj.texcoords.emplace_back(uv.values[2 * i], uv.values[2 * i + 1]);
+  mb.uv_present.insert(mb.uv_present.end(), count, 1);
+}
+
+// NORMAL of `count` new vertices, normalised (+z for a zero or non-finite one; zeros where the
+// primitive has none, computed later).
+void read_normals(const Reader& reader, int acc, std::size_t count, const std::string& plabel,
+                  MeshBuild& mb) {
+  if (acc < 0) {
+    mb.obj.normals.insert(mb.obj.normals.end(), count, glm::vec3(0.0f));
+    mb.normal_present.insert(mb.normal_present.end(), count, 0);
+    return;
+  }
+  const AccessorData nrm = reader.read(acc, plabel + " NORMAL");
+  if (nrm.components != 3 || nrm.count != count)
+    reader.fail(plabel + " NORMAL: not a VEC3 accessor with one entry per vertex");
+  mb.any_normal = true;
+  for (std::size_t i = 0; i < nrm.count; ++i) {
+    glm::dvec3 n(nrm.values[3 * i], nrm.values[3 * i + 1], nrm.values[3 * i + 2]);
+    const double len = glm::length(n);
+    n = (std::isfinite(len) && len > 0.0) ? n / len : glm::dvec3(0.0, 0.0, 1.0);
+    mb.obj.normals.emplace_back(n);
+  }
+  mb.normal_present.insert(mb.normal_present.end(), count, 1);
+}
+
+// The primitive's vertices appended (or found among those already read); returns the first
+// vertex's index and sets vertex_count.
+std::uint32_t primitive_vertices(const Reader& reader, const PrimitiveAccessors& a,
+                                 const std::string& label, const std::string& plabel, MeshBuild& mb,
+                                 std::size_t& vertex_count) {
+  const auto key = std::make_tuple(a.position, a.texcoord, a.normal);
+  if (const auto it = mb.vertex_base.find(key); it != mb.vertex_base.end()) {
+    vertex_count = reader.accessor(a.position, plabel).count;
+    return it->second;
+  }
+  const AccessorData pos = read_positions(reader, a.position, label, plabel);
+  const auto base = static_cast<std::uint32_t>(mb.obj.positions.size());
+  vertex_count = pos.count;
+  mb.vertex_base.emplace(key, base);
+  for (std::size_t i = 0; i < pos.count; ++i)
+    mb.obj.positions.emplace_back(pos.values[3 * i], pos.values[3 * i + 1], pos.values[3 * i + 2]);
+  read_texcoords(reader, a.texcoord, pos.count, plabel, mb);
+  read_normals(reader, a.normal, pos.count, plabel, mb);
+  return base;
+}
+
+// The primitive's indices, each below vertex_count (0..n-1 where it has none).
+std::vector<std::uint32_t> primitive_indices(const Reader& reader, const tinygltf::Primitive& prim,
+                                             const std::string& label, const std::string& plabel,
+                                             std::size_t vertex_count) {
+  std::vector<std::uint32_t> idx;
+  if (prim.indices < 0) {
+    idx.resize(vertex_count);
+    for (std::size_t i = 0; i < vertex_count; ++i)
+      idx[i] = static_cast<std::uint32_t>(i);
+    return idx;
+  }
+  idx = reader.read_indices(prim.indices, plabel + " indices");
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    if (idx[i] >= vertex_count)
+      reader.fail(label + ": accessor " + std::to_string(prim.indices) + " (indices) entry " +
+                  std::to_string(i) + " = " + std::to_string(idx[i]) + " is not below the " +
+                  std::to_string(vertex_count) + " vertices");
+  }
+  return idx;
+}
+
+// One triangle primitive's vertices, triangles and material appended to the mesh.
+void convert_primitive(const tinygltf::Model& model, const Reader& reader,
+                       const tinygltf::Primitive& prim, const std::string& label,
+                       const std::string& plabel, std::uint32_t default_material,
+                       bool& default_used, MeshBuild& mb) {
+  if (!prim.targets.empty()) mb.morph = true;
+  const auto pos_it = prim.attributes.find("POSITION");
+  if (pos_it == prim.attributes.end()) reader.fail(plabel + ": no POSITION attribute");
+  const auto find_attr = [&](const char* name) {
+    const auto it = prim.attributes.find(name);
+    return it == prim.attributes.end() ? -1 : it->second;
+  };
+  const PrimitiveAccessors acc{pos_it->second, find_attr("TEXCOORD_0"), find_attr("NORMAL")};
+  std::size_t vertex_count = 0;
+  const std::uint32_t base = primitive_vertices(reader, acc, label, plabel, mb, vertex_count);
+  const std::vector<std::uint32_t> idx =
+      primitive_indices(reader, prim, label, plabel, vertex_count);
+  std::uint32_t material = default_material;
+  if (prim.material < 0) default_used = true;
+  if (prim.material >= 0) {
+    if (static_cast<std::size_t>(prim.material) >= model.materials.size())
+      reader.fail(plabel + ": material " + std::to_string(prim.material) + " does not exist");
+    material = static_cast<std::uint32_t>(prim.material);
+  }
+  for (const glm::uvec3& t : assemble(prim.mode, idx)) {
+    mb.obj.triangles.push_back(t + glm::uvec3(base));
+    mb.obj.material.push_back(material);
+  }
+}
+
 Object convert_mesh(const tinygltf::Model& model, const Reader& reader, std::size_t mesh_index,
                     std::uint32_t default_material, bool& default_used, Scene& scene) {
   const tinygltf::Mesh& mesh = model.meshes[mesh_index];
   const std::string label = mesh_label(mesh, mesh_index);
-  Object obj;
-  obj.name = mesh.name.empty() ? "mesh" + std::to_string(mesh_index) : mesh.name;
-  bool any_uv = false;
-  bool any_normal = false;
-  std::vector<std::uint8_t> uv_present;
-  std::vector<std::uint8_t> normal_present;
-  // Primitives that share their vertex accessors (a common exporter pattern) share vertices.
-  std::map<std::tuple<int, int, int>, std::uint32_t> vertex_base;
-  bool morph = false;
+  MeshBuild mb;
+  mb.obj.name = mesh.name.empty() ? "mesh" + std::to_string(mesh_index) : mesh.name;
   for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
     const tinygltf::Primitive& prim = mesh.primitives[p];
+    if (!is_triangle_primitive(prim, label, p, scene)) continue;
     const std::string plabel = label + " primitive " + std::to_string(p);
-    if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-        prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-      ++scene.skipped_primitives;
-      scene.warn(label + ": primitive " + std::to_string(p) + " has mode " +
-                 std::to_string(prim.mode) +
-                 " (points or lines): skipped, only triangles are ray traced");
-      continue;
-    }
-    if (!prim.targets.empty()) morph = true;
-    const auto pos_it = prim.attributes.find("POSITION");
-    if (pos_it == prim.attributes.end()) reader.fail(plabel + ": no POSITION attribute");
-    const auto find_attr = [&](const char* name) {
-      const auto it = prim.attributes.find(name);
-      return it == prim.attributes.end() ? -1 : it->second;
-    };
-    const int uv_acc = find_attr("TEXCOORD_0");
-    const int n_acc = find_attr("NORMAL");
-    const auto key = std::make_tuple(pos_it->second, uv_acc, n_acc);
-    std::uint32_t base = 0;
-    std::size_t vertex_count = 0;
-    if (const auto it = vertex_base.find(key); it != vertex_base.end()) {
-      base = it->second;
-      vertex_count = reader.accessor(pos_it->second, plabel).count;
-    } else {
-      const AccessorData pos = reader.read(pos_it->second, plabel + " POSITION");
-      if (pos.components != 3) reader.fail(plabel + " POSITION: not a VEC3 accessor");
-      for (std::size_t i = 0; i < pos.values.size(); ++i) {
-        if (!std::isfinite(pos.values[i]) ||
-            std::abs(pos.values[i]) > static_cast<double>(std::numeric_limits<float>::max()))
-          reader.fail(label + ": accessor " + std::to_string(pos_it->second) +
-                      " (POSITION) has a non-finite value at vertex " + std::to_string(i / 3));
-      }
-      base = static_cast<std::uint32_t>(obj.positions.size());
-      vertex_count = pos.count;
-      vertex_base.emplace(key, base);
-      for (std::size_t i = 0; i < pos.count; ++i)
-        obj.positions.emplace_back(pos.values[3 * i], pos.values[3 * i + 1], pos.values[3 * i + 2]);
-      if (uv_acc >= 0) {
-        const AccessorData uv = reader.read(uv_acc, plabel + " TEXCOORD_0");
-        if (uv.components != 2 || uv.count != pos.count)
-          reader.fail(plabel + " TEXCOORD_0: not a VEC2 accessor with one entry per vertex");
-        any_uv = true;
-        for (std::size_t i = 0; i < uv.count; ++i)
-          obj.texcoords.emplace_back(uv.values[2 * i], uv.values[2 * i + 1]);
-        uv_present.insert(uv_present.end(), pos.count, 1);
-      } else {
-        obj.texcoords.insert(obj.texcoords.end(), pos.count, glm::vec2(0.0f));
-        uv_present.insert(uv_present.end(), pos.count, 0);
-      }
-      if (n_acc >= 0) {
-        const AccessorData nrm = reader.read(n_acc, plabel + " NORMAL");
-        if (nrm.components != 3 || nrm.count != pos.count)
-          reader.fail(plabel + " NORMAL: not a VEC3 accessor with one entry per vertex");
-        any_normal = true;
-        for (std::size_t i = 0; i < nrm.count; ++i) {
-          glm::dvec3 n(nrm.values[3 * i], nrm.values[3 * i + 1], nrm.values[3 * i + 2]);
-          const double len = glm::length(n);
-          n = (std::isfinite(len) && len > 0.0) ? n / len : glm::dvec3(0.0, 0.0, 1.0);
-          obj.normals.emplace_back(n);
-        }
-        normal_present.insert(normal_present.end(), pos.count, 1);
-      } else {
-        obj.normals.insert(obj.normals.end(), pos.count, glm::vec3(0.0f));
-        normal_present.insert(normal_present.end(), pos.count, 0);
-      }
-    }
-    std::vector<std::uint32_t> idx;
-    if (prim.indices >= 0) {
-      idx = reader.read_indices(prim.indices, plabel + " indices");
-      for (std::size_t i = 0; i < idx.size(); ++i) {
-        if (idx[i] >= vertex_count)
-          reader.fail(label + ": accessor " + std::to_string(prim.indices) + " (indices) entry " +
-                      std::to_string(i) + " = " + std::to_string(idx[i]) + " is not below the " +
-                      std::to_string(vertex_count) + " vertices");
-      }
-    } else {
-      idx.resize(vertex_count);
-      for (std::size_t i = 0; i < vertex_count; ++i)
-        idx[i] = static_cast<std::uint32_t>(i);
-    }
-    std::uint32_t material = default_material;
-    if (prim.material < 0) default_used = true;
-    if (prim.material >= 0) {
-      if (static_cast<std::size_t>(prim.material) >= model.materials.size())
-        reader.fail(plabel + ": material " + std::to_string(prim.material) + " does not exist");
-      material = static_cast<std::uint32_t>(prim.material);
-    }
-    for (const glm::uvec3& t : assemble(prim.mode, idx)) {
-      obj.triangles.push_back(t + glm::uvec3(base));
-      obj.material.push_back(material);
-    }
+    convert_primitive(model, reader, prim, label, plabel, default_material, default_used, mb);
   }
-  if (morph)
+  if (mb.morph)
     scene.warn(
         label +
         " has morph targets: rendered with its base shape (morph targets are not supported)");
-  if (!any_uv) obj.texcoords.clear();
-  if (any_normal) {
-    std::vector<std::uint8_t> missing(normal_present.size());
+  Object& obj = mb.obj;
+  if (!mb.any_uv) obj.texcoords.clear();
+  if (mb.any_normal) {
+    std::vector<std::uint8_t> missing(mb.normal_present.size());
     for (std::size_t i = 0; i < missing.size(); ++i)
-      missing[i] = normal_present[i] ? 0 : 1;
+      missing[i] = mb.normal_present[i] ? 0 : 1;
     compute_missing_normals(obj, missing);
   } else {
     obj.normals.clear();
   }
   mark_degenerate_triangles(obj);
-  return obj;
+  return std::move(mb.obj);
 }
 
 glm::dvec4 to_vec4(const AccessorData& d, std::size_t i) {
@@ -501,7 +563,10 @@ Texture decode_image(const unsigned char* bytes, std::size_t size, const std::st
   return tex;
 }
 
-Scene load_gltf(const std::string& path) {
+namespace {
+
+// tinygltf's parse of the file (binary when it starts with "glTF"), images left to the stash.
+void parse_gltf(const std::string& path, tinygltf::Model& model, ImageStash& stash) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw std::runtime_error(path + ": no such file");
@@ -512,10 +577,7 @@ Scene load_gltf(const std::string& path) {
     f.read(magic, 4);
   }
   const bool binary = std::memcmp(magic, "glTF", 4) == 0;
-
-  tinygltf::Model model;
   tinygltf::TinyGLTF gltf;
-  ImageStash stash;
   gltf.SetImageLoader(&stash_image, &stash);
   std::string err;
   std::string warn;
@@ -525,13 +587,12 @@ Scene load_gltf(const std::string& path) {
     if (err.empty()) err = "unknown tinygltf error";
     throw std::runtime_error(path + ": cannot load glTF: " + one_line(err));
   }
-  const Reader reader(model, path);
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+}
 
-  Scene scene;
-  // Extensions: geometry we cannot decode (Draco, meshopt, ...) must not load as garbage, so an
-  // unsupported *required* extension is refused; material and texture extensions only change
-  // appearance, so they are ignored with a warning.
+// Extensions: geometry we cannot decode (Draco, meshopt, ...) must not load as garbage, so an
+// unsupported *required* extension is refused; material and texture extensions only change
+// appearance, so they are ignored with a warning.
+void check_extensions(const tinygltf::Model& model, const Reader& reader, Scene& scene) {
   const auto supported = [](const std::string& ext) {
     return ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" ||
            ext == "KHR_materials_transmission" || ext == "KHR_materials_ior";
@@ -546,20 +607,68 @@ Scene load_gltf(const std::string& path) {
   for (const std::string& ext : model.extensionsUsed) {
     if (!supported(ext)) scene.warn("extension " + ext + " is not supported: ignored");
   }
+}
 
-  // Every external image must exist, even one the shader will not use: a missing file is a
-  // broken asset.
-  stash.bytes.resize(model.images.size());
+// Where the file's images come from: the encoded bytes per image and the folder of external ones.
+struct ImageSource {
+  const std::string& path;
+  std::filesystem::path dir;
+  ImageStash& stash;
+};
+
+// Every external image must exist, even one the shader will not use: a missing file is a broken
+// asset.
+void check_images(const tinygltf::Model& model, ImageSource& src) {
+  src.stash.bytes.resize(model.images.size());
   for (std::size_t i = 0; i < model.images.size(); ++i) {
     const tinygltf::Image& img = model.images[i];
-    if (stash.bytes[i].empty()) {
+    if (src.stash.bytes[i].empty()) {
       const std::string file =
-          img.uri.empty() ? "image " + std::to_string(i) : (dir / img.uri).string();
-      throw std::runtime_error(path + ": image file missing or unreadable: " + file);
+          img.uri.empty() ? "image " + std::to_string(i) : (src.dir / img.uri).string();
+      throw std::runtime_error(src.path + ": image file missing or unreadable: " + file);
     }
   }
+}
 
-  // Materials; textures are decoded only for the base colour.
+// Image si decoded into a scene texture once (image_texture: its texture index, -1 until then).
+int image_texture_index(const tinygltf::Model& model, std::size_t si, ImageSource& src,
+                        std::vector<int>& image_texture, Scene& scene) {
+  if (image_texture[si] >= 0) return image_texture[si];
+  const tinygltf::Image& img = model.images[si];
+  const bool embedded = img.uri.empty() || img.uri.rfind("data:", 0) == 0;
+  const std::string name = embedded ? "embedded:" + std::to_string(si) : img.uri;
+  const std::string file =
+      embedded ? src.path + " image " + std::to_string(si) : (src.dir / img.uri).string();
+  Texture tex = decode_image(src.stash.bytes[si].data(), src.stash.bytes[si].size(), file);
+  tex.name = name;
+  image_texture[si] = static_cast<int>(scene.textures.size());
+  scene.textures.push_back(std::move(tex));
+  return image_texture[si];
+}
+
+// The base colour texture of a material (the only one decoded), from TEXCOORD_0.
+void read_base_texture(const tinygltf::Model& model, const Reader& reader,
+                       const tinygltf::TextureInfo& info, ImageSource& src,
+                       std::vector<int>& image_texture, Material& mat, Scene& scene) {
+  const auto ti = static_cast<std::size_t>(info.index);
+  if (ti >= model.textures.size())
+    reader.fail(mat.name + ": texture " + std::to_string(ti) + " does not exist");
+  const int source = model.textures[ti].source;
+  if (source < 0 || static_cast<std::size_t>(source) >= model.images.size()) {
+    scene.warn("texture " + std::to_string(ti) + " has no image it can use: material '" + mat.name +
+               "' is untextured");
+    return;
+  }
+  mat.texture =
+      image_texture_index(model, static_cast<std::size_t>(source), src, image_texture, scene);
+  if (info.texCoord != 0)
+    scene.warn("material '" + mat.name + "' uses TEXCOORD_" + std::to_string(info.texCoord) +
+               ": TEXCOORD_0 is used instead");
+}
+
+// Materials; textures are decoded only for the base colour.
+void convert_materials(const tinygltf::Model& model, const Reader& reader, ImageSource& src,
+                       Scene& scene) {
   std::vector<int> image_texture(model.images.size(), -1);
   for (std::size_t m = 0; m < model.materials.size(); ++m) {
     const tinygltf::Material& gm = model.materials[m];
@@ -571,42 +680,17 @@ Scene load_gltf(const std::string& path) {
                                  pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
     mat.metallic = static_cast<float>(pbr.metallicFactor);
     mat.roughness = static_cast<float>(pbr.roughnessFactor);
-    if (pbr.baseColorTexture.index >= 0) {
-      const auto ti = static_cast<std::size_t>(pbr.baseColorTexture.index);
-      if (ti >= model.textures.size())
-        reader.fail(mat.name + ": texture " + std::to_string(ti) + " does not exist");
-      const int src = model.textures[ti].source;
-      if (src < 0 || static_cast<std::size_t>(src) >= model.images.size()) {
-        scene.warn("texture " + std::to_string(ti) + " has no image it can use: material '" +
-                   mat.name + "' is untextured");
-      } else {
-        const auto si = static_cast<std::size_t>(src);
-        if (image_texture[si] < 0) {
-          const tinygltf::Image& img = model.images[si];
-          const std::string name = img.uri.empty() || img.uri.rfind("data:", 0) == 0
-                                       ? "embedded:" + std::to_string(si)
-                                       : img.uri;
-          const std::string file = img.uri.empty() || img.uri.rfind("data:", 0) == 0
-                                       ? path + " image " + std::to_string(si)
-                                       : (dir / img.uri).string();
-          Texture tex = decode_image(stash.bytes[si].data(), stash.bytes[si].size(), file);
-          tex.name = name;
-          image_texture[si] = static_cast<int>(scene.textures.size());
-          scene.textures.push_back(std::move(tex));
-        }
-        mat.texture = image_texture[si];
-        if (pbr.baseColorTexture.texCoord != 0)
-          scene.warn("material '" + mat.name + "' uses TEXCOORD_" +
-                     std::to_string(pbr.baseColorTexture.texCoord) +
-                     ": TEXCOORD_0 is used instead");
-      }
-    }
+    if (pbr.baseColorTexture.index >= 0)
+      read_base_texture(model, reader, pbr.baseColorTexture, src, image_texture, mat, scene);
     read_glass(gm, mat, scene);
     derive_fixed_function_terms(mat, gm.alphaMode == "BLEND");
     scene.materials.push_back(std::move(mat));
   }
-  // glTF's default material, for primitives without one: white, fully metallic and rough (the
-  // glTF default factors). Added only when a primitive uses it.
+}
+
+// Every mesh an object. glTF's default material, for primitives without one: white, fully
+// metallic and rough (the glTF default factors). Added only when a primitive uses it.
+void convert_meshes(const tinygltf::Model& model, const Reader& reader, Scene& scene) {
   const auto default_material = static_cast<std::uint32_t>(scene.materials.size());
   bool default_used = false;
   for (std::size_t m = 0; m < model.meshes.size(); ++m)
@@ -619,8 +703,26 @@ Scene load_gltf(const std::string& path) {
     derive_fixed_function_terms(mat, false);
     scene.materials.push_back(mat);
   }
+}
 
-  // Nodes.
+// A node's local transform: its matrix, or translation, rotation and scale.
+void read_node_transform(const tinygltf::Node& gn, Node& node) {
+  if (gn.matrix.size() == 16) {
+    node.use_trs = false;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        node.matrix[c][r] = gn.matrix[static_cast<std::size_t>(c * 4 + r)];
+    return;
+  }
+  if (gn.translation.size() == 3)
+    node.translation = {gn.translation[0], gn.translation[1], gn.translation[2]};
+  if (gn.rotation.size() == 4)
+    node.rotation =
+        glm::normalize(glm::dquat(gn.rotation[3], gn.rotation[0], gn.rotation[1], gn.rotation[2]));
+  if (gn.scale.size() == 3) node.scale = {gn.scale[0], gn.scale[1], gn.scale[2]};
+}
+
+void convert_nodes(const tinygltf::Model& model, const Reader& reader, Scene& scene) {
   const std::size_t node_count = model.nodes.size();
   scene.nodes.resize(node_count);
   for (std::size_t n = 0; n < node_count; ++n) {
@@ -644,103 +746,166 @@ Scene load_gltf(const std::string& path) {
       node.children.push_back(c);
       scene.nodes[static_cast<std::size_t>(c)].parent = static_cast<int>(n);
     }
-    if (gn.matrix.size() == 16) {
-      node.use_trs = false;
-      for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r)
-          node.matrix[c][r] = gn.matrix[static_cast<std::size_t>(c * 4 + r)];
-    } else {
-      if (gn.translation.size() == 3)
-        node.translation = {gn.translation[0], gn.translation[1], gn.translation[2]};
-      if (gn.rotation.size() == 4)
-        node.rotation = glm::normalize(
-            glm::dquat(gn.rotation[3], gn.rotation[0], gn.rotation[1], gn.rotation[2]));
-      if (gn.scale.size() == 3) node.scale = {gn.scale[0], gn.scale[1], gn.scale[2]};
-    }
+    read_node_transform(gn, node);
   }
+}
 
-  // Default scene; a file without scenes renders every root node.
-  if (!model.scenes.empty()) {
-    int s = model.defaultScene;
-    if (s < 0 || static_cast<std::size_t>(s) >= model.scenes.size()) s = 0;
-    for (int r : model.scenes[static_cast<std::size_t>(s)].nodes) {
-      if (r < 0 || static_cast<std::size_t>(r) >= node_count)
-        reader.fail("scene " + std::to_string(s) + ": node " + std::to_string(r) +
-                    " does not exist");
-      scene.roots.push_back(r);
-    }
-  } else {
+// Default scene; a file without scenes renders every root node.
+void choose_roots(const tinygltf::Model& model, const Reader& reader, Scene& scene) {
+  const std::size_t node_count = model.nodes.size();
+  if (model.scenes.empty()) {
     for (std::size_t n = 0; n < node_count; ++n)
       if (scene.nodes[n].parent < 0) scene.roots.push_back(static_cast<int>(n));
+    return;
   }
+  int s = model.defaultScene;
+  if (s < 0 || static_cast<std::size_t>(s) >= model.scenes.size()) s = 0;
+  for (int r : model.scenes[static_cast<std::size_t>(s)].nodes) {
+    if (r < 0 || static_cast<std::size_t>(r) >= node_count)
+      reader.fail("scene " + std::to_string(s) + ": node " + std::to_string(r) + " does not exist");
+    scene.roots.push_back(r);
+  }
+}
 
-  // Animations (all clips play together; docs/scenes.md).
-  std::vector<std::uint8_t> targeted(node_count, 0);
+// The channel's animated property; false (with a warning) for morph weights.
+bool read_channel_path(const std::string& target_path, AnimChannel& ch, Scene& scene) {
+  if (target_path == "translation") {
+    ch.path = AnimPath::kTranslation;
+  } else if (target_path == "rotation") {
+    ch.path = AnimPath::kRotation;
+  } else if (target_path == "scale") {
+    ch.path = AnimPath::kScale;
+  } else {
+    scene.warn("animation of '" + target_path + "' (morph weights) is not supported: ignored");
+    return false;
+  }
+  return true;
+}
+
+AnimInterpolation read_interpolation(const std::string& interpolation, Scene& scene) {
+  if (interpolation == "STEP") return AnimInterpolation::kStep;
+  if (interpolation == "CUBICSPLINE") {
+    scene.warn(
+        "CUBICSPLINE animation interpolation is not supported: interpolated linearly "
+        "between its key values (tangents ignored)");
+    return AnimInterpolation::kCubicSpline;
+  }
+  return AnimInterpolation::kLinear;
+}
+
+// The sampler's key times (finite, ascending) and key values (a cubic spline's middle value of
+// each in-tangent, value, out-tangent triple).
+void read_channel_keys(const Reader& reader, const tinygltf::AnimationSampler& gs,
+                       const std::string& label, const std::string& target_path, AnimChannel& ch) {
+  const AccessorData in = reader.read(gs.input, label + " input");
+  const AccessorData out = reader.read(gs.output, label + " output");
+  if (in.components != 1) reader.fail(label + " input: not a SCALAR accessor");
+  const int want = ch.path == AnimPath::kRotation ? 4 : 3;
+  if (out.components != want)
+    reader.fail(label + " output: wrong accessor type for " + target_path);
+  const std::size_t keys = in.count;
+  const std::size_t per_key = ch.interpolation == AnimInterpolation::kCubicSpline ? 3 : 1;
+  if (keys == 0 || out.count != keys * per_key)
+    reader.fail(label + ": " + std::to_string(out.count) + " output values for " +
+                std::to_string(keys) + " keys");
+  for (std::size_t k = 0; k < keys; ++k) {
+    const double t = in.values[k];
+    if (!std::isfinite(t) || (k > 0 && t < ch.times.back()))
+      reader.fail(label + ": key times are not finite and ascending");
+    ch.times.push_back(t);
+    ch.values.push_back(to_vec4(out, k * per_key + (per_key == 3 ? 1 : 0)));
+  }
+}
+
+// One animation channel into the scene; marks its node in `targeted`.
+void convert_channel(const Reader& reader, const tinygltf::Animation& anim,
+                     const tinygltf::AnimationChannel& gc, const std::string& label,
+                     std::vector<std::uint8_t>& targeted, Scene& scene) {
+  if (gc.target_node < 0) return;
+  if (static_cast<std::size_t>(gc.target_node) >= targeted.size())
+    reader.fail(label + ": node " + std::to_string(gc.target_node) + " does not exist");
+  AnimChannel ch;
+  ch.node = gc.target_node;
+  if (!read_channel_path(gc.target_path, ch, scene)) return;
+  if (gc.sampler < 0 || static_cast<std::size_t>(gc.sampler) >= anim.samplers.size())
+    reader.fail(label + ": sampler " + std::to_string(gc.sampler) + " does not exist");
+  const tinygltf::AnimationSampler& gs = anim.samplers[static_cast<std::size_t>(gc.sampler)];
+  ch.interpolation = read_interpolation(gs.interpolation, scene);
+  read_channel_keys(reader, gs, label, gc.target_path, ch);
+  scene.animation_seconds = std::max(scene.animation_seconds, ch.times.back());
+  if (ch.interpolation == AnimInterpolation::kCubicSpline)
+    ch.interpolation = AnimInterpolation::kLinear;
+  targeted[static_cast<std::size_t>(ch.node)] = 1;
+  // An animated node's matrix is replaced by TRS (glTF forbids animating matrix nodes; be
+  // lenient).
+  scene.nodes[static_cast<std::size_t>(ch.node)].use_trs = true;
+  scene.animations.push_back(std::move(ch));
+}
+
+// Animations (all clips play together; docs/scenes.md); returns, per node, whether a channel
+// targets it.
+std::vector<std::uint8_t> convert_animations(const tinygltf::Model& model, const Reader& reader,
+                                             Scene& scene) {
+  std::vector<std::uint8_t> targeted(model.nodes.size(), 0);
   for (std::size_t a = 0; a < model.animations.size(); ++a) {
     const tinygltf::Animation& anim = model.animations[a];
     for (std::size_t c = 0; c < anim.channels.size(); ++c) {
-      const tinygltf::AnimationChannel& gc = anim.channels[c];
       const std::string label = "animation " + std::to_string(a) + " channel " + std::to_string(c);
-      if (gc.target_node < 0) continue;
-      if (static_cast<std::size_t>(gc.target_node) >= node_count)
-        reader.fail(label + ": node " + std::to_string(gc.target_node) + " does not exist");
-      AnimChannel ch;
-      ch.node = gc.target_node;
-      if (gc.target_path == "translation") {
-        ch.path = AnimPath::kTranslation;
-      } else if (gc.target_path == "rotation") {
-        ch.path = AnimPath::kRotation;
-      } else if (gc.target_path == "scale") {
-        ch.path = AnimPath::kScale;
-      } else {
-        scene.warn("animation of '" + gc.target_path +
-                   "' (morph weights) is not supported: ignored");
-        continue;
-      }
-      if (gc.sampler < 0 || static_cast<std::size_t>(gc.sampler) >= anim.samplers.size())
-        reader.fail(label + ": sampler " + std::to_string(gc.sampler) + " does not exist");
-      const tinygltf::AnimationSampler& gs = anim.samplers[static_cast<std::size_t>(gc.sampler)];
-      if (gs.interpolation == "STEP") {
-        ch.interpolation = AnimInterpolation::kStep;
-      } else if (gs.interpolation == "CUBICSPLINE") {
-        ch.interpolation = AnimInterpolation::kCubicSpline;
-        scene.warn(
-            "CUBICSPLINE animation interpolation is not supported: interpolated linearly "
-            "between its key values (tangents ignored)");
-      } else {
-        ch.interpolation = AnimInterpolation::kLinear;
-      }
-      const AccessorData in = reader.read(gs.input, label + " input");
-      const AccessorData out = reader.read(gs.output, label + " output");
-      if (in.components != 1) reader.fail(label + " input: not a SCALAR accessor");
-      const int want = ch.path == AnimPath::kRotation ? 4 : 3;
-      if (out.components != want)
-        reader.fail(label + " output: wrong accessor type for " + gc.target_path);
-      const std::size_t keys = in.count;
-      const std::size_t per_key = ch.interpolation == AnimInterpolation::kCubicSpline ? 3 : 1;
-      if (keys == 0 || out.count != keys * per_key)
-        reader.fail(label + ": " + std::to_string(out.count) + " output values for " +
-                    std::to_string(keys) + " keys");
-      for (std::size_t k = 0; k < keys; ++k) {
-        const double t = in.values[k];
-        if (!std::isfinite(t) || (k > 0 && t < ch.times.back()))
-          reader.fail(label + ": key times are not finite and ascending");
-        ch.times.push_back(t);
-        ch.values.push_back(to_vec4(out, k * per_key + (per_key == 3 ? 1 : 0)));
-      }
-      scene.animation_seconds = std::max(scene.animation_seconds, ch.times.back());
-      if (ch.interpolation == AnimInterpolation::kCubicSpline)
-        ch.interpolation = AnimInterpolation::kLinear;
-      targeted[static_cast<std::size_t>(ch.node)] = 1;
-      // An animated node's matrix is replaced by TRS (glTF forbids animating matrix nodes; be
-      // lenient).
-      scene.nodes[static_cast<std::size_t>(ch.node)].use_trs = true;
-      scene.animations.push_back(std::move(ch));
+      convert_channel(reader, anim, anim.channels[c], label, targeted, scene);
     }
   }
+  return targeted;
+}
 
-  // Instances, cameras and lights of the default scene, depth-first in node order.
-  std::vector<std::uint8_t> visited(node_count, 0);
+// A perspective camera on node n (others are skipped with a warning).
+void add_camera(const tinygltf::Model& model, const Reader& reader, int n, int camera, Node& node,
+                Scene& scene) {
+  if (static_cast<std::size_t>(camera) >= model.cameras.size())
+    reader.fail("node " + std::to_string(n) + ": camera " + std::to_string(camera) +
+                " does not exist");
+  const tinygltf::Camera& gc = model.cameras[static_cast<std::size_t>(camera)];
+  if (gc.type != "perspective") {
+    scene.warn("camera " + std::to_string(camera) + " is " + gc.type +
+               ": skipped (only perspective cameras are supported)");
+    return;
+  }
+  Camera cam;
+  cam.name = gc.name.empty() ? "camera" + std::to_string(camera) : gc.name;
+  cam.yfov = static_cast<float>(gc.perspective.yfov);
+  cam.node = n;
+  node.camera = static_cast<int>(scene.cameras.size());
+  scene.cameras.push_back(cam);
+}
+
+// A KHR_lights_punctual light on node n: point lights, spot lights as point lights; directional
+// ones are skipped with a warning.
+void add_light(const tinygltf::Model& model, const Reader& reader, int n, const tinygltf::Value& v,
+               Node& node, Scene& scene) {
+  const int li = v.IsInt() ? v.Get<int>() : -1;
+  if (li < 0 || static_cast<std::size_t>(li) >= model.lights.size())
+    reader.fail("node " + std::to_string(n) + ": light " + std::to_string(li) + " does not exist");
+  const tinygltf::Light& gl = model.lights[static_cast<std::size_t>(li)];
+  if (gl.type == "directional") {
+    scene.warn("light " + std::to_string(li) +
+               " is directional: skipped (only point lights are supported)");
+    return;
+  }
+  if (gl.type == "spot")
+    scene.warn("light " + std::to_string(li) + " is a spot light: used as a point light (no cone)");
+  Light light;
+  glm::vec3 color(1.0f);
+  if (gl.color.size() == 3) color = glm::vec3(gl.color[0], gl.color[1], gl.color[2]);
+  light.color = glm::clamp(color * static_cast<float>(std::min(gl.intensity, 1.0)), 0.0f, 1.0f);
+  light.node = n;
+  node.light = static_cast<int>(scene.lights.size());
+  scene.lights.push_back(light);
+}
+
+// Instances, cameras and lights of the default scene, depth-first in node order; a node is
+// animated when a channel targets it or an ancestor.
+void place_nodes(const tinygltf::Model& model, const Reader& reader,
+                 const std::vector<std::uint8_t>& targeted, Scene& scene) {
+  std::vector<std::uint8_t> visited(model.nodes.size(), 0);
   std::vector<std::pair<int, bool>> stack;  // node, an ancestor is animated
   for (auto r = scene.roots.rbegin(); r != scene.roots.rend(); ++r)
     stack.emplace_back(*r, false);
@@ -761,51 +926,31 @@ Scene load_gltf(const std::string& path) {
       inst.dynamic = node.animated;
       scene.instances.push_back(inst);
     }
-    if (gn.camera >= 0) {
-      if (static_cast<std::size_t>(gn.camera) >= model.cameras.size())
-        reader.fail("node " + std::to_string(n) + ": camera " + std::to_string(gn.camera) +
-                    " does not exist");
-      const tinygltf::Camera& gc = model.cameras[static_cast<std::size_t>(gn.camera)];
-      if (gc.type == "perspective") {
-        Camera cam;
-        cam.name = gc.name.empty() ? "camera" + std::to_string(gn.camera) : gc.name;
-        cam.yfov = static_cast<float>(gc.perspective.yfov);
-        cam.node = n;
-        node.camera = static_cast<int>(scene.cameras.size());
-        scene.cameras.push_back(cam);
-      } else {
-        scene.warn("camera " + std::to_string(gn.camera) + " is " + gc.type +
-                   ": skipped (only perspective cameras are supported)");
-      }
-    }
-    if (const auto ext = gn.extensions.find("KHR_lights_punctual"); ext != gn.extensions.end()) {
-      const tinygltf::Value& v = ext->second.Get("light");
-      const int li = v.IsInt() ? v.Get<int>() : -1;
-      if (li < 0 || static_cast<std::size_t>(li) >= model.lights.size())
-        reader.fail("node " + std::to_string(n) + ": light " + std::to_string(li) +
-                    " does not exist");
-      const tinygltf::Light& gl = model.lights[static_cast<std::size_t>(li)];
-      if (gl.type == "directional") {
-        scene.warn("light " + std::to_string(li) +
-                   " is directional: skipped (only point lights are supported)");
-      } else {
-        if (gl.type == "spot")
-          scene.warn("light " + std::to_string(li) +
-                     " is a spot light: used as a point light (no cone)");
-        Light light;
-        glm::vec3 color(1.0f);
-        if (gl.color.size() == 3) color = glm::vec3(gl.color[0], gl.color[1], gl.color[2]);
-        light.color =
-            glm::clamp(color * static_cast<float>(std::min(gl.intensity, 1.0)), 0.0f, 1.0f);
-        light.node = n;
-        node.light = static_cast<int>(scene.lights.size());
-        scene.lights.push_back(light);
-      }
-    }
+    if (gn.camera >= 0) add_camera(model, reader, n, gn.camera, node, scene);
+    if (const auto ext = gn.extensions.find("KHR_lights_punctual"); ext != gn.extensions.end())
+      add_light(model, reader, n, ext->second.Get("light"), node, scene);
     for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
       stack.emplace_back(*c, node.animated);
   }
+}
 
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+  tinygltf::Model model;
+  ImageStash stash;
+  parse_gltf(path, model, stash);
+  const Reader reader(model, path);
+  ImageSource images{path, std::filesystem::path(path).parent_path(), stash};
+  Scene scene;
+  check_extensions(model, reader, scene);
+  check_images(model, images);
+  convert_materials(model, reader, images, scene);
+  convert_meshes(model, reader, scene);
+  convert_nodes(model, reader, scene);
+  choose_roots(model, reader, scene);
+  const std::vector<std::uint8_t> targeted = convert_animations(model, reader, scene);
+  place_nodes(model, reader, targeted, scene);
   scene.source = path;
   scene.set_time(0.0);
   return scene;

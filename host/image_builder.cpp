@@ -171,11 +171,6 @@ std::uint64_t items_in_bank(std::uint64_t count, int j) {
   return count / memif::kSceneBanks + (static_cast<std::uint64_t>(j) < count % memif::kSceneBanks);
 }
 
-std::uint64_t stripe_words(std::uint64_t count, int item_words) {
-  return (count + memif::kSceneBanks - 1) / memif::kSceneBanks *
-         static_cast<std::uint64_t>(item_words);
-}
-
 // ---- scene banks ---------------------------------------------------------------------------
 
 std::uint32_t top_copies(const BuiltImage& b) {
@@ -534,15 +529,9 @@ std::uint32_t write_lights(BuiltImage& b, const Scene& scene) {
   return changed;
 }
 
-void write_shading_bank(BuiltImage& b, const Scene& scene) {
-  MemoryImage& im = b.image;
-  memif::FrameRegisters& regs = im.registers();
-  ImageStats& s = b.stats;
-  const std::size_t materials = std::max<std::size_t>(1, scene.materials.size());
-  if (materials > 65536)
-    throw std::runtime_error("scene has " + std::to_string(materials) +
-                             " materials; shading records address at most 65536");
-  // Textures used by a material, stored once each, in texture index order.
+// The textures the materials use (stored once each, in texture index order); refuses a material
+// whose texture index is out of range.
+std::vector<std::uint8_t> used_textures(const Scene& scene) {
   std::vector<std::uint8_t> used(scene.textures.size(), 0);
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
     const int t = scene.materials[m].texture;
@@ -552,25 +541,33 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
                                std::to_string(scene.textures.size()));
     if (t >= 0) used[static_cast<std::size_t>(t)] = 1;
   }
-  if (b.params.max_texture_size < 1 || b.params.max_texture_size > 32768 ||
-      (b.params.max_texture_size & (b.params.max_texture_size - 1)) != 0)
-    throw std::runtime_error("maximum texture size " + std::to_string(b.params.max_texture_size) +
-                             " is not a power of two in 1..32768");
-  std::vector<StoredTexture> textures(scene.textures.size());
+  return used;
+}
+
+// The shading bank's regions in words, in their order.
+struct ShadingLayout {
+  std::uint64_t material_words = 0;
+  std::uint64_t light_words = 0;
+  std::uint64_t record_words = 0;
   std::uint64_t texel_words = 0;
+  std::uint64_t end() const { return material_words + light_words + record_words + texel_words; }
+};
+
+// The used textures resampled to powers of two within the size limit, then, with fit_textures,
+// halved (the largest first, the lowest index on a tie) until the bank fits or every texture is
+// down to 1x1: textures give way before the scene is refused.
+std::vector<StoredTexture> stored_textures(BuiltImage& b, const Scene& scene,
+                                           const std::vector<std::uint8_t>& used,
+                                           ShadingLayout& lay) {
+  ImageStats& s = b.stats;
+  std::vector<StoredTexture> textures(scene.textures.size());
   for (std::size_t t = 0; t < scene.textures.size(); ++t) {
     if (!used[t]) continue;
     textures[t] = resample(scene.textures[t], t, b.params.max_texture_size);
-    texel_words += textures[t].texels.size();
+    lay.texel_words += textures[t].texels.size();
     ++s.textures;
   }
-  const std::uint64_t material_words = memif::kMaterialWords * materials;
-  const std::uint64_t light_words = memif::kLightWords * scene.lights.size();
-  const std::uint64_t record_words = memif::kShadingRecordWords * s.triangle_slots;
-  // Textures give way before the scene is refused: halve the largest (lowest index on a tie)
-  // until the bank fits or every texture is down to 1x1.
-  while (b.params.fit_textures &&
-         material_words + light_words + record_words + texel_words > b.params.bank_words) {
+  while (b.params.fit_textures && lay.end() > b.params.bank_words) {
     std::size_t largest = textures.size();
     for (std::size_t t = 0; t < textures.size(); ++t)
       if (used[t] && textures[t].texels.size() > 1 &&
@@ -578,9 +575,9 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
            textures[t].texels.size() > textures[largest].texels.size()))
         largest = t;
     if (largest == textures.size()) break;
-    texel_words -= textures[largest].texels.size();
+    lay.texel_words -= textures[largest].texels.size();
     halve(textures[largest]);
-    texel_words += textures[largest].texels.size();
+    lay.texel_words += textures[largest].texels.size();
     ++s.texture_halvings;
   }
   for (std::size_t t = 0; t < scene.textures.size(); ++t)
@@ -588,68 +585,114 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
         ((1u << textures[t].log2_width) != static_cast<std::uint32_t>(scene.textures[t].width) ||
          (1u << textures[t].log2_height) != static_cast<std::uint32_t>(scene.textures[t].height)))
       ++s.resampled_textures;
-  const std::uint64_t end = material_words + light_words + record_words + texel_words;
-  if (end > b.params.bank_words) {
-    const std::uint64_t cap = b.params.bank_words;
-    const char* region = material_words > cap                                ? "materials"
-                         : material_words + light_words > cap                ? "lights"
-                         : material_words + light_words + record_words > cap ? "shading records"
-                                                                             : "textures";
-    throw std::runtime_error("scene does not fit: shading bank 2 needs " + mb(end * 4) + " of " +
-                             mb(cap * 4) + " (materials " + mb(material_words * 4) + ", lights " +
-                             mb(light_words * 4) + ", shading records " + mb(record_words * 4) +
-                             ", textures " + mb(texel_words * 4) + "; " + region + " overflow by " +
-                             mb((end - cap) * 4) + " = " + std::to_string((end - cap) * 4) +
-                             " bytes); raise --bank-mb");
-  }
-  regs.material_base = 0;
-  regs.light_base = static_cast<std::uint32_t>(material_words);
-  regs.light_count = static_cast<std::uint32_t>(scene.lights.size());
-  regs.shading_record_base = static_cast<std::uint32_t>(material_words + light_words);
-  auto& bank = im.bank(memif::kShadingBank);
-  // Textures.
-  std::vector<std::uint32_t> tex_address(scene.textures.size(), memif::kNone);
-  std::uint64_t at = material_words + light_words + record_words;
-  for (std::size_t t = 0; t < scene.textures.size(); ++t) {
+  return textures;
+}
+
+// Refuses a shading bank that does not fit, naming the region that overflows.
+void check_shading_fits(const ShadingLayout& lay, std::uint64_t cap) {
+  const std::uint64_t end = lay.end();
+  if (end <= cap) return;
+  const std::uint64_t mw = lay.material_words;
+  const std::uint64_t lw = lay.light_words;
+  const std::uint64_t rw = lay.record_words;
+  const char* region = mw > cap             ? "materials"
+                       : mw + lw > cap      ? "lights"
+                       : mw + lw + rw > cap ? "shading records"
+                                            : "textures";
+  throw std::runtime_error(
+      "scene does not fit: shading bank 2 needs " + mb(end * 4) + " of " + mb(cap * 4) +
+      " (materials " + mb(mw * 4) + ", lights " + mb(lw * 4) + ", shading records " + mb(rw * 4) +
+      ", textures " + mb(lay.texel_words * 4) + "; " + region + " overflow by " +
+      mb((end - cap) * 4) + " = " + std::to_string((end - cap) * 4) + " bytes); raise --bank-mb");
+}
+
+// Writes the used textures after the shading records; returns each one's word address.
+std::vector<std::uint32_t> write_textures(BuiltImage& b, const std::vector<std::uint8_t>& used,
+                                          const std::vector<StoredTexture>& textures,
+                                          const ShadingLayout& lay) {
+  auto& bank = b.image.bank(memif::kShadingBank);
+  std::vector<std::uint32_t> tex_address(textures.size(), memif::kNone);
+  std::uint64_t at = lay.material_words + lay.light_words + lay.record_words;
+  for (std::size_t t = 0; t < textures.size(); ++t) {
     if (!used[t]) continue;
     tex_address[t] = static_cast<std::uint32_t>(at);
     std::copy(textures[t].texels.begin(), textures[t].texels.end(),
               bank.begin() + static_cast<std::ptrdiff_t>(at));
     at += textures[t].texels.size();
   }
-  // Materials.
+  return tex_address;
+}
+
+// Material m's record: colours as 8-bit channels, the texture's address and size, the secondary
+// ray weights and the two refraction ratios.
+memif::MaterialRecord material_record(const BuiltImage& b, const Material& mat, std::size_t m,
+                                      const std::vector<StoredTexture>& textures,
+                                      const std::vector<std::uint32_t>& tex_address) {
+  memif::MaterialRecord rec;
+  rec.diffuse_rgba = to8(mat.base_color.r) | (to8(mat.base_color.g) << 8) |
+                     (to8(mat.base_color.b) << 16) | (to8(mat.base_color.a) << 24);
+  const float sh = std::clamp(mat.shininess, 0.0f, 255.0f);
+  rec.specular_rgb_shininess =
+      rgb8(mat.specular) | (static_cast<std::uint32_t>(std::lround(sh)) << 24);
+  if (mat.texture >= 0) {
+    const auto t = static_cast<std::size_t>(mat.texture);
+    rec.texture = tex_address[t];
+    rec.log2_width = textures[t].log2_width;
+    rec.log2_height = textures[t].log2_height;
+  }
+  rec.reflectivity = to8(mat.reflectivity);
+  rec.transparency = to8(mat.transparency);
+  rec.refraction = to8(mat.refraction);
+  if (rec.refraction > 0) {
+    // Both ratios rounded once from binary64, so the RGS selects one instead of dividing.
+    const double ior = ior_of(mat, m);
+    rec.eta_enter = ff::from_double(1.0 / ior, b.params.format, ff::Mode{});
+    rec.eta_leave = ff::from_double(ior, b.params.format, ff::Mode{});
+  }
+  return rec;
+}
+
+// Every material's record (a scene without materials gets one default record).
+void write_materials(BuiltImage& b, const Scene& scene, std::size_t materials,
+                     const std::vector<StoredTexture>& textures,
+                     const std::vector<std::uint32_t>& tex_address) {
+  auto& bank = b.image.bank(memif::kShadingBank);
   for (std::size_t m = 0; m < materials; ++m) {
     memif::MaterialRecord rec;
-    if (m < scene.materials.size()) {
-      const Material& mat = scene.materials[m];
-      rec.diffuse_rgba = to8(mat.base_color.r) | (to8(mat.base_color.g) << 8) |
-                         (to8(mat.base_color.b) << 16) | (to8(mat.base_color.a) << 24);
-      const float sh = std::clamp(mat.shininess, 0.0f, 255.0f);
-      rec.specular_rgb_shininess =
-          rgb8(mat.specular) | (static_cast<std::uint32_t>(std::lround(sh)) << 24);
-      if (mat.texture >= 0) {
-        const auto t = static_cast<std::size_t>(mat.texture);
-        rec.texture = tex_address[t];
-        rec.log2_width = textures[t].log2_width;
-        rec.log2_height = textures[t].log2_height;
-      }
-      rec.reflectivity = to8(mat.reflectivity);
-      rec.transparency = to8(mat.transparency);
-      rec.refraction = to8(mat.refraction);
-      if (rec.refraction > 0) {
-        // Both ratios rounded once from binary64, so the RGS selects one instead of dividing.
-        const double ior = ior_of(mat, m);
-        rec.eta_enter = ff::from_double(1.0 / ior, b.params.format, ff::Mode{});
-        rec.eta_leave = ff::from_double(ior, b.params.format, ff::Mode{});
-      }
-    }
+    if (m < scene.materials.size())
+      rec = material_record(b, scene.materials[m], m, textures, tex_address);
     rec.bilinear = b.params.bilinear;
     const auto w = memif::encode_material(rec);
     std::copy(w.begin(), w.end(),
               bank.begin() + static_cast<std::ptrdiff_t>(memif::kMaterialWords * m));
   }
-  write_lights(b, scene);
-  // Shading records: one per triangle slot of every stored object.
+}
+
+// A triangle's texture coordinates in 4.12 fixed point. Subtracting the triangle's integer floor
+// is exact under repeat wrapping.
+void set_texcoords(BuiltImage& b, const Scene& scene, std::size_t oi, std::uint32_t t,
+                   memif::ShadingRecord& rec) {
+  const Object& obj = scene.objects[oi];
+  const glm::uvec3& tri = obj.triangles[t];
+  const glm::vec2 uv[3] = {obj.texcoords[tri.x], obj.texcoords[tri.y], obj.texcoords[tri.z]};
+  for (const glm::vec2& c : uv)
+    if (!std::isfinite(c.x) || !std::isfinite(c.y))
+      throw std::runtime_error(object_name(scene, oi) + " triangle " + std::to_string(t) +
+                               " has a non-finite texture coordinate");
+  const double fu = std::floor(std::min({uv[0].x, uv[1].x, uv[2].x}));
+  const double fv = std::floor(std::min({uv[0].y, uv[1].y, uv[2].y}));
+  for (int k = 0; k < 3; ++k) {
+    std::uint64_t clamped = 0;
+    rec.tex_u[k] = texcoord_4_12(static_cast<double>(uv[k].x) - fu, clamped);
+    rec.tex_v[k] = texcoord_4_12(static_cast<double>(uv[k].y) - fv, clamped);
+    b.stats.clamped_texcoords += clamped > 0 ? 1 : 0;
+  }
+}
+
+// Shading records: one per triangle slot of every stored object.
+void write_shading_records(BuiltImage& b, const Scene& scene, std::size_t materials) {
+  const memif::FrameRegisters& regs = b.image.registers();
+  auto& bank = b.image.bank(memif::kShadingBank);
   for (std::size_t oi = 0; oi < b.objects.size(); ++oi) {
     const ObjectInfo& info = b.objects[oi];
     if (!info.stored) continue;
@@ -666,23 +709,7 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
         throw std::runtime_error(object_name(scene, oi) + " triangle " + std::to_string(t) +
                                  " references material " + std::to_string(rec.material) + " of " +
                                  std::to_string(scene.materials.size()));
-      if (has_uv) {
-        const glm::uvec3& tri = obj.triangles[t];
-        const glm::vec2 uv[3] = {obj.texcoords[tri.x], obj.texcoords[tri.y], obj.texcoords[tri.z]};
-        for (const glm::vec2& c : uv)
-          if (!std::isfinite(c.x) || !std::isfinite(c.y))
-            throw std::runtime_error(object_name(scene, oi) + " triangle " + std::to_string(t) +
-                                     " has a non-finite texture coordinate");
-        // Subtracting the triangle's integer floor is exact under repeat wrapping.
-        const double fu = std::floor(std::min({uv[0].x, uv[1].x, uv[2].x}));
-        const double fv = std::floor(std::min({uv[0].y, uv[1].y, uv[2].y}));
-        for (int k = 0; k < 3; ++k) {
-          std::uint64_t clamped = 0;
-          rec.tex_u[k] = texcoord_4_12(static_cast<double>(uv[k].x) - fu, clamped);
-          rec.tex_v[k] = texcoord_4_12(static_cast<double>(uv[k].y) - fv, clamped);
-          s.clamped_texcoords += clamped > 0 ? 1 : 0;
-        }
-      }
+      if (has_uv) set_texcoords(b, scene, oi, t, rec);
       const auto w = memif::encode_shading(rec);
       const std::size_t a =
           regs.shading_record_base +
@@ -690,11 +717,39 @@ void write_shading_bank(BuiltImage& b, const Scene& scene) {
       std::copy(w.begin(), w.end(), bank.begin() + static_cast<std::ptrdiff_t>(a));
     }
   }
-  s.material_bytes = material_words * 4;
-  s.light_bytes = light_words * 4;
-  s.shading_record_bytes = record_words * 4;
-  s.texture_bytes = texel_words * 4;
-  s.bytes_per_bank[memif::kShadingBank] = end * 4;
+}
+
+void write_shading_bank(BuiltImage& b, const Scene& scene) {
+  memif::FrameRegisters& regs = b.image.registers();
+  ImageStats& s = b.stats;
+  const std::size_t materials = std::max<std::size_t>(1, scene.materials.size());
+  if (materials > 65536)
+    throw std::runtime_error("scene has " + std::to_string(materials) +
+                             " materials; shading records address at most 65536");
+  const std::vector<std::uint8_t> used = used_textures(scene);
+  if (b.params.max_texture_size < 1 || b.params.max_texture_size > 32768 ||
+      (b.params.max_texture_size & (b.params.max_texture_size - 1)) != 0)
+    throw std::runtime_error("maximum texture size " + std::to_string(b.params.max_texture_size) +
+                             " is not a power of two in 1..32768");
+  ShadingLayout lay;
+  lay.material_words = memif::kMaterialWords * materials;
+  lay.light_words = memif::kLightWords * scene.lights.size();
+  lay.record_words = memif::kShadingRecordWords * s.triangle_slots;
+  const std::vector<StoredTexture> textures = stored_textures(b, scene, used, lay);
+  check_shading_fits(lay, b.params.bank_words);
+  regs.material_base = 0;
+  regs.light_base = static_cast<std::uint32_t>(lay.material_words);
+  regs.light_count = static_cast<std::uint32_t>(scene.lights.size());
+  regs.shading_record_base = static_cast<std::uint32_t>(lay.material_words + lay.light_words);
+  const std::vector<std::uint32_t> tex_address = write_textures(b, used, textures, lay);
+  write_materials(b, scene, materials, textures, tex_address);
+  write_lights(b, scene);
+  write_shading_records(b, scene, materials);
+  s.material_bytes = lay.material_words * 4;
+  s.light_bytes = lay.light_words * 4;
+  s.shading_record_bytes = lay.record_words * 4;
+  s.texture_bytes = lay.texel_words * 4;
+  s.bytes_per_bank[memif::kShadingBank] = lay.end() * 4;
 }
 
 }  // namespace
@@ -710,6 +765,11 @@ int bottom_level_depth(const ImageParams& p, std::size_t triangles, std::size_t 
   return std::min(kd_max_depth(p.kd, triangles), p.stack_entries - top_level_depth(p, instances));
 }
 
+std::uint64_t stripe_words(std::uint64_t count, int item_words) {
+  return (count + memif::kSceneBanks - 1) / memif::kSceneBanks *
+         static_cast<std::uint64_t>(item_words);
+}
+
 std::uint64_t ImageStats::scene_bytes() const {
   std::uint64_t n = 0;
   for (int j = 0; j < memif::kSceneBanks; ++j)
@@ -717,7 +777,9 @@ std::uint64_t ImageStats::scene_bytes() const {
   return n;
 }
 
-BuiltImage build_image(const Scene& scene, const ImageParams& params) {
+namespace {
+
+void check_image_params(const ImageParams& params) {
   if (!params.format.valid())
     throw std::runtime_error("image format " + ff::format_name(params.format) +
                              " is not supported");
@@ -739,12 +801,12 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
   if (params.stack_entries < 2 || params.stack_entries > 4096)
     throw std::runtime_error("traversal stack of " + std::to_string(params.stack_entries) +
                              " entries is outside 2..4096");
-  BuiltImage b;
-  b.params = params;
-  b.params.kd.split_format = params.format;
-  const ff::Format& f = params.format;
+}
 
-  // The frame buffer and the RGS's exact int -> float pixel indices (decision D8).
+// The frame buffer's pixels, refused where the RGS's int -> float pixel indices would not be
+// exact (decision D8) or the frame buffer bank is too small.
+std::uint64_t frame_pixels(const ImageParams& params) {
+  const ff::Format& f = params.format;
   const std::uint64_t pixels = static_cast<std::uint64_t>(std::max(params.width, 0)) *
                                static_cast<std::uint64_t>(std::max(params.height, 0));
   const std::uint64_t max_index = 1ull << (f.man_bits + 1);
@@ -761,9 +823,11 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
                              std::to_string(params.width) + "x" + std::to_string(params.height) +
                              " (overflow by " + std::to_string((pixels - params.bank_words) * 4) +
                              " bytes); raise --bank-mb");
+  return pixels;
+}
 
-  // Bottom level: T_delta per slot, then the tree over the non-degenerate triangles, for every
-  // object an instance uses.
+// Every object an instance uses is stored.
+void mark_stored_objects(BuiltImage& b, const Scene& scene) {
   b.objects.resize(scene.objects.size());
   for (std::size_t i = 0; i < scene.instances.size(); ++i) {
     const std::uint32_t o = scene.instances[i].object;
@@ -772,52 +836,75 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
                                std::to_string(o) + " of " + std::to_string(scene.objects.size()));
     b.objects[o].stored = true;
   }
-  for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
-    ObjectInfo& info = b.objects[oi];
-    if (!info.stored) continue;
-    const Object& obj = scene.objects[oi];
-    const std::size_t n = obj.triangles.size();
-    if (n > memif::kNone / memif::kTriangleRows)
-      throw std::runtime_error(object_name(scene, oi) + " has too many triangles (" +
-                               std::to_string(n) + ")");
-    info.triangles = static_cast<std::uint32_t>(n);
-    info.t_delta.assign(n, std::nullopt);
-    std::vector<std::uint8_t> skip(n, 1);
-    for (std::size_t t = 0; t < n; ++t) {
-      const glm::uvec3& tri = obj.triangles[t];
-      if (tri.x >= obj.positions.size() || tri.y >= obj.positions.size() ||
-          tri.z >= obj.positions.size())
-        throw std::runtime_error(object_name(scene, oi) + " triangle " + std::to_string(t) +
-                                 " indexes a vertex beyond its " +
-                                 std::to_string(obj.positions.size()));
-      if (t < obj.degenerate.size() && obj.degenerate[t]) continue;
-      auto m = triangle_matrix(obj.positions[tri.x], obj.positions[tri.y], obj.positions[tri.z]);
-      if (!m || !fits_format(*m, f)) continue;
-      info.t_delta[t] = *m;
-      skip[t] = 0;
-    }
-    info.dropped = static_cast<std::uint32_t>(std::count(skip.begin(), skip.end(), 1));
-    const auto t0 = std::chrono::steady_clock::now();
-    if (info.dropped == n) {
-      info.tree = empty_tree();
-    } else {
-      // Top + bottom must fit the traversal stack (both levels share it).
-      KdBuildParams kd = b.params.kd;
-      kd.max_depth = bottom_level_depth(params, n - info.dropped, scene.instances.size());
-      info.tree = build_kdtree_for_units(
-          std::span<const glm::vec3>(obj.positions), std::span<const glm::uvec3>(obj.triangles),
-          std::span<const std::uint8_t>(skip), kd, static_cast<KdObjective>(params.tree_objective),
-          params.tree_objective_ratio);
-    }
-    const double secs = seconds_since(t0);
-    b.stats.bottom_build_seconds += secs;
-    ++b.stats.bottom_level_builds;
-    ++b.stats.stored_objects;
-    b.stats.triangle_slots += n;
-    b.stats.dropped_triangles += info.dropped;
-  }
+}
 
-  // Instances and the top level.
+// T_delta per triangle slot; returns the skip list of the tree (1: degenerate, or a matrix the
+// format cannot hold).
+std::vector<std::uint8_t> triangle_matrices(const Scene& scene, std::size_t oi, const ff::Format& f,
+                                            ObjectInfo& info) {
+  const Object& obj = scene.objects[oi];
+  const std::size_t n = obj.triangles.size();
+  info.t_delta.assign(n, std::nullopt);
+  std::vector<std::uint8_t> skip(n, 1);
+  for (std::size_t t = 0; t < n; ++t) {
+    const glm::uvec3& tri = obj.triangles[t];
+    if (tri.x >= obj.positions.size() || tri.y >= obj.positions.size() ||
+        tri.z >= obj.positions.size())
+      throw std::runtime_error(object_name(scene, oi) + " triangle " + std::to_string(t) +
+                               " indexes a vertex beyond its " +
+                               std::to_string(obj.positions.size()));
+    if (t < obj.degenerate.size() && obj.degenerate[t]) continue;
+    auto m = triangle_matrix(obj.positions[tri.x], obj.positions[tri.y], obj.positions[tri.z]);
+    if (!m || !fits_format(*m, f)) continue;
+    info.t_delta[t] = *m;
+    skip[t] = 0;
+  }
+  return skip;
+}
+
+// Bottom level of one stored object: T_delta per slot, then the tree over the non-degenerate
+// triangles.
+void build_bottom_level(BuiltImage& b, const Scene& scene, std::size_t oi) {
+  const ImageParams& params = b.params;
+  ObjectInfo& info = b.objects[oi];
+  const Object& obj = scene.objects[oi];
+  const std::size_t n = obj.triangles.size();
+  if (n > memif::kNone / memif::kTriangleRows)
+    throw std::runtime_error(object_name(scene, oi) + " has too many triangles (" +
+                             std::to_string(n) + ")");
+  info.triangles = static_cast<std::uint32_t>(n);
+  const std::vector<std::uint8_t> skip = triangle_matrices(scene, oi, params.format, info);
+  info.dropped = static_cast<std::uint32_t>(std::count(skip.begin(), skip.end(), 1));
+  const auto t0 = std::chrono::steady_clock::now();
+  if (info.dropped == n) {
+    info.tree = empty_tree();
+  } else {
+    // Top + bottom must fit the traversal stack (both levels share it).
+    KdBuildParams kd = params.kd;
+    kd.max_depth = bottom_level_depth(params, n - info.dropped, scene.instances.size());
+    info.tree = build_kdtree_for_units(
+        std::span<const glm::vec3>(obj.positions), std::span<const glm::uvec3>(obj.triangles),
+        std::span<const std::uint8_t>(skip), kd, static_cast<KdObjective>(params.tree_objective),
+        params.tree_objective_ratio);
+  }
+  const double secs = seconds_since(t0);
+  b.stats.bottom_build_seconds += secs;
+  ++b.stats.bottom_level_builds;
+  ++b.stats.stored_objects;
+  b.stats.triangle_slots += n;
+  b.stats.dropped_triangles += info.dropped;
+}
+
+// The top level's reserved slots: a dynamic scene's grow by top_level_headroom.
+void reserve_top_level(BuiltImage& b, double headroom) {
+  b.top_node_capacity =
+      static_cast<std::uint32_t>(std::ceil(headroom * static_cast<double>(b.top.nodes.size())));
+  b.top_list_capacity =
+      static_cast<std::uint32_t>(std::ceil(headroom * static_cast<double>(b.top.items.size())));
+}
+
+// Instances and the top level.
+void build_instances(BuiltImage& b, const Scene& scene) {
   b.instances.resize(scene.instances.size());
   for (std::size_t i = 0; i < scene.instances.size(); ++i)
     update_instance(b, i, scene.instances[i]);
@@ -825,22 +912,11 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
   bool dynamic = false;
   for (const Instance& inst : scene.instances)
     dynamic = dynamic || inst.dynamic;
-  const double headroom = dynamic ? std::max(1.0, params.top_level_headroom) : 1.0;
-  b.top_node_capacity =
-      static_cast<std::uint32_t>(std::ceil(headroom * static_cast<double>(b.top.nodes.size())));
-  b.top_list_capacity =
-      static_cast<std::uint32_t>(std::ceil(headroom * static_cast<double>(b.top.items.size())));
+  reserve_top_level(b, dynamic ? std::max(1.0, b.params.top_level_headroom) : 1.0);
+}
 
-  b.image = MemoryImage(f, params.bank_words);
-  assign_scene_layout(b);
-  write_shading_bank(b, scene);
-  write_scene_banks(b);
-  fill_scene_stats(b);
-  b.stats.frame_buffer_bytes = pixels * 4;
-  b.stats.bytes_per_bank[memif::kFrameBank0] = pixels * 4;
-  b.stats.bytes_per_bank[memif::kFrameBank1] = pixels * 4;
-
-  // Frame registers.
+void set_frame_registers(BuiltImage& b, const Scene& scene) {
+  const ImageParams& params = b.params;
   memif::FrameRegisters& regs = b.image.registers();
   regs.width = static_cast<std::uint32_t>(params.width);
   regs.height = static_cast<std::uint32_t>(params.height);
@@ -849,11 +925,34 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
   double eps = params.epsilon;
   if (!(eps > 0.0)) eps = 1e-4 * glm::length(glm::dvec3(diag));
   if (!(eps > 0.0) || !std::isfinite(eps)) eps = 1e-4;  // an empty or flat scene
-  regs.epsilon = ff::from_double(eps, f, ff::Mode{});
+  regs.epsilon = ff::from_double(eps, params.format, ff::Mode{});
   regs.ambient_rgb = params.ambient_rgb & 0xFFFFFFu;
   regs.background_rgb = params.background_rgb & 0xFFFFFFu;
   regs.max_depth = params.max_depth;
   regs.frame_bank = memif::kFrameBank0;
+}
+
+}  // namespace
+
+BuiltImage build_image(const Scene& scene, const ImageParams& params) {
+  check_image_params(params);
+  BuiltImage b;
+  b.params = params;
+  b.params.kd.split_format = params.format;
+  const std::uint64_t pixels = frame_pixels(params);
+  mark_stored_objects(b, scene);
+  for (std::size_t oi = 0; oi < scene.objects.size(); ++oi)
+    if (b.objects[oi].stored) build_bottom_level(b, scene, oi);
+  build_instances(b, scene);
+  b.image = MemoryImage(params.format, params.bank_words);
+  assign_scene_layout(b);
+  write_shading_bank(b, scene);
+  write_scene_banks(b);
+  fill_scene_stats(b);
+  b.stats.frame_buffer_bytes = pixels * 4;
+  b.stats.bytes_per_bank[memif::kFrameBank0] = pixels * 4;
+  b.stats.bytes_per_bank[memif::kFrameBank1] = pixels * 4;
+  set_frame_registers(b, scene);
   return b;
 }
 
@@ -861,14 +960,17 @@ std::uint64_t full_upload_bytes(const BuiltImage& image) {
   return image.stats.scene_bytes() + image.stats.bytes_per_bank[memif::kShadingBank];
 }
 
-UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
+namespace {
+
+// Bad input is refused before anything changes: another set of objects, instances or lights, an
+// instance that names another object or has a transform the format cannot hold, a bad camera.
+void check_rebuild_input(const BuiltImage& b, const Scene& scene) {
   if (scene.objects.size() != b.objects.size() || scene.instances.size() != b.instances.size())
     throw std::runtime_error(
         "rebuild_top_level: the scene has " + std::to_string(scene.objects.size()) +
         " objects and " + std::to_string(scene.instances.size()) +
         " instances, the image was built for " + std::to_string(b.objects.size()) + " and " +
         std::to_string(b.instances.size()));
-  // Bad input is refused before anything changes.
   for (std::size_t i = 0; i < b.instances.size(); ++i) {
     if (scene.instances[i].object != b.instances[i].object)
       throw std::runtime_error("rebuild_top_level: instance " + std::to_string(i) +
@@ -884,6 +986,42 @@ UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
         "rebuild_top_level: the scene has " + std::to_string(scene.lights.size()) +
         " lights, the image was built for " + std::to_string(b.image.registers().light_count));
   primary_basis(choose_camera(scene, b.params), b.params.width, b.params.height);
+}
+
+// The new top level written into its reserved slots with the rows of the instances that need
+// them (two copies: every row the other copy does not hold yet; one: the moved instances), or,
+// when it outgrew them, the scene banks laid out again.
+void write_new_top_level(BuiltImage& b, const std::vector<std::uint8_t>& moved, bool two,
+                         UploadDelta& d) {
+  const int rw = ff::row_words(b.params.format);
+  if (b.top.nodes.size() > b.top_node_capacity || b.top.items.size() > b.top_list_capacity) {
+    reserve_top_level(b, std::max(1.0, b.params.top_level_headroom));
+    assign_scene_layout(b);
+    write_scene_banks(b);
+    fill_scene_stats(b);
+    d.relayout = true;
+    d.relayout_bytes = b.stats.scene_bytes();
+    return;
+  }
+  write_top_level(b);
+  std::uint64_t rewritten = 0;
+  for (std::size_t i = 0; i < b.instances.size(); ++i) {
+    // The other copy holds the matrices of two frames ago: it needs every row that differs.
+    if (two ? !instance_matrix_stored(b, i) : moved[i] != 0) {
+      write_instance_matrix(b, i);
+      ++rewritten;
+    }
+  }
+  fill_scene_stats(b);
+  d.top_node_bytes = 8 * b.top.nodes.size();
+  d.top_list_bytes = 4 * b.top.items.size();
+  d.instance_row_bytes = 4ull * rw * 3 * rewritten;
+}
+
+}  // namespace
+
+UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
+  check_rebuild_input(b, scene);
   UploadDelta d;
   std::vector<std::uint8_t> moved(b.instances.size(), 0);
   for (std::size_t i = 0; i < b.instances.size(); ++i) {
@@ -908,188 +1046,8 @@ UploadDelta rebuild_top_level(BuiltImage& b, const Scene& scene) {
     name_top_copy(b);
   }
   build_top_level(b);
-  const int rw = ff::row_words(b.params.format);
-  if (b.top.nodes.size() > b.top_node_capacity || b.top.items.size() > b.top_list_capacity) {
-    const double headroom = std::max(1.0, b.params.top_level_headroom);
-    b.top_node_capacity =
-        static_cast<std::uint32_t>(std::ceil(headroom * static_cast<double>(b.top.nodes.size())));
-    b.top_list_capacity =
-        static_cast<std::uint32_t>(std::ceil(headroom * static_cast<double>(b.top.items.size())));
-    assign_scene_layout(b);
-    write_scene_banks(b);
-    fill_scene_stats(b);
-    d.relayout = true;
-    d.relayout_bytes = b.stats.scene_bytes();
-  } else {
-    write_top_level(b);
-    std::uint64_t rewritten = 0;
-    for (std::size_t i = 0; i < b.instances.size(); ++i) {
-      // The other copy holds the matrices of two frames ago: it needs every row that differs.
-      if (two ? !instance_matrix_stored(b, i) : moved[i] != 0) {
-        write_instance_matrix(b, i);
-        ++rewritten;
-      }
-    }
-    fill_scene_stats(b);
-    d.top_node_bytes = 8 * b.top.nodes.size();
-    d.top_list_bytes = 4 * b.top.items.size();
-    d.instance_row_bytes = 4ull * rw * 3 * rewritten;
-  }
+  write_new_top_level(b, moved, two, d);
   set_view_registers(b, scene);
-  return d;
-}
-
-// ---- decoding --------------------------------------------------------------------------------
-
-std::span<const std::uint32_t> DecodedImage::leaf_items(const memif::KdNode& leaf) const {
-  return std::span<const std::uint32_t>(lists).subspan(leaf.first, leaf.count);
-}
-
-EncodedAffine DecodedImage::triangle_matrix(const DecodedInstance& instance,
-                                            std::uint32_t triangle) const {
-  const std::uint64_t r0 =
-      instance.header.triangle_row_base + std::uint64_t{memif::kTriangleRows} * triangle;
-  if (r0 + 3 > rows.size())
-    throw std::runtime_error("triangle " + std::to_string(triangle) + " lies outside the rows");
-  return {rows[r0], rows[r0 + 1], rows[r0 + 2]};
-}
-
-namespace {
-
-DecodedTree extract_tree(const DecodedImage& d, std::uint32_t root) {
-  if (root >= d.nodes.size())
-    throw std::runtime_error("corrupt image: root node " + std::to_string(root) + " outside the " +
-                             std::to_string(d.nodes.size()) + " nodes");
-  std::vector<std::uint32_t> stack{root};
-  std::vector<std::uint8_t> seen(d.nodes.size(), 0);
-  std::uint32_t last = root;
-  while (!stack.empty()) {
-    const std::uint32_t k = stack.back();
-    stack.pop_back();
-    if (seen[k])
-      throw std::runtime_error("corrupt image: node " + std::to_string(k) + " is reached twice");
-    seen[k] = 1;
-    last = std::max(last, k);
-    const memif::KdNode& n = d.nodes[k];
-    if (n.leaf) {
-      if (std::uint64_t{n.first} + n.count > d.lists.size())
-        throw std::runtime_error("corrupt image: leaf " + std::to_string(k) + " lists entries " +
-                                 std::to_string(n.first) + "+" + std::to_string(n.count) +
-                                 " beyond the " + std::to_string(d.lists.size()) + " list entries");
-      continue;
-    }
-    if (n.axis > 2 || std::uint64_t{n.child_pair} + 1 >= d.nodes.size() || n.child_pair <= k)
-      throw std::runtime_error("corrupt image: node " + std::to_string(k) + " has child pair " +
-                               std::to_string(n.child_pair) + " outside the tree");
-    for (int side = 0; side < 2; ++side) {
-      const memif::KdNode& c = d.nodes[n.child_pair + static_cast<std::uint32_t>(side)];
-      if ((side == 0 ? n.empty_left : n.empty_right) != (c.leaf && c.count == 0))
-        throw std::runtime_error("corrupt image: node " + std::to_string(k) +
-                                 "'s empty flag of its " + (side == 0 ? "left" : "right") +
-                                 " child disagrees with the child");
-    }
-    stack.push_back(n.child_pair + 1);
-    stack.push_back(n.child_pair);
-  }
-  DecodedTree t;
-  t.root = root;
-  t.nodes.assign(d.nodes.begin() + root, d.nodes.begin() + last + 1);
-  return t;
-}
-
-}  // namespace
-
-DecodedImage decode_image(const memif::MemoryImage& image) {
-  DecodedImage d;
-  d.format = image.format();
-  d.registers = image.registers();
-  d.regions = image.regions();
-  const memif::SceneRegions& r = d.regions;
-  const int rw = ff::row_words(d.format);
-  const std::uint64_t end =
-      stripe_words(r.count[0], 2) + stripe_words(r.count[1], 1) + stripe_words(r.count[2], rw);
-  if (r.base[1] < stripe_words(r.count[0], 2) ||
-      r.base[2] < r.base[1] + stripe_words(r.count[1], 1) ||
-      r.base[2] + stripe_words(r.count[2], rw) > image.bank_words() || end > image.bank_words())
-    throw std::runtime_error("corrupt image: scene regions overlap or exceed the bank");
-  d.nodes.reserve(r.count[0]);
-  for (std::uint32_t i = 0; i < r.count[0]; ++i)
-    d.nodes.push_back(image.node(i));
-  d.lists.reserve(r.count[1]);
-  for (std::uint32_t i = 0; i < r.count[1]; ++i)
-    d.lists.push_back(image.list_entry(i));
-  d.rows.reserve(r.count[2]);
-  for (std::uint32_t i = 0; i < r.count[2]; ++i)
-    d.rows.push_back(image.row(i));
-
-  const memif::FrameRegisters& regs = d.registers;
-  d.top = extract_tree(d, regs.top_root);
-  const std::uint64_t inst_end =
-      regs.instance_row_base + std::uint64_t{memif::kInstanceRows} * regs.instance_count;
-  if (inst_end > d.rows.size())
-    throw std::runtime_error("corrupt image: " + std::to_string(regs.instance_count) +
-                             " instance records do not fit in the " +
-                             std::to_string(d.rows.size()) + " rows");
-  for (std::uint32_t i = 0; i < regs.instance_count; ++i) {
-    const std::uint32_t r0 = regs.instance_row_base + memif::kInstanceRows * i;
-    DecodedInstance inst;
-    for (int k = 0; k < 3; ++k)
-      inst.world_to_object[k] = d.rows[r0 + k];
-    inst.header = image.instance_header(i);
-    for (int a = 0; a < 3; ++a) {
-      inst.bounds_min[a] = d.rows[r0 + 4][a];
-      inst.bounds_max[a] = d.rows[r0 + 5][a];
-    }
-    if (!d.bottom.count(inst.header.root))
-      d.bottom.emplace(inst.header.root, extract_tree(d, inst.header.root));
-    d.instances.push_back(inst);
-  }
-  for (const auto& node : d.top.nodes)
-    if (node.leaf)
-      for (std::uint32_t item : d.leaf_items(node))
-        if (item >= regs.instance_count)
-          throw std::runtime_error("corrupt image: top-level list names instance " +
-                                   std::to_string(item) + " of " +
-                                   std::to_string(regs.instance_count));
-
-  // Shading bank, in the builder's order: materials up to the light table, lights, one shading
-  // record per triangle slot (the rows after the instance records), textures.
-  const auto& bank = image.bank(memif::kShadingBank);
-  auto need = [&](std::uint64_t from, std::uint64_t words, const char* what) {
-    if (from + words > bank.size())
-      throw std::runtime_error(std::string("corrupt image: ") + what + " beyond the shading bank");
-  };
-  if (regs.light_base < regs.material_base)
-    throw std::runtime_error("corrupt image: light table before the material table");
-  const std::uint32_t materials = (regs.light_base - regs.material_base) / memif::kMaterialWords;
-  need(regs.material_base, std::uint64_t{materials} * memif::kMaterialWords, "materials");
-  for (std::uint32_t m = 0; m < materials; ++m)
-    d.materials.push_back(
-        memif::decode_material(&bank[regs.material_base + memif::kMaterialWords * m]));
-  need(regs.light_base, std::uint64_t{regs.light_count} * memif::kLightWords, "lights");
-  for (std::uint32_t l = 0; l < regs.light_count; ++l) {
-    const std::size_t a = regs.light_base + std::size_t{memif::kLightWords} * l;
-    d.lights.push_back({{bank[a], bank[a + 1], bank[a + 2]}, bank[a + 3]});
-  }
-  const std::uint64_t records = (d.rows.size() - inst_end) / memif::kTriangleRows;
-  need(regs.shading_record_base, records * memif::kShadingRecordWords, "shading records");
-  d.shading.reserve(records);
-  for (std::uint64_t s = 0; s < records; ++s)
-    d.shading.push_back(
-        memif::decode_shading(&bank[regs.shading_record_base + memif::kShadingRecordWords * s]));
-  std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> tex;
-  for (const auto& m : d.materials)
-    if (m.texture != memif::kNone) tex[m.texture] = {m.log2_width, m.log2_height};
-  for (const auto& [address, dims] : tex) {
-    DecodedTexture t;
-    t.address = address;
-    t.width = 1u << dims.first;
-    t.height = 1u << dims.second;
-    need(address, std::uint64_t{t.width} * t.height, "texture");
-    t.texels.assign(bank.begin() + address,
-                    bank.begin() + address + std::size_t{t.width} * t.height);
-    d.textures.push_back(std::move(t));
-  }
   return d;
 }
 

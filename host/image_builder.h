@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fixedfloat/format.h"
+#include "host/image_decoder.h"
 #include "host/kdtree.h"
 #include "host/primary_rays.h"
 #include "host/scene.h"
@@ -153,6 +154,10 @@ int bottom_level_depth(const ImageParams& params, std::size_t triangles, std::si
 
 BuiltImage build_image(const Scene& scene, const ImageParams& params = {});
 
+// Words one stripe type takes in each scene bank when `count` items of `item_words` words are
+// interleaved over the three banks (the builder's layout; the decoder reads it back).
+std::uint64_t stripe_words(std::uint64_t count, int item_words);
+
 // Bytes a full upload writes: every data word of the scene banks and the shading bank.
 std::uint64_t full_upload_bytes(const BuiltImage& image);
 
@@ -189,59 +194,5 @@ struct UploadDelta {
 // instance transform or camera; throws when a relayout does not fit the banks (then `built` must be
 // built again).
 UploadDelta rebuild_top_level(BuiltImage& built, const Scene& scene);
-
-// ---- reading an image back (tests, the functional model's tests) ------------------------------
-
-// One kd-tree as stored: nodes[k] is node root + k (indices in the nodes stay absolute), covering
-// every node reachable from the root.
-struct DecodedTree {
-  std::uint32_t root = 0;
-  std::vector<memif::KdNode> nodes;
-  const memif::KdNode& node(std::uint32_t index) const { return nodes.at(index - root); }
-};
-
-struct DecodedInstance {
-  EncodedAffine world_to_object{};  // float encodings, row r = (m_r0, m_r1, m_r2, t_r)
-  memif::InstanceHeader header;
-  std::array<std::uint32_t, 3> bounds_min{};  // object-space bounds, float encodings
-  std::array<std::uint32_t, 3> bounds_max{};
-};
-
-struct DecodedLight {
-  std::array<std::uint32_t, 3> position{};  // float encodings
-  std::uint32_t rgb = 0;
-};
-
-struct DecodedTexture {
-  std::uint32_t address = 0;  // shading-bank word address of texel (0, 0)
-  std::uint32_t width = 0;
-  std::uint32_t height = 0;
-  std::vector<std::uint32_t> texels;  // RGBA8, row-major
-};
-
-struct DecodedImage {
-  ff::Format format;
-  memif::FrameRegisters registers;
-  memif::SceneRegions regions;
-  std::vector<memif::KdNode> nodes;                // every node slot
-  std::vector<std::uint32_t> lists;                // every list slot
-  std::vector<std::array<std::uint32_t, 4>> rows;  // every row slot as four encodings
-  DecodedTree top;
-  std::vector<DecodedInstance> instances;
-  std::map<std::uint32_t, DecodedTree> bottom;  // by root node index
-  std::vector<memif::MaterialRecord> materials;
-  std::vector<DecodedLight> lights;
-  std::vector<memif::ShadingRecord> shading;  // every shading record (one per triangle slot)
-  std::vector<DecodedTexture> textures;       // by ascending address
-
-  std::span<const std::uint32_t> leaf_items(const memif::KdNode& leaf) const;
-  // T_delta of triangle `triangle` of the instance's object, as float encodings.
-  EncodedAffine triangle_matrix(const DecodedInstance& instance, std::uint32_t triangle) const;
-};
-
-// Reads a whole image back through the format's accessors. Throws std::runtime_error naming the
-// first inconsistency (a child or list index outside its region, a cycle, a record outside the
-// shading bank).
-DecodedImage decode_image(const memif::MemoryImage& image);
 
 }  // namespace saarcor::host

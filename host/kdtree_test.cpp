@@ -373,17 +373,16 @@ Hit brute_force(const Ray& r, const Mesh& m) {
   return h;
 }
 
-// A plain front-to-back kd-tree traversal with a stack (binary64, with a little slack so that
-// rounding never loses a cell).
-Hit traverse(const KdTree& tree, const Ray& r, const Mesh& m, double slack) {
-  Hit h;
-  double t0 = 0.0;
-  double t1 = std::numeric_limits<double>::infinity();
+// The ray's parameter interval [t0, t1] inside the tree's bounds (widened by slack); false when
+// it misses them.
+bool clip_to_bounds(const KdTree& tree, const Ray& r, double slack, double& t0, double& t1) {
+  t0 = 0.0;
+  t1 = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 3; ++k) {
     const double lo = tree.bounds.lo[k];
     const double hi = tree.bounds.hi[k];
     if (r.d[k] == 0.0) {
-      if (r.o[k] < lo || r.o[k] > hi) return h;
+      if (r.o[k] < lo || r.o[k] > hi) return false;
       continue;
     }
     double a = (lo - r.o[k]) / r.d[k];
@@ -392,46 +391,54 @@ Hit traverse(const KdTree& tree, const Ray& r, const Mesh& m, double slack) {
     t0 = std::max(t0, a - slack);
     t1 = std::min(t1, b + slack);
   }
-  if (t0 > t1) return h;
-  struct Entry {
-    std::uint32_t node;
-    double t0;
-    double t1;
-  };
-  std::vector<Entry> stack;
+  return !(t0 > t1);
+}
+
+struct TraversalEntry {
+  std::uint32_t node;
+  double t0;
+  double t1;
+};
+
+// One inner-node step: the child to visit next, the far one pushed when the ray's interval
+// [t0, t1] reaches both.
+std::uint32_t step_inner(const KdTreeNode& nd, const Ray& r, double slack, double& t0, double& t1,
+                         std::vector<TraversalEntry>& stack) {
+  const int k = nd.axis;
+  const double o = r.o[k];
+  const double s = nd.split;
+  const std::uint32_t left = nd.child;
+  const std::uint32_t right = nd.child + 1;
+  if (r.d[k] == 0.0) {
+    if (o < s) return left;
+    if (o > s) return right;
+    stack.push_back({right, t0, t1});
+    return left;
+  }
+  const double t = (s - o) / r.d[k];
+  const bool left_first = o < s || (o == s && r.d[k] < 0.0);
+  const std::uint32_t near = left_first ? left : right;
+  const std::uint32_t far = left_first ? right : left;
+  if (t > t1 + slack || t < 0.0) return near;  // beyond the interval, or behind the origin
+  if (t < t0 - slack) return far;
+  stack.push_back({far, std::max(t0, t - slack), t1});
+  t1 = std::min(t1, t + slack);
+  return near;
+}
+
+// A plain front-to-back kd-tree traversal with a stack (binary64, with a little slack so that
+// rounding never loses a cell).
+Hit traverse(const KdTree& tree, const Ray& r, const Mesh& m, double slack) {
+  Hit h;
+  double t0 = 0.0;
+  double t1 = 0.0;
+  if (!clip_to_bounds(tree, r, slack, t0, t1)) return h;
+  std::vector<TraversalEntry> stack;
   std::uint32_t n = 0;
   for (;;) {
     const KdTreeNode& nd = tree.nodes[n];
     if (!nd.leaf) {
-      const int k = nd.axis;
-      const double o = r.o[k];
-      const double s = nd.split;
-      const std::uint32_t left = nd.child;
-      const std::uint32_t right = nd.child + 1;
-      if (r.d[k] == 0.0) {
-        if (o < s) {
-          n = left;
-        } else if (o > s) {
-          n = right;
-        } else {
-          stack.push_back({right, t0, t1});
-          n = left;
-        }
-        continue;
-      }
-      const double t = (s - o) / r.d[k];
-      const bool left_first = o < s || (o == s && r.d[k] < 0.0);
-      const std::uint32_t near = left_first ? left : right;
-      const std::uint32_t far = left_first ? right : left;
-      if (t > t1 + slack || t < 0.0) {  // beyond the interval, or behind the origin
-        n = near;
-      } else if (t < t0 - slack) {
-        n = far;
-      } else {
-        stack.push_back({far, std::max(t0, t - slack), t1});
-        n = near;
-        t1 = std::min(t1, t + slack);
-      }
+      n = step_inner(nd, r, slack, t0, t1, stack);
       continue;
     }
     for (std::uint32_t i = 0; i < nd.count; ++i) {
@@ -809,6 +816,79 @@ TEST(KdTree, ParametersBoundTheTree) {
   check_triangle_tree(deep, m, {});
 }
 
+// Whether the line r meets box b (binary64 slabs).
+bool line_meets_box(const Ray& r, const DBox& b) {
+  double t0 = -std::numeric_limits<double>::infinity();
+  double t1 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    double a = (b.lo[k] - r.o[k]) / r.d[k];
+    double c = (b.hi[k] - r.o[k]) / r.d[k];
+    if (a > c) std::swap(a, c);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, c);
+  }
+  return t0 <= t1;
+}
+
+// The tree's inner nodes, leaves and leaf items whose boxes a line passes, summed over lines.
+struct LineVisits {
+  double inner = 0.0;
+  double leaves = 0.0;
+  double tests = 0.0;
+};
+
+void count_visits(const KdTree& tree, const Ray& r, const DBox& root, LineVisits& v) {
+  std::vector<std::pair<std::uint32_t, DBox>> stack{{0, root}};
+  while (!stack.empty()) {
+    const auto [n, box] = stack.back();
+    stack.pop_back();
+    if (!line_meets_box(r, box)) continue;
+    const KdTreeNode& nd = tree.nodes[n];
+    if (nd.leaf) {
+      v.leaves += 1.0;
+      v.tests += nd.count;
+      continue;
+    }
+    v.inner += 1.0;
+    DBox l = box;
+    DBox rr = box;
+    l.hi[nd.axis] = nd.split;
+    rr.lo[nd.axis] = nd.split;
+    stack.push_back({nd.child, l});
+    stack.push_back({nd.child + 1, rr});
+  }
+}
+
+// Monte Carlo estimate of the surface-area expectations: uniformly distributed random lines
+// through the root box (the isotropic line measure, under which P(line meets a convex box | it
+// meets the root box) = area ratio); returns the visits per line.
+LineVisits visits_per_line(const KdTree& tree, int lines) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const DBox root{dv(tree.bounds.lo), dv(tree.bounds.hi)};
+  const glm::dvec3 center = 0.5 * (root.lo + root.hi);
+  const double radius = 0.5 * glm::length(root.hi - root.lo);
+  LineVisits v;
+  int done = 0;
+  while (done < lines) {
+    Ray r;
+    r.d = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+    // A uniform point on the disc through the centre perpendicular to d.
+    const glm::dvec3 e1 = glm::normalize(
+        glm::cross(r.d, std::fabs(r.d.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+    const glm::dvec3 e2 = glm::cross(r.d, e1);
+    double a = u(rng);
+    double b = u(rng);
+    if (a * a + b * b > 1.0) continue;
+    r.o = center + radius * (a * e1 + b * e2);
+    if (!line_meets_box(r, root)) continue;
+    ++done;
+    count_visits(tree, r, root, v);
+  }
+  return {v.inner / done, v.leaves / done, v.tests / done};
+}
+
 TEST(KdTree, StatisticsAreConsistent) {
   const Mesh m = random_triangles(1200, 5, 10.0f, 0.5f);
   const KdBuildParams p;
@@ -839,68 +919,10 @@ TEST(KdTree, StatisticsAreConsistent) {
   EXPECT_EQ(again.sah_cost, s.sah_cost);
   EXPECT_EQ(again.depth, s.depth);
 
-  // Monte Carlo check of the surface-area expectations: uniformly distributed random lines
-  // through the root box (the isotropic line measure, under which P(line meets a convex box |
-  // it meets the root box) = area ratio), counting the nodes whose boxes they pass.
-  std::mt19937 rng(3);
-  std::normal_distribution<double> g;
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const glm::dvec3 lo = dv(tree.bounds.lo);
-  const glm::dvec3 hi = dv(tree.bounds.hi);
-  const glm::dvec3 center = 0.5 * (lo + hi);
-  const double radius = 0.5 * glm::length(hi - lo);
-  auto meets = [](const Ray& r, const DBox& b) {
-    double t0 = -std::numeric_limits<double>::infinity();
-    double t1 = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 3; ++k) {
-      double a = (b.lo[k] - r.o[k]) / r.d[k];
-      double c = (b.hi[k] - r.o[k]) / r.d[k];
-      if (a > c) std::swap(a, c);
-      t0 = std::max(t0, a);
-      t1 = std::min(t1, c);
-    }
-    return t0 <= t1;
-  };
-  double inner = 0.0;
-  double leaves = 0.0;
-  double tests = 0.0;
-  int lines = 0;
-  while (lines < 20000 / kScale) {
-    Ray r;
-    r.d = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
-    // A uniform point on the disc through the centre perpendicular to d.
-    const glm::dvec3 e1 = glm::normalize(
-        glm::cross(r.d, std::fabs(r.d.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
-    const glm::dvec3 e2 = glm::cross(r.d, e1);
-    double a = u(rng);
-    double b = u(rng);
-    if (a * a + b * b > 1.0) continue;
-    r.o = center + radius * (a * e1 + b * e2);
-    if (!meets(r, DBox{lo, hi})) continue;
-    ++lines;
-    std::vector<std::pair<std::uint32_t, DBox>> stack{{0, DBox{lo, hi}}};
-    while (!stack.empty()) {
-      const auto [n, box] = stack.back();
-      stack.pop_back();
-      if (!meets(r, box)) continue;
-      const KdTreeNode& nd = tree.nodes[n];
-      if (nd.leaf) {
-        leaves += 1.0;
-        tests += nd.count;
-        continue;
-      }
-      inner += 1.0;
-      DBox l = box;
-      DBox rr = box;
-      l.hi[nd.axis] = nd.split;
-      rr.lo[nd.axis] = nd.split;
-      stack.push_back({nd.child, l});
-      stack.push_back({nd.child + 1, rr});
-    }
-  }
-  EXPECT_NEAR(inner / lines, s.expected_traversal_steps, 0.05 * s.expected_traversal_steps);
-  EXPECT_NEAR(leaves / lines, s.expected_leaf_visits, 0.05 * s.expected_leaf_visits);
-  EXPECT_NEAR(tests / lines, s.expected_item_tests, 0.05 * s.expected_item_tests);
+  const LineVisits per_line = visits_per_line(tree, 20000 / kScale);
+  EXPECT_NEAR(per_line.inner, s.expected_traversal_steps, 0.05 * s.expected_traversal_steps);
+  EXPECT_NEAR(per_line.leaves, s.expected_leaf_visits, 0.05 * s.expected_leaf_visits);
+  EXPECT_NEAR(per_line.tests, s.expected_item_tests, 0.05 * s.expected_item_tests);
 }
 
 // Node for node: every field of every node the same.

@@ -37,140 +37,186 @@ struct VcdFile {
   }
 };
 
-VcdFile parse_vcd(const std::string& text) {
-  VcdFile f;
-  std::istringstream in(text);
-  std::vector<std::string> tok;
-  for (std::string t; in >> t;)
-    tok.push_back(t);
-  std::size_t i = 0;
-  auto fail = [&](const std::string& m) {
-    if (f.error.empty()) f.error = m + " (token " + std::to_string(i) + ")";
-  };
-  auto skip_to_end = [&] {
-    while (i < tok.size() && tok[i] != "$end")
-      ++i;
-    if (i == tok.size()) fail("missing $end");
-    ++i;
-  };
-  std::vector<std::string> scope;
-  bool defs_done = false;
-  const std::set<std::string> var_types = {
-      "event", "integer", "parameter", "real",   "realtime", "reg",  "supply0", "supply1", "time",
-      "tri",   "triand",  "trior",     "trireg", "tri0",     "tri1", "wand",    "wire",    "wor"};
-  const std::set<std::string> scope_types = {"begin", "fork", "function", "module", "task"};
-  // Declarations.
-  while (i < tok.size() && !defs_done && f.error.empty()) {
-    const std::string& t = tok[i];
-    if (t == "$comment" || t == "$date" || t == "$version") {
-      ++i;
-      skip_to_end();
-    } else if (t == "$timescale") {
-      ++i;
-      std::string ts;
-      while (i < tok.size() && tok[i] != "$end")
-        ts += tok[i++];
-      ++i;
-      const std::set<std::string> ok = {"1s",  "10s",  "100s",  "1ms", "10ms", "100ms",
-                                        "1us", "10us", "100us", "1ns", "10ns", "100ns",
-                                        "1ps", "10ps", "100ps", "1fs", "10fs", "100fs"};
-      if (!ok.count(ts)) fail("bad timescale " + ts);
-    } else if (t == "$scope") {
-      if (i + 3 >= tok.size() || !scope_types.count(tok[i + 1]) || tok[i + 3] != "$end") {
-        fail("bad $scope");
-        break;
+// The parser behind parse_vcd: the tokens, a cursor and the first error (later ones are not
+// recorded, so the message names where the file first broke the grammar).
+class VcdParser {
+ public:
+  explicit VcdParser(const std::string& text) {
+    std::istringstream in(text);
+    for (std::string t; in >> t;)
+      tok_.push_back(t);
+  }
+
+  VcdFile parse() {
+    declarations();
+    if (!defs_done_) fail("no $enddefinitions");
+    simulation();
+    if (in_dump_) fail("unterminated dump");
+    return std::move(f_);
+  }
+
+ private:
+  void fail(const std::string& m) {
+    if (f_.error.empty()) f_.error = m + " (token " + std::to_string(i_) + ")";
+  }
+  void skip_to_end() {
+    while (i_ < tok_.size() && tok_[i_] != "$end")
+      ++i_;
+    if (i_ == tok_.size()) fail("missing $end");
+    ++i_;
+  }
+
+  // Declaration commands, up to $enddefinitions.
+  void declarations() {
+    while (i_ < tok_.size() && !defs_done_ && f_.error.empty()) {
+      const std::string& t = tok_[i_];
+      if (t == "$comment" || t == "$date" || t == "$version") {
+        ++i_;
+        skip_to_end();
+      } else if (t == "$timescale") {
+        timescale();
+      } else if (t == "$scope") {
+        if (!open_scope()) break;
+      } else if (t == "$upscope") {
+        if (scope_.empty() || i_ + 1 >= tok_.size() || tok_[i_ + 1] != "$end") fail("bad $upscope");
+        if (!scope_.empty()) scope_.pop_back();
+        i_ += 2;
+      } else if (t == "$var") {
+        if (!var()) break;
+      } else if (t == "$enddefinitions") {
+        if (!scope_.empty()) fail("unbalanced $scope");
+        ++i_;
+        if (i_ >= tok_.size() || tok_[i_] != "$end") fail("$enddefinitions without $end");
+        ++i_;
+        defs_done_ = true;
+      } else {
+        fail("unexpected token in declarations: " + t);
       }
-      scope.push_back(tok[i + 2]);
-      i += 4;
-    } else if (t == "$upscope") {
-      if (scope.empty() || i + 1 >= tok.size() || tok[i + 1] != "$end") fail("bad $upscope");
-      if (!scope.empty()) scope.pop_back();
-      i += 2;
-    } else if (t == "$var") {
-      if (i + 5 >= tok.size() || !var_types.count(tok[i + 1])) {
-        fail("bad $var");
-        break;
-      }
-      const int size = std::stoi(tok[i + 2]);
-      const std::string id = tok[i + 3];
-      std::string ref;
-      for (const auto& s : scope)
-        ref += s + ".";
-      ref += tok[i + 4];
-      i += 5;
-      if (tok[i] != "$end") {  // optional bit select [msb:lsb]
-        if (tok[i] != "[" + std::to_string(size - 1) + ":0]") fail("bad bit select " + tok[i]);
-        ++i;
-      }
-      if (tok[i] != "$end") fail("$var without $end");
-      ++i;
-      if (size < 1) fail("var size < 1");
-      for (char c : id) {
-        if (c < 33 || c > 126) fail("bad identifier code");
-      }
-      if (f.vars.count(id)) fail("identifier code declared twice: " + id);
-      if (f.history.count(ref)) fail("reference declared twice: " + ref);
-      f.vars[id] = {size, ref};
-      f.history[ref];
-    } else if (t == "$enddefinitions") {
-      if (!scope.empty()) fail("unbalanced $scope");
-      ++i;
-      if (i >= tok.size() || tok[i] != "$end") fail("$enddefinitions without $end");
-      ++i;
-      defs_done = true;
-    } else {
-      fail("unexpected token in declarations: " + t);
     }
   }
-  if (!defs_done) fail("no $enddefinitions");
-  // Simulation commands.
-  bool have_time = false;
-  std::uint64_t now = 0;
-  bool in_dump = false;
-  while (i < tok.size() && f.error.empty()) {
-    const std::string& t = tok[i];
-    auto change = [&](const std::string& id, const std::string& v, bool scalar) {
-      auto it = f.vars.find(id);
-      if (it == f.vars.end()) return fail("value change for undeclared id " + id);
-      if (!have_time) return fail("value change before the first #time");
-      if (scalar && it->second.size != 1) return fail("scalar change of a vector " + id);
-      if (!scalar && static_cast<int>(v.size()) > it->second.size) return fail("too wide");
-      f.history[it->second.ref].emplace_back(now, v);
-    };
-    if (t[0] == '#') {
-      const std::uint64_t nt = std::stoull(t.substr(1));
-      if (have_time && nt <= now) fail("time does not increase: " + t);
-      now = nt;
-      have_time = true;
-      ++i;
-    } else if (t == "$dumpvars" || t == "$dumpall" || t == "$dumpon" || t == "$dumpoff") {
-      if (in_dump) fail("nested dump");
-      in_dump = true;
-      ++i;
-    } else if (t == "$end") {
-      if (!in_dump) fail("stray $end");
-      in_dump = false;
-      ++i;
-    } else if (t == "$comment") {
-      ++i;
-      skip_to_end();
-    } else if (t[0] == 'b' || t[0] == 'B') {
+
+  void timescale() {
+    ++i_;
+    std::string ts;
+    while (i_ < tok_.size() && tok_[i_] != "$end")
+      ts += tok_[i_++];
+    ++i_;
+    const std::set<std::string> ok = {"1s",  "10s",  "100s",  "1ms", "10ms", "100ms",
+                                      "1us", "10us", "100us", "1ns", "10ns", "100ns",
+                                      "1ps", "10ps", "100ps", "1fs", "10fs", "100fs"};
+    if (!ok.count(ts)) fail("bad timescale " + ts);
+  }
+
+  bool open_scope() {
+    const std::set<std::string> scope_types = {"begin", "fork", "function", "module", "task"};
+    if (i_ + 3 >= tok_.size() || !scope_types.count(tok_[i_ + 1]) || tok_[i_ + 3] != "$end") {
+      fail("bad $scope");
+      return false;
+    }
+    scope_.push_back(tok_[i_ + 2]);
+    i_ += 4;
+    return true;
+  }
+
+  // $var type size id reference [msb:lsb] $end
+  bool var() {
+    const std::set<std::string> var_types = {
+        "event", "integer", "parameter", "real",   "realtime", "reg",  "supply0", "supply1", "time",
+        "tri",   "triand",  "trior",     "trireg", "tri0",     "tri1", "wand",    "wire",    "wor"};
+    if (i_ + 5 >= tok_.size() || !var_types.count(tok_[i_ + 1])) {
+      fail("bad $var");
+      return false;
+    }
+    const int size = std::stoi(tok_[i_ + 2]);
+    const std::string id = tok_[i_ + 3];
+    std::string ref;
+    for (const auto& s : scope_)
+      ref += s + ".";
+    ref += tok_[i_ + 4];
+    i_ += 5;
+    if (tok_[i_] != "$end") {  // optional bit select [msb:lsb]
+      if (tok_[i_] != "[" + std::to_string(size - 1) + ":0]") fail("bad bit select " + tok_[i_]);
+      ++i_;
+    }
+    if (tok_[i_] != "$end") fail("$var without $end");
+    ++i_;
+    if (size < 1) fail("var size < 1");
+    for (char c : id) {
+      if (c < 33 || c > 126) fail("bad identifier code");
+    }
+    if (f_.vars.count(id)) fail("identifier code declared twice: " + id);
+    if (f_.history.count(ref)) fail("reference declared twice: " + ref);
+    f_.vars[id] = {size, ref};
+    f_.history[ref];
+    return true;
+  }
+
+  void change(const std::string& id, const std::string& v, bool scalar) {
+    auto it = f_.vars.find(id);
+    if (it == f_.vars.end()) return fail("value change for undeclared id " + id);
+    if (!have_time_) return fail("value change before the first #time");
+    if (scalar && it->second.size != 1) return fail("scalar change of a vector " + id);
+    if (!scalar && static_cast<int>(v.size()) > it->second.size) return fail("too wide");
+    f_.history[it->second.ref].emplace_back(now_, v);
+  }
+
+  // Simulation commands: times, dump blocks, comments and value changes.
+  void simulation() {
+    while (i_ < tok_.size() && f_.error.empty()) {
+      const std::string& t = tok_[i_];
+      if (t[0] == '#') {
+        const std::uint64_t nt = std::stoull(t.substr(1));
+        if (have_time_ && nt <= now_) fail("time does not increase: " + t);
+        now_ = nt;
+        have_time_ = true;
+        ++i_;
+      } else if (t == "$dumpvars" || t == "$dumpall" || t == "$dumpon" || t == "$dumpoff") {
+        if (in_dump_) fail("nested dump");
+        in_dump_ = true;
+        ++i_;
+      } else if (t == "$end") {
+        if (!in_dump_) fail("stray $end");
+        in_dump_ = false;
+        ++i_;
+      } else if (t == "$comment") {
+        ++i_;
+        skip_to_end();
+      } else {
+        value_change(t);
+      }
+    }
+  }
+
+  // A vector change "bVALUE id" or a scalar change "Vid".
+  void value_change(const std::string& t) {
+    if (t[0] == 'b' || t[0] == 'B') {
       const std::string v = t.substr(1);
       if (v.empty() || v.find_first_not_of("01xXzZ") != std::string::npos) fail("bad vector");
-      if (i + 1 >= tok.size())
+      if (i_ + 1 >= tok_.size())
         fail("vector without id");
       else
-        change(tok[i + 1], v, false);
-      i += 2;
+        change(tok_[i_ + 1], v, false);
+      i_ += 2;
     } else if (std::string("01xXzZ").find(t[0]) != std::string::npos && t.size() >= 2) {
       change(t.substr(1), t.substr(0, 1), true);
-      ++i;
+      ++i_;
     } else {
       fail("unexpected token in simulation: " + t);
     }
   }
-  if (in_dump) fail("unterminated dump");
-  return f;
+
+  std::vector<std::string> tok_;
+  std::size_t i_ = 0;
+  VcdFile f_;
+  std::vector<std::string> scope_;
+  bool defs_done_ = false;
+  bool have_time_ = false;
+  std::uint64_t now_ = 0;
+  bool in_dump_ = false;
+};
+
+VcdFile parse_vcd(const std::string& text) {
+  return VcdParser(text).parse();
 }
 
 TEST(VcdTracer, OutputFollowsTheVcdGrammarAndCarriesWhatTheDesignDid) {

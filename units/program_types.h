@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "fixedfloat/float.h"
+#include "hw/huge_pages.h"
 #include "memif/image_format.h"
 #include "memif/request.h"
 #include "units/datapath.h"
-#include "units/huge_pages.h"
 #include "units/unit_fp.h"
 
 namespace saarcor::units {
@@ -284,9 +284,9 @@ struct FrameSink {
     std::array<std::uint32_t, 3> o{}, d{};
     RayCounters counters;
   };
-  // (HugePageAllocator: a frame's buffers are first touched in 2 MiB pages.)
-  std::vector<Pixel, HugePageAllocator<Pixel>> pixels;
-  std::vector<std::array<std::uint32_t, 3>, HugePageAllocator<std::array<std::uint32_t, 3>>>
+  // (hw::HugePageAllocator: a frame's buffers are first touched in 2 MiB pages.)
+  std::vector<Pixel, hw::HugePageAllocator<Pixel>> pixels;
+  std::vector<std::array<std::uint32_t, 3>, hw::HugePageAllocator<std::array<std::uint32_t, 3>>>
       colour_sum;  // sum of weight * colour (docs 7)
   std::array<RayCounters, kRayKinds> by_kind{};
   std::array<std::uint64_t, kRayKinds> rays_issued{};
