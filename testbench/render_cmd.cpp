@@ -20,7 +20,7 @@
 #include "testbench/heartbeat.h"
 #include "testbench/hit_exr.h"
 #include "testbench/image_io.h"
-#include "testbench/run_dir.h"
+#include "testbench/report.h"
 #include "units/functional_model.h"
 #include "units/request_trace.h"
 
@@ -46,11 +46,6 @@ std::uint32_t float_bits(float f) {
   std::uint32_t b;
   std::memcpy(&b, &f, 4);
   return b;
-}
-
-std::string describe_format(ff::Format f) {
-  return "Float<" + std::to_string(f.exp_bits) + "," + std::to_string(f.man_bits) + "> (" +
-         ff::format_name(f) + ")";
 }
 
 // ---- float reference ---------------------------------------------------------------------------
@@ -84,16 +79,6 @@ PixelHit to_pixel_hit(const host::FloatHit& h, std::uint32_t instance_id, const 
   return p;
 }
 
-nlohmann::json counter_json(const std::vector<std::pair<const char*, std::uint64_t>>& totals,
-                            std::uint64_t rays) {
-  nlohmann::json j;
-  for (const auto& [name, total] : totals) {
-    j[name] = {{"total", total},
-               {"per_ray", rays ? static_cast<double>(total) / static_cast<double>(rays) : 0.0}};
-  }
-  return j;
-}
-
 FrameResult render_float_frame(const PreparedScene& prep, const RenderSettings& settings) {
   FrameResult r;
   r.model = "float";
@@ -112,13 +97,8 @@ FrameResult render_float_frame(const PreparedScene& prep, const RenderSettings& 
   r.image.rgb = frame.rgb;
   const host::FloatTraceStats& s = frame.stats;
   r.rays = s.rays;
-  r.counters["per_ray"] = counter_json({{"traversal_steps", s.traversal_steps},
-                                        {"leaves", s.leaves},
-                                        {"list_entries", s.list_entries},
-                                        {"mailbox_skips", s.mailbox_skips},
-                                        {"transformations", s.transformations},
-                                        {"intersections", s.intersections}},
-                                       s.rays);
+  r.counter_stats = float_counter_stats(s);
+  r.counters = nest(r.counter_stats);
   r.counters["note"] = "float reference: counters of primary rays; binary32 ops are not counted";
   return r;
 }
@@ -204,11 +184,6 @@ PixelHit functional_pixel_hit(const units::FrameSink::Pixel& p, ff::Format f,
   return h;
 }
 
-nlohmann::json ops_json(const ff::OpCounts& c) {
-  return {{"add", c.add},   {"mul", c.mul}, {"div", c.div},
-          {"sqrt", c.sqrt}, {"cmp", c.cmp}, {"total", c.total()}};
-}
-
 FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene& prep,
                                     const RenderSettings& settings) {
   FrameResult r;
@@ -236,41 +211,8 @@ FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene&
   r.image.width = frame.width;
   r.image.height = frame.height;
   r.image.rgb = frame.rgb;
-  nlohmann::json per_kind;
-  for (int k = 0; k < units::kRayKinds; ++k) {
-    const units::RayCounters& c = frame.by_kind[k];
-    const std::uint64_t n = frame.rays_issued[k];
-    r.rays += n;
-    nlohmann::json j = counter_json({{"traversal_steps", c.traversal_steps},
-                                     {"list_entries", c.list_entries},
-                                     {"mailbox_skips", c.mailbox_skips},
-                                     {"transformations", c.transformations},
-                                     {"intersections", c.intersections}},
-                                    n);
-    j["rays_issued"] = n;
-    j["rays_returned"] = frame.rays_returned[k];
-    per_kind[units::ray_kind_name(static_cast<units::RayKind>(k))] = j;
-  }
-  r.counters["per_ray"] = per_kind;
-  const units::UnitStats& u = frame.units;
-  r.counters["ops"] = {{"traversal", ops_json(u.traversal_ops)},
-                       {"transformation", ops_json(u.transformation_ops)},
-                       {"intersection", ops_json(u.intersection_ops)},
-                       {"rgs", ops_json(u.rgs_ops)}};
-  r.counters["units"] = {{"traversal_steps", u.traversal_steps},
-                         {"inner_steps", u.inner_steps},
-                         {"clip_steps", u.clip_steps},
-                         {"clips", u.clips},
-                         {"exit_only_clips", u.exit_only_clips},
-                         {"list_steps", u.list_steps},
-                         {"transformation_steps", u.transformation_steps},
-                         {"shading_transformation_steps", u.shading_transformation_steps},
-                         {"intersection_packets", u.intersection_packets},
-                         {"sub_packets", u.sub_packets},
-                         {"stack_drops", u.stack_drops},
-                         {"empty_leaf_steps", u.empty_leaf_steps},
-                         {"packets", u.packets},
-                         {"requests", u.requests}};
+  r.counter_stats = functional_counter_stats(frame, r.rays);
+  r.counters = nest(r.counter_stats);
   return r;
 }
 
@@ -295,14 +237,14 @@ FrameResult render_cycle_frame(const ModelSpec& model, const PreparedScene& prep
   r.rays = c.rays;
   r.cycle = cycle_report_json(c);
   // The trees are part of the configuration an architect sweeps (kd.* keys).
-  for (const host::TreeSettingInfo& t : host::describe_tree_settings(prep.built.params))
-    r.cycle["configuration"][t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
+  r.cycle["configuration"].update(tree_configuration_json(prep.built.params));
   r.table4 = table4_text(c, prep.spec);
-  r.counters["per_ray"] = r.cycle["per_ray"];
-  r.counters["ops"] = {{"traversal", ops_json(c.frame.units.traversal_ops)},
-                       {"transformation", ops_json(c.frame.units.transformation_ops)},
-                       {"intersection", ops_json(c.frame.units.intersection_ops)},
-                       {"rgs", ops_json(c.frame.units.rgs_ops)}};
+  // The per-ray counters of the frame report and the float units' op counts.
+  for (ReportStat& st : cycle_stats(c))
+    if (st.name.starts_with("per_ray.")) r.counter_stats.push_back(std::move(st));
+  for (ReportStat& st : op_stats(c.frame.units))
+    r.counter_stats.push_back(std::move(st));
+  r.counters = nest(r.counter_stats);
   return r;
 }
 
@@ -655,50 +597,6 @@ PixelHit cycle_pixel(const ModelSpec& model, const PreparedScene& prep, RenderSe
   return h;
 }
 
-// --out-dir: the report without host timing, which goes to host.json; the configuration alone;
-// every statistic one per line; the command line. File names in the report are relative to the
-// folder, so a run folder reads the same wherever it is moved.
-void write_run_files(const RenderOptions& opts, nlohmann::json report, const FrameResult& frame,
-                     std::vector<std::pair<std::string, std::string>>& outputs) {
-  nlohmann::json host;
-  host["seconds"] = report["seconds"];
-  host["rays_per_second"] = report["rays_per_second"];
-  host["load_seconds"] = report["configuration"]["load_seconds"];
-  host["build_seconds"] = report["configuration"]["build_seconds"];
-  report.erase("seconds");
-  report.erase("rays_per_second");
-  report["configuration"].erase("load_seconds");
-  report["configuration"].erase("build_seconds");
-  if (report.contains("host")) host["cycle_model"] = take_cycle_host(report);
-  outputs.push_back({"report", run_file(opts.out_dir, "report.json")});
-  outputs.push_back({"stats", run_file(opts.out_dir, "stats.txt")});
-  outputs.push_back({"config", run_file(opts.out_dir, "config.json")});
-  outputs.push_back({"command", run_file(opts.out_dir, "command.txt")});
-  outputs.push_back({"host", run_file(opts.out_dir, "host.json")});
-  nlohmann::json names;
-  for (const auto& [k, v] : outputs)
-    names[k] = std::filesystem::path(v).filename().string();
-  report["outputs"] = names;
-
-  nlohmann::json config = report["configuration"];
-  config["scene"] = report["scene"];
-  config["model"] = report["model"];
-  config["resolution"] = report["resolution"];
-  std::vector<StatLine> stats;
-  if (!frame.cycle.is_null()) {
-    append_cycle_stats(stats, frame.cycle);
-  } else {
-    stats.push_back({"rays", static_cast<double>(frame.rays), "rays traced (count)"});
-    append_counter_stats(stats, frame.counters);
-  }
-
-  write_text_file(run_file(opts.out_dir, "report.json"), report.dump(2) + "\n");
-  write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text(stats));
-  write_text_file(run_file(opts.out_dir, "config.json"), config.dump(2) + "\n");
-  write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
-  write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
-}
-
 }  // namespace
 
 int run_render(const RenderOptions& opts) {
@@ -793,49 +691,11 @@ int run_render(const RenderOptions& opts) {
   const double rays_per_s = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
   const std::string report = in_dir ? run_file(opts.out_dir, "report.json") : opts.report;
   if (!report.empty()) {
-    nlohmann::json j;
-    j["scene"] = opts.scene;
-    j["model"] = model.name;
-    j["resolution"] = {{"width", settings.res.width}, {"height", settings.res.height}};
-    j["seconds"] = frame.seconds;
-    j["rays"] = frame.rays;
-    j["rays_per_second"] = rays_per_s;
-    j["counters"] = frame.counters;
-    const auto& st = prep.built.stats;
-    j["configuration"] = {{"time", settings.time},
-                          {"shadows", settings.shadows},
-                          {"depth", settings.depth},
-                          {"image_format", describe_format(prep.built.params.format)},
-                          {"bank_words", prep.built.params.bank_words},
-                          {"bank_mb", settings.bank_mb},
-                          {"instances", prep.scene.instances.size()},
-                          {"objects", prep.scene.objects.size()},
-                          {"triangles_unique", prep.scene.unique_triangles()},
-                          {"triangles_instanced", prep.scene.instanced_triangles()},
-                          {"triangles_dropped", st.dropped_triangles},
-                          {"scene_bytes", st.scene_bytes()},
-                          {"light_defaulted", prep.scene.light_defaulted},
-                          {"load_seconds", prep.load_seconds},
-                          {"build_seconds", prep.build_seconds}};
-    if (!frame.cycle.is_null()) {  // the cycle model's figures at the top, its parameters inside
-      nlohmann::json c = frame.cycle;
-      j["configuration"]["cycle"] = c["configuration"];
-      c.erase("configuration");
-      j.update(c);
-    } else {  // the other models read the same trees: their keys are configuration too
-      for (const host::TreeSettingInfo& t : host::describe_tree_settings(prep.built.params))
-        j["configuration"]["trees"][t.name] = {
-            {"value", t.value}, {"unit", t.unit}, {"help", t.help}};
-    }
+    nlohmann::json j = render_report_json(opts.scene, model.name, frame, prep, settings);
     if (in_dir) {
-      write_run_files(opts, j, frame, outputs);
+      write_render_folder(opts.out_dir, std::move(j), frame, opts.argv, outputs);
     } else {
-      nlohmann::json out;
-      for (const auto& [k, v] : outputs)
-        out[k] = v;
-      j["outputs"] = out;
-      write_text_file(report, j.dump(2) + "\n");
-      outputs.push_back({"report", report});
+      write_render_report(report, std::move(j), outputs);
     }
   }
   std::printf("saarcor render: %s, model %s, %dx%d, %.3f s, %" PRIu64 " rays (%.3g rays/s)\n",
