@@ -599,17 +599,15 @@ PixelHit cycle_pixel(const ModelSpec& model, const PreparedScene& prep, RenderSe
 
 }  // namespace
 
-int run_render(const RenderOptions& opts) {
-  if (opts.frames_given) return run_frame_sequence(opts);
-  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty())
-    throw std::runtime_error("--fps, --dt, --frame-gap and --bus-sweep need --frames N");
-  const ModelSpec model = parse_model(opts.model);
-  RenderSettings settings =
-      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
-  settings.cycle = opts.cycle;
-  int threads = 0;  // the cycle model's threads over all DynRTPs (--konata-threads)
+namespace {
+
+// The render's options checked before the scene loads (a bad one costs no render): the model's
+// own options, --pixel, the traces, the output names. Returns the cycle model's threads over all
+// DynRTPs (--konata-threads; 0 for the other models).
+int check_render_options(const RenderOptions& opts, const ModelSpec& model,
+                         const std::optional<PixelCoord>& pixel) {
+  int threads = 0;
   if (model.kind == ModelKind::kCycle) {
-    // A bad --preset/--set fails before the scene loads.
     const units::CycleParams cp = resolve_cycle_params(opts.cycle);
     threads = cp.pipelines * cp.threads;
   } else if (opts.cycle.any_given()) {
@@ -617,12 +615,8 @@ int run_render(const RenderOptions& opts) {
         "--preset, --set (but kd.* keys), --interval, --host-threads and --vcd apply to --model "
         "cycle only");
   }
-  std::optional<PixelCoord> pixel;
-  if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
   check_trace_options(opts.trace, model, pixel.has_value());
-  // Output names are checked before the work, so a bad one costs no render.
-  const bool in_dir = !opts.out_dir.empty();
-  if (in_dir) {
+  if (!opts.out_dir.empty()) {
     check_out_dir(opts.out_dir);
     if (opts.out_given || !opts.report.empty() || !opts.hits.empty())
       throw std::runtime_error(
@@ -632,50 +626,49 @@ int run_render(const RenderOptions& opts) {
   } else if (opts.hits_asked && opts.hits.empty()) {
     throw std::runtime_error("bad --hits: expected a file name FILE.exr (or --out-dir DIR)");
   }
-  const std::string out =
-      in_dir ? run_file(opts.out_dir, "image") : output_prefix(opts.out, {".png", ".exr"});
+  if (opts.out_dir.empty()) output_prefix(opts.out, {".png", ".exr"});  // throws on a bad --out
   if (!opts.hits.empty() && !opts.hits.ends_with(".exr")) {
     throw std::runtime_error("bad --hits '" + opts.hits + "': a hit EXR file name ends in .exr");
   }
   if (!opts.report.empty() && !opts.report.ends_with(".json")) {
     throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
   }
+  return threads;
+}
 
-  TraceFiles traces(opts.trace, threads);  // opened now: an unwritable one costs no render
-  settings.trace = traces.run;
-
-  const ff::Format format =
-      model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
-  const PreparedScene prep = prepare_scene(opts.scene, settings, format);
-
-  if (pixel) {
-    std::vector<std::string> cycle_lines;
-    const PixelHit h = model.kind == ModelKind::kCycle
-                           ? cycle_pixel(model, prep, settings, *pixel, cycle_lines)
-                           : trace_pixel(model, prep, settings, *pixel);
-    std::printf("saarcor render %s --model %s --res %dx%d --time %g\n%s", opts.scene.c_str(),
-                model.name.c_str(), settings.res.width, settings.res.height, settings.time,
-                format_pixel_hit(*pixel, h).c_str());
-    if (model.kind == ModelKind::kFunctional) {
-      // Every unit request of the pixel's packet, in the order the thread program made them.
-      const units::PixelTrace t =
-          units::trace_pixel(prep.built.image, functional_params(settings), pixel->x, pixel->y);
-      for (const std::string& line : t.log)
-        std::printf("  %s\n", line.c_str());
-    }
-    // The cycle model: every request of the pixel's packet with the cycle a unit issued it.
-    for (const std::string& line : cycle_lines)
+// --pixel x,y: the pixel's hit record and every unit request of its packet.
+void print_pixel(const RenderOptions& opts, const ModelSpec& model, const PreparedScene& prep,
+                 const RenderSettings& settings, PixelCoord pixel) {
+  std::vector<std::string> cycle_lines;
+  const PixelHit h = model.kind == ModelKind::kCycle
+                         ? cycle_pixel(model, prep, settings, pixel, cycle_lines)
+                         : trace_pixel(model, prep, settings, pixel);
+  std::printf("saarcor render %s --model %s --res %dx%d --time %g\n%s", opts.scene.c_str(),
+              model.name.c_str(), settings.res.width, settings.res.height, settings.time,
+              format_pixel_hit(pixel, h).c_str());
+  if (model.kind == ModelKind::kFunctional) {
+    // Every unit request of the pixel's packet, in the order the thread program made them.
+    const units::PixelTrace t =
+        units::trace_pixel(prep.built.image, functional_params(settings), pixel.x, pixel.y);
+    for (const std::string& line : t.log)
       std::printf("  %s\n", line.c_str());
-    return 0;
   }
+  // The cycle model: every request of the pixel's packet with the cycle a unit issued it.
+  for (const std::string& line : cycle_lines)
+    std::printf("  %s\n", line.c_str());
+}
 
-  progress("rendering " + std::to_string(settings.res.width) + "x" +
-           std::to_string(settings.res.height) + " with the " + model.name + " model");
-  const FrameResult frame = render_model(model, prep, settings);
-
+// The frame's image (and float EXR), hit EXR and report, each added to `outputs`.
+void write_frame_outputs(const RenderOptions& opts, const ModelSpec& model,
+                         const PreparedScene& prep, const RenderSettings& settings,
+                         const FrameResult& frame, TraceFiles& traces,
+                         std::vector<std::pair<std::string, std::string>>& outputs) {
+  const bool in_dir = !opts.out_dir.empty();
+  const std::string out =
+      in_dir ? run_file(opts.out_dir, "image") : output_prefix(opts.out, {".png", ".exr"});
   const std::string png = out + ".png";
   write_rgb8(png, frame.image);
-  std::vector<std::pair<std::string, std::string>> outputs = {{"image", png}};
+  outputs.push_back({"image", png});
   traces.finish(outputs);
   if (opts.exr) {
     const std::string exr = out + ".exr";
@@ -688,16 +681,46 @@ int run_render(const RenderOptions& opts) {
     write_hit_exr(hits, frame.hits);
     outputs.push_back({"hits", hits});
   }
-  const double rays_per_s = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
-  const std::string report = in_dir ? run_file(opts.out_dir, "report.json") : opts.report;
-  if (!report.empty()) {
-    nlohmann::json j = render_report_json(opts.scene, model.name, frame, prep, settings);
-    if (in_dir) {
-      write_render_folder(opts.out_dir, std::move(j), frame, opts.argv, outputs);
-    } else {
-      write_render_report(report, std::move(j), outputs);
-    }
+  if (in_dir) {
+    write_render_folder(opts.out_dir,
+                        render_report_json(opts.scene, model.name, frame, prep, settings), frame,
+                        opts.argv, outputs);
+  } else if (!opts.report.empty()) {
+    write_render_report(opts.report,
+                        render_report_json(opts.scene, model.name, frame, prep, settings), outputs);
   }
+}
+
+}  // namespace
+
+int run_render(const RenderOptions& opts) {
+  if (opts.frames_given) return run_frame_sequence(opts);
+  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty())
+    throw std::runtime_error("--fps, --dt, --frame-gap and --bus-sweep need --frames N");
+  const ModelSpec model = parse_model(opts.model);
+  RenderSettings settings =
+      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
+  settings.cycle = opts.cycle;
+  std::optional<PixelCoord> pixel;
+  if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
+  const int threads = check_render_options(opts, model, pixel);
+  TraceFiles traces(opts.trace, threads);  // opened now: an unwritable one costs no render
+  settings.trace = traces.run;
+
+  const ff::Format format =
+      model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
+  const PreparedScene prep = prepare_scene(opts.scene, settings, format);
+  if (pixel) {
+    print_pixel(opts, model, prep, settings, *pixel);
+    return 0;
+  }
+
+  progress("rendering " + std::to_string(settings.res.width) + "x" +
+           std::to_string(settings.res.height) + " with the " + model.name + " model");
+  const FrameResult frame = render_model(model, prep, settings);
+  std::vector<std::pair<std::string, std::string>> outputs;
+  write_frame_outputs(opts, model, prep, settings, frame, traces, outputs);
+  const double rays_per_s = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
   std::printf("saarcor render: %s, model %s, %dx%d, %.3f s, %" PRIu64 " rays (%.3g rays/s)\n",
               opts.scene.c_str(), model.name.c_str(), settings.res.width, settings.res.height,
               frame.seconds, frame.rays, rays_per_s);

@@ -14,6 +14,7 @@
 #include "host/tree_settings.h"
 #include "testbench/frame_sequence.h"
 #include "testbench/image_io.h"
+#include "testbench/paper_cmd.h"
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
 #include "testbench/sweep_cmd.h"
@@ -815,6 +816,52 @@ void write_sweep_folder(const SweepOptions& opts, const SweepResult& sweep,
 
 // ---- precision ------------------------------------------------------------------------------
 
+namespace {
+
+// One format's row of the precision report.
+nlohmann::json precision_row_json(const PrecisionRow& r) {
+  nlohmann::json row;
+  row["mantissa"] = r.mantissa;
+  row["format"] = ff::format_name(ff::Format{7, r.mantissa});
+  row["same_triangle_pct"] = r.same_triangle_pct;
+  row["psnr_db"] = std::isfinite(r.psnr_db) ? nlohmann::json(r.psnr_db) : nlohmann::json();
+  row["t_rel_err_median"] = r.t_rel_err_median ? nlohmann::json(*r.t_rel_err_median) : nullptr;
+  row["t_rel_err_max"] = r.t_rel_err_max ? nlohmann::json(*r.t_rel_err_max) : nullptr;
+  row["mismatches"] = {{"hit_vs_miss", r.mismatches.hit_vs_miss},
+                       {"edge_tie", r.mismatches.edge_tie},
+                       {"grazing", r.mismatches.grazing},
+                       {"other", r.mismatches.other}};
+  return row;
+}
+
+// One format's statistics (stats.txt), named eM.NAME.
+void precision_row_stats(const PrecisionRow& r, std::vector<StatLine>& stats) {
+  const std::string m = "e7m" + std::to_string(r.mantissa) + ".";
+  const std::string of = " of Float<7," + std::to_string(r.mantissa) + "> against float";
+  stats.push_back({m + "same_triangle_pct", r.same_triangle_pct,
+                   "% of pixels hitting the same triangle" + of, "%"});
+  // Identical images have no finite PSNR; stats.txt carries the number, so infinity is left
+  // out rather than printed as a value no parser agrees on.
+  if (std::isfinite(r.psnr_db))
+    stats.push_back({m + "psnr_db", r.psnr_db, "image PSNR" + of, "dB"});
+  if (r.t_rel_err_median)
+    stats.push_back({m + "t_rel_err_median", *r.t_rel_err_median,
+                     "median relative hit-distance error" + of, "ratio"});
+  if (r.t_rel_err_max)
+    stats.push_back({m + "t_rel_err_max", *r.t_rel_err_max,
+                     "largest relative hit-distance error" + of, "ratio"});
+  stats.push_back({m + "mismatches.hit_vs_miss", static_cast<double>(r.mismatches.hit_vs_miss),
+                   "pixels where one hits and the other misses", "pixels"});
+  stats.push_back({m + "mismatches.edge_tie", static_cast<double>(r.mismatches.edge_tie),
+                   "different triangles, hit on a shared edge", "pixels"});
+  stats.push_back({m + "mismatches.grazing", static_cast<double>(r.mismatches.grazing),
+                   "different triangles, grazing ray", "pixels"});
+  stats.push_back({m + "mismatches.other", static_cast<double>(r.mismatches.other),
+                   "different triangles, other cause", "pixels"});
+}
+
+}  // namespace
+
 void write_precision_report(const std::string& json, const std::string& out_dir,
                             const std::string& scene, const RenderSettings& settings, int lo,
                             int hi, const std::vector<PrecisionRow>& rows,
@@ -827,66 +874,104 @@ void write_precision_report(const std::string& json, const std::string& out_dir,
   nlohmann::json host;  // --out-dir: the frames' wall-clock seconds, apart from the results
   std::vector<StatLine> stats;
   for (const PrecisionRow& r : rows) {
-    nlohmann::json row;
-    row["mantissa"] = r.mantissa;
-    row["format"] = ff::format_name(ff::Format{7, r.mantissa});
-    row["same_triangle_pct"] = r.same_triangle_pct;
-    row["psnr_db"] = std::isfinite(r.psnr_db) ? nlohmann::json(r.psnr_db) : nlohmann::json();
-    row["t_rel_err_median"] = r.t_rel_err_median ? nlohmann::json(*r.t_rel_err_median) : nullptr;
-    row["t_rel_err_max"] = r.t_rel_err_max ? nlohmann::json(*r.t_rel_err_max) : nullptr;
-    row["mismatches"] = {{"hit_vs_miss", r.mismatches.hit_vs_miss},
-                         {"edge_tie", r.mismatches.edge_tie},
-                         {"grazing", r.mismatches.grazing},
-                         {"other", r.mismatches.other}};
+    nlohmann::json row = precision_row_json(r);
     if (in_dir) {
       host["rows"].push_back({{"mantissa", r.mantissa}, {"seconds", r.seconds}});
     } else {
       row["seconds"] = r.seconds;
     }
     j["rows"].push_back(row);
-    const std::string m = "e7m" + std::to_string(r.mantissa) + ".";
-    const std::string of = " of Float<7," + std::to_string(r.mantissa) + "> against float";
-    stats.push_back({m + "same_triangle_pct", r.same_triangle_pct,
-                     "% of pixels hitting the same triangle" + of, "%"});
-    // Identical images have no finite PSNR; stats.txt carries the number, so infinity is left
-    // out rather than printed as a value no parser agrees on.
-    if (std::isfinite(r.psnr_db))
-      stats.push_back({m + "psnr_db", r.psnr_db, "image PSNR" + of, "dB"});
-    if (r.t_rel_err_median)
-      stats.push_back({m + "t_rel_err_median", *r.t_rel_err_median,
-                       "median relative hit-distance error" + of, "ratio"});
-    if (r.t_rel_err_max)
-      stats.push_back({m + "t_rel_err_max", *r.t_rel_err_max,
-                       "largest relative hit-distance error" + of, "ratio"});
-    stats.push_back({m + "mismatches.hit_vs_miss", static_cast<double>(r.mismatches.hit_vs_miss),
-                     "pixels where one hits and the other misses", "pixels"});
-    stats.push_back({m + "mismatches.edge_tie", static_cast<double>(r.mismatches.edge_tie),
-                     "different triangles, hit on a shared edge", "pixels"});
-    stats.push_back({m + "mismatches.grazing", static_cast<double>(r.mismatches.grazing),
-                     "different triangles, grazing ray", "pixels"});
-    stats.push_back({m + "mismatches.other", static_cast<double>(r.mismatches.other),
-                     "different triangles, other cause", "pixels"});
+    precision_row_stats(r, stats);
   }
-  if (in_dir) {
-    j["outputs"] = {{"plot", "precision.png"}, {"report", "report.json"},  {"stats", "stats.txt"},
-                    {"config", "config.json"}, {"command", "command.txt"}, {"host", "host.json"}};
-    // The study's whole configuration: the frame, the formats, and the tree keys every format's
-    // image is built with (at their defaults: the study has no --set).
-    host::ImageParams trees;
-    nlohmann::json config;
-    config["scene"] = scene;
-    config["resolution"] = j["resolution"];
-    config["bank_mb"] = settings.bank_mb;
-    config["mantissa"] = {{"from", lo}, {"to", hi}};
-    config["exponent_bits"] = 7;
-    config["reference"] = "float";
-    config["shadows"] = settings.shadows;
-    config["depth"] = settings.depth;
-    config["trees"] = tree_configuration_json(trees);
-    write_run_folder({out_dir, j, std::move(config), std::move(host), stats_text(stats), argv, {}});
-  } else {
+  if (!in_dir) {
     write_text_file(json, j.dump(2) + "\n");
+    return;
   }
+  j["outputs"] = {{"plot", "precision.png"}, {"report", "report.json"},  {"stats", "stats.txt"},
+                  {"config", "config.json"}, {"command", "command.txt"}, {"host", "host.json"}};
+  // The study's whole configuration: the frame, the formats, and the tree keys every format's
+  // image is built with (at their defaults: the study has no --set).
+  nlohmann::json config;
+  config["scene"] = scene;
+  config["resolution"] = j["resolution"];
+  config["bank_mb"] = settings.bank_mb;
+  config["mantissa"] = {{"from", lo}, {"to", hi}};
+  config["exponent_bits"] = 7;
+  config["reference"] = "float";
+  config["shadows"] = settings.shadows;
+  config["depth"] = settings.depth;
+  config["trees"] = tree_configuration_json(host::ImageParams{});
+  write_run_folder({out_dir, j, std::move(config), std::move(host), stats_text(stats), argv, {}});
+}
+
+// ---- the paper's tables ---------------------------------------------------------------------
+
+namespace {
+
+// A figure's model value over the paper's (0 where the paper has none).
+double paper_ratio(const PaperFigure& f) {
+  return f.paper == 0.0 ? 0.0 : f.model / f.paper;
+}
+
+}  // namespace
+
+nlohmann::json paper_entry_json(int table, const std::string& paper, const std::string& scene,
+                                bool reference, const std::string& resolution,
+                                const std::vector<PaperFigure>& figures,
+                                const std::vector<std::string>& settings,
+                                const nlohmann::json& cycle) {
+  nlohmann::json e;
+  e["table"] = table;
+  e["paper_scene"] = paper;
+  e["scene"] = scene;
+  e["kind"] = reference ? "reference" : "stand-in";
+  e["resolution"] = resolution;
+  e["paper_resolution"] = table == 3 ? "512x384" : "1024x768";
+  nlohmann::json fj = nlohmann::json::object();
+  for (const PaperFigure& g : figures)
+    fj[g.key] = {{"model", g.model}, {"paper", g.paper}, {"ratio", paper_ratio(g)}};
+  e["figures"] = fj;
+  e["configuration"] = settings;
+  e["report"] = cycle;
+  return e;
+}
+
+nlohmann::json paper_tables_json(int scale, const std::vector<std::string>& set,
+                                 std::vector<nlohmann::json>& per_scene) {
+  nlohmann::json entries = nlohmann::json::array();
+  for (nlohmann::json& scene_entries : per_scene)
+    for (nlohmann::json& e : scene_entries)
+      entries.push_back(std::move(e));
+  nlohmann::json j;
+  j["scale"] = scale;
+  j["configuration"] = set;  // each entry lists its own, the paper's filter included
+  j["entries"] = entries;
+  return j;
+}
+
+nlohmann::json thread_curve_json(const std::vector<int>& counts,
+                                 const std::vector<nlohmann::json>& reports,
+                                 const std::string& resolution) {
+  nlohmann::json rows = nlohmann::json::array();
+  double first = 0.0, last = 0.0;
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const int t = counts[i];
+    const nlohmann::json& report = reports[i];
+    const double fps = report["fps"].get<double>();
+    if (t == 1) first = fps;
+    // The paper: nearly linear up to 32 threads, about +10 % from 32 to 64.
+    const double paper_step = t == 1 ? 1.0 : t <= 32 ? 2.0 : 1.10;
+    const double step = t == 1 ? 1.0 : fps / last;
+    rows.push_back({{"threads", t},
+                    {"fps", fps},
+                    {"speedup", fps / first},
+                    {"step", step},
+                    {"paper_step", paper_step},
+                    {"ratio", step / paper_step},
+                    {"usage", report["usage"]}});
+    last = fps;
+  }
+  return {{"scene", "builtin:room"}, {"resolution", resolution}, {"rows", rows}};
 }
 
 // ---- the run folder ----------------------------------------------------------------------------

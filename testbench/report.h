@@ -35,6 +35,7 @@ struct PreparedScene;
 struct RenderSettings;
 struct SequenceFrame;
 struct SequenceResult;
+struct PaperFigure;
 struct PrecisionRow;
 struct SweepOptions;
 struct SweepPoint;
@@ -146,6 +147,24 @@ void write_precision_report(const std::string& json, const std::string& out_dir,
                             const std::string& scene, const RenderSettings& settings, int lo,
                             int hi, const std::vector<PrecisionRow>& rows,
                             const std::vector<std::string>& argv);
+
+// ---- the paper's tables ---------------------------------------------------------------------
+
+// One table's entry for one scene of `saarcor paper`: the scene, the frame's resolution, each
+// figure beside the paper's with their ratio, the settings and the model's whole cycle report.
+nlohmann::json paper_entry_json(int table, const std::string& paper, const std::string& scene,
+                                bool reference, const std::string& resolution,
+                                const std::vector<PaperFigure>& figures,
+                                const std::vector<std::string>& settings,
+                                const nlohmann::json& cycle);
+// The tables' result: the entries, scene after scene (moved out of `per_scene`).
+nlohmann::json paper_tables_json(int scale, const std::vector<std::string>& set,
+                                 std::vector<nlohmann::json>& per_scene);
+// The thread curve: per thread count its fps, speed-up, speed-up per doubling beside the paper's
+// and the units' usage, from each count's cycle report.
+nlohmann::json thread_curve_json(const std::vector<int>& counts,
+                                 const std::vector<nlohmann::json>& reports,
+                                 const std::string& resolution);
 
 // ---- the run folder ----------------------------------------------------------------------------
 

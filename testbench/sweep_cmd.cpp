@@ -359,6 +359,76 @@ int run_sweep_merge(const SweepMergeOptions& opts) {
   return 0;
 }
 
+namespace {
+
+// Under mpirun: every rank sends rank 0 its points (or its error); rank 0 gets the first failing
+// rank's error or every rank's points, in sweep order. Returns false on the other ranks.
+bool gather_ranks(MpiRanks& ranks, std::string& error, SweepResult& sweep) {
+  const std::vector<std::string> all = ranks.gather(sweep_rank_message(error, sweep).dump());
+  if (ranks.rank() != 0) return false;
+  std::vector<SweepPoint> points;
+  for (std::size_t r = 0; r < all.size() && error.empty(); ++r) {
+    const nlohmann::json j = nlohmann::json::parse(all[r]);
+    if (j.contains("error")) {
+      error = j["error"].get<std::string>();
+      break;
+    }
+    for (SweepPoint& p : sweep_points_from_json(j["points"]))
+      points.push_back(std::move(p));
+  }
+  if (error.empty()) {
+    std::ranges::sort(points, {}, &SweepPoint::index);
+    sweep.points = std::move(points);
+    sweep.shard = 0;
+    sweep.shards = 1;
+    set_speedups(sweep);
+  }
+  return true;
+}
+
+// --report, --csv and --out-dir checked (one line naming the option).
+void check_sweep_outputs(const SweepOptions& opts) {
+  if (!opts.report.empty() && !opts.report.ends_with(".json")) {
+    throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
+  }
+  if (!opts.csv.empty() && !opts.csv.ends_with(".csv")) {
+    throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
+  }
+  if (!opts.out_dir.empty()) {
+    check_out_dir(opts.out_dir);
+    if (!opts.csv.empty() || !opts.report.empty())
+      throw std::runtime_error(
+          "--out-dir names every file it writes (sweep.csv, report.json): drop --csv and "
+          "--report");
+  }
+}
+
+// The sweep's summary line, where its files went and its table.
+void print_sweep(const SweepOptions& opts, const SweepResult& sweep, const RenderSettings& settings,
+                 std::size_t count) {
+  const std::string shard =
+      sweep.shards > 1 ? ", shard " + opts.shard + ": " + std::to_string(sweep.points.size()) : "";
+  std::printf(
+      "saarcor sweep: %s, model %s, %dx%d, %zu points%s, every one bit-identical to the "
+      "functional %s model (hit records and image, %" PRIu64 " rays)\n",
+      opts.scene.c_str(), opts.model.c_str(), settings.res.width, settings.res.height, count,
+      shard.c_str(), sweep.functional_model.c_str(), sweep.functional_rays);
+  if (!opts.out_dir.empty()) {
+    std::printf(
+        "  run folder: %s (sweep.csv, report.json, stats.txt, config.json, command.txt, "
+        "host.json)\n",
+        opts.out_dir.c_str());
+  }
+  if (!opts.report.empty()) {
+    std::printf("  report:    %s\n", opts.report.c_str());
+  }
+  if (!opts.csv.empty()) {
+    std::printf("  csv:       %s\n", opts.csv.c_str());
+  }
+}
+
+}  // namespace
+
 int run_sweep(const SweepOptions& opts) {
   // Under mpirun every rank runs this; rank 0 gathers and alone prints and writes. Every failure
   // of any rank, bad input included, reaches rank 0 as text, so no rank waits for a dead one and
@@ -384,19 +454,7 @@ int run_sweep(const SweepOptions& opts) {
     }
     // Every bad input fails here, before the scene loads and before any frame runs.
     count = sweep_points(axes, settings.cycle).size();
-    if (!opts.report.empty() && !opts.report.ends_with(".json")) {
-      throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
-    }
-    if (!opts.csv.empty() && !opts.csv.ends_with(".csv")) {
-      throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
-    }
-    if (!opts.out_dir.empty()) {
-      check_out_dir(opts.out_dir);
-      if (!opts.csv.empty() || !opts.report.empty())
-        throw std::runtime_error(
-            "--out-dir names every file it writes (sweep.csv, report.json): drop --csv and "
-            "--report");
-    }
+    check_sweep_outputs(opts);
     const bool per_core = jobs == 0;
     jobs = resolve_jobs(jobs);
     SweepRun run;
@@ -417,28 +475,7 @@ int run_sweep(const SweepOptions& opts) {
   } catch (const std::exception& e) {
     error = e.what();
   }
-  if (ranks.size() > 1) {
-    const std::vector<std::string> all = ranks.gather(sweep_rank_message(error, sweep).dump());
-    if (ranks.rank() != 0) return error.empty() ? 0 : 1;
-    // The first failing rank's error; otherwise every rank's points, in sweep order.
-    std::vector<SweepPoint> points;
-    for (std::size_t r = 0; r < all.size() && error.empty(); ++r) {
-      const nlohmann::json j = nlohmann::json::parse(all[r]);
-      if (j.contains("error")) {
-        error = j["error"].get<std::string>();
-        break;
-      }
-      for (SweepPoint& p : sweep_points_from_json(j["points"]))
-        points.push_back(std::move(p));
-    }
-    if (error.empty()) {
-      std::ranges::sort(points, {}, &SweepPoint::index);
-      sweep.points = std::move(points);
-      sweep.shard = 0;
-      sweep.shards = 1;
-      set_speedups(sweep);
-    }
-  }
+  if (ranks.size() > 1 && !gather_ranks(ranks, error, sweep)) return error.empty() ? 0 : 1;
   if (!error.empty()) throw std::runtime_error(error);
 
   if (!opts.out_dir.empty()) write_sweep_folder(opts, sweep, settings, jobs, ranks.size());
@@ -448,25 +485,7 @@ int run_sweep(const SweepOptions& opts) {
   if (!opts.csv.empty()) {
     write_text_file(opts.csv, sweep_csv(sweep));
   }
-  const std::string shard =
-      sweep.shards > 1 ? ", shard " + opts.shard + ": " + std::to_string(sweep.points.size()) : "";
-  std::printf(
-      "saarcor sweep: %s, model %s, %dx%d, %zu points%s, every one bit-identical to the "
-      "functional %s model (hit records and image, %" PRIu64 " rays)\n",
-      opts.scene.c_str(), opts.model.c_str(), settings.res.width, settings.res.height, count,
-      shard.c_str(), sweep.functional_model.c_str(), sweep.functional_rays);
-  if (!opts.out_dir.empty()) {
-    std::printf(
-        "  run folder: %s (sweep.csv, report.json, stats.txt, config.json, command.txt, "
-        "host.json)\n",
-        opts.out_dir.c_str());
-  }
-  if (!opts.report.empty()) {
-    std::printf("  report:    %s\n", opts.report.c_str());
-  }
-  if (!opts.csv.empty()) {
-    std::printf("  csv:       %s\n", opts.csv.c_str());
-  }
+  print_sweep(opts, sweep, settings, count);
   std::printf("%s", sweep_table(sweep).c_str());
   return 0;
 }
