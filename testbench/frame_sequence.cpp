@@ -14,6 +14,7 @@
 #include "host/frame_upload.h"
 #include "host/tree_settings.h"
 #include "hw/kernel.h"
+#include "hw/stats.h"
 #include "memif/memory_system.h"
 #include "testbench/chip.h"
 #include "testbench/heartbeat.h"
@@ -628,8 +629,7 @@ SequenceOutput bus_sweep_output(const RenderOptions& opts, const ModelSpec& mode
   // One block of statistics per bandwidth.
   std::vector<std::pair<std::string, std::vector<StatLine>>> blocks;
   for (const SequenceResult& p : points)
-    blocks.push_back(
-        {"host bus " + nlohmann::json(p.bus_mb_s).dump() + " MB/s", sequence_stat_lines(p)});
+    blocks.push_back({"host bus " + hw::json_number(p.bus_mb_s) + " MB/s", sequence_stat_lines(p)});
   out.stats = stats_text_blocks(blocks);
   return out;
 }

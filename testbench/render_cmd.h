@@ -161,9 +161,9 @@ struct RenderOptions {
   double bank_mb = 4.0;
   CycleRenderOptions cycle;
   TraceOptions trace;
-  // --out-dir DIR (testbench/run_dir.h): image.png, image.exr (--exr), hits.exr (--hits without
-  // a file name), report.json, stats.txt, config.json, command.txt, host.json; --out, --report and
-  // a --hits file name are refused with it (the folder names every file).
+  // --out-dir DIR (testbench/report.h write_run_folder): image.png, image.exr (--exr), hits.exr
+  // (--hits without a file name), report.json, stats.txt, config.json, command.txt, host.json;
+  // --out, --report and a --hits file name are refused with it (the folder names every file).
   std::string out_dir;
   bool out_given = false;         // --out was on the command line (not its default)
   bool hits_asked = false;        // --hits was on the command line, with or without a file name

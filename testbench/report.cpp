@@ -319,8 +319,8 @@ nlohmann::json cycle_configuration_json(const units::CycleParams& p) {
   return conf;
 }
 
-}  // namespace
-
+// The figures of a span (units/figures.h kFigures) the frame's report writes, into `j` at their
+// dotted names ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}).
 void add_figures(nlohmann::json& j, const units::CycleFigures& f) {
   for (int i = 0; i < units::kFigureCount; ++i) {
     const units::FigureInfo& info = units::kFigures[i];
@@ -330,6 +330,8 @@ void add_figures(nlohmann::json& j, const units::CycleFigures& f) {
     j[std::string(n.substr(0, dot))][std::string(n.substr(dot + 1))] = f.at(i);
   }
 }
+
+}  // namespace
 
 std::vector<ReportStat> cycle_stats(const CycleFrame& c) {
   std::vector<ReportStat> out;

@@ -98,9 +98,6 @@ nlohmann::json cycle_report_json(const CycleFrame& frame);
 // JSON): each frame statistic as "frame.NAME" with its declaration's description and unit, then
 // every statistic of the hw/ registry with its own.
 std::vector<StatLine> cycle_stat_lines(const nlohmann::json& cycle);
-// The figures of a span (units/figures.h kFigures) the frame's report writes into `j` at their
-// dotted names ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}).
-void add_figures(nlohmann::json& j, const units::CycleFigures& f);
 
 // ---- frame sequences (render --frames N) -------------------------------------------------------
 

@@ -51,8 +51,8 @@ struct SweepOptions {
   // over the ranks on this host). The rows are the same for every count.
   int jobs = 0;
   std::string shard;  // "K/N": only the points of shard K of N (1 <= K <= N), for array jobs
-  // --out-dir DIR (testbench/run_dir.h): sweep.csv, report.json, stats.txt, config.json,
-  // command.txt, host.json; --csv and --report are refused with it.
+  // --out-dir DIR (testbench/report.h write_run_folder): sweep.csv, report.json, stats.txt,
+  // config.json, command.txt, host.json; --csv and --report are refused with it.
   std::string out_dir;
   std::vector<std::string> argv;  // the command line, for command.txt
 };
