@@ -97,6 +97,9 @@ class Stats {
   void sample(std::uint64_t cycle);
   // {"period": N, "names": [...], "samples": [[cycle, v0, v1, ...], ...]}
   std::string time_series_json() const;
+  // The series as sampled: the names of its columns, and its rows ([cycle, v0, v1, ...]).
+  const std::vector<std::string>& time_series_names() const { return series_names_; }
+  const std::vector<std::vector<double>>& time_series() const { return series_; }
 
  private:
   struct Entry {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -99,27 +100,79 @@ class Chip {
   std::vector<std::unique_ptr<DynRtp>> pipes_;
 };
 
-// The counts the figures are computed from (units/figures.h), summed over the DynRTPs.
-FigureCounts snapshot(hw::Kernel& k, Chip& chip) {
-  FigureCounts s;
-  s.cycle = k.now();
-  s.pipelines = chip.pipelines();
-  for (int p = 0; p < chip.pipelines(); ++p) {
-    DynRtp& d = chip.pipeline(p);
-    for (int i = 0; i < kTable4Units; ++i)
-      s.issued[static_cast<std::size_t>(i)] += d.unit(kTable4Unit[i]).issue_cycles();
-    for (int c = 0; c < kCacheUnits; ++c) {
-      const memif::Cache& cache = chip.memory().cache(p, kCacheItem[c]);
-      s.requests[static_cast<std::size_t>(c)] += cache.requests_count();
-      s.hits[static_cast<std::size_t>(c)] += cache.hits() + cache.merges();
-      s.bytes[static_cast<std::size_t>(c)] +=
-          k.stats().get_counter(cache.name() + ".mem_bytes").value;
+// Where the counts the figures are computed from (units/figures.h FigureCounts) live in the
+// registry, per DynRTP: its units' issue cycles, its caches' requests, hits, merges and memory
+// bytes, its RGS's shading and frame-buffer bytes. The frame's counts and each interval's (the
+// registry's time series, --interval) are read from the same statistics.
+struct FigureStats {
+  std::vector<std::string> issued, requests, hits, merges, bytes, shading, frame;
+  int pipelines = 1;
+
+  explicit FigureStats(Chip& chip) : pipelines(chip.pipelines()) {
+    for (int p = 0; p < chip.pipelines(); ++p) {
+      DynRtp& d = chip.pipeline(p);
+      for (int i = 0; i < kTable4Units; ++i)
+        issued.push_back(d.unit(kTable4Unit[i]).name() + ".issue_cycles");
+      for (int c = 0; c < kCacheUnits; ++c) {
+        const std::string& n = chip.memory().cache(p, kCacheItem[c]).name();
+        requests.push_back(n + ".requests");
+        hits.push_back(n + ".hits");
+        merges.push_back(n + ".merges");
+        bytes.push_back(n + ".mem_bytes");
+      }
+      const std::string pre = "dynrtp" + std::to_string(p) + ".";
+      shading.push_back(pre + "shading.mem_bytes");
+      frame.push_back(pre + "frame.mem_bytes");
     }
-    const std::string pre = "dynrtp" + std::to_string(p) + ".";
-    s.shading_bytes += k.stats().get_counter(pre + "shading.mem_bytes").value;
-    s.frame_bytes += k.stats().get_counter(pre + "frame.mem_bytes").value;
   }
-  return s;
+
+  // The counts at `cycle`, each statistic's value given by `value(name)`.
+  template <class Value>
+  FigureCounts counts(std::uint64_t cycle, const Value& value) const {
+    FigureCounts s;
+    s.cycle = cycle;
+    s.pipelines = pipelines;
+    for (std::size_t p = 0; p < shading.size(); ++p) {
+      for (std::size_t i = 0; i < kTable4Units; ++i)
+        s.issued[i] += value(issued[p * kTable4Units + i]);
+      for (std::size_t c = 0; c < kCacheUnits; ++c) {
+        const std::size_t at = p * kCacheUnits + c;
+        s.requests[c] += value(requests[at]);
+        s.hits[c] += value(hits[at]) + value(merges[at]);
+        s.bytes[c] += value(bytes[at]);
+      }
+      s.shading_bytes += value(shading[p]);
+      s.frame_bytes += value(frame[p]);
+    }
+    return s;
+  }
+};
+
+FigureCounts snapshot(const hw::Kernel& k, const FigureStats& fs) {
+  return fs.counts(k.now(), [&](const std::string& n) { return k.stats().get_counter(n).value; });
+}
+
+// The figures of each span of the registry's time series (sampled by simulate every `interval`
+// cycles and at the frame's end), from the frame's start counts on.
+std::vector<CycleFigures> interval_figures(hw::Kernel& k, const FigureStats& fs,
+                                           const FigureCounts& start, std::uint64_t interval,
+                                           double clock_mhz) {
+  hw::Stats& st = k.stats();
+  st.set_time_series_period(interval);
+  std::map<std::string, std::size_t> column;
+  for (std::size_t i = 0; i < st.time_series_names().size(); ++i)
+    column[st.time_series_names()[i]] = i + 1;  // column 0 is the cycle
+  std::vector<CycleFigures> series;
+  FigureCounts last = start;
+  for (const std::vector<double>& row : st.time_series()) {
+    const auto cycle = static_cast<std::uint64_t>(row[0]);
+    if (cycle <= last.cycle) continue;
+    const FigureCounts now = fs.counts(
+        cycle, [&](const std::string& n) { return static_cast<std::uint64_t>(row[column.at(n)]); });
+    series.push_back(compute_figures(last, now, clock_mhz));
+    last = now;
+  }
+  return series;
 }
 
 // With several DynRTPs each thread also names its pipeline (thread t is pipeline t / threads').
@@ -139,14 +192,14 @@ std::string thread_report(RecordedThreads<F, kLanes>& threads, const CycleParams
   return s.str();
 }
 
-// Runs the kernel until `done` (by default: the chip has retired every packet), sampling the
-// figures every opt.interval cycles into out.series and reporting progress.
+// Runs the kernel until `done` (by default: the chip has retired every packet) in spans of
+// opt.interval cycles (--interval; 65536 without), sampling the registry's time series after each
+// span, and reporting progress.
 template <class F, int kLanes>
 void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, const CycleParams& p,
-              const CycleRunOptions& opt, CycleFrame& out, std::function<bool()> done = {}) {
+              const CycleRunOptions& opt, std::function<bool()> done = {}) {
   if (!done) done = [&] { return chip.finished(); };
   const std::uint64_t chunk = opt.interval != 0 ? opt.interval : 65536;
-  FigureCounts last = snapshot(k, chip);
   while (!done()) {
     std::uint64_t budget = chunk;
     if (opt.max_cycles != 0) {
@@ -160,11 +213,8 @@ void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, co
       throw std::runtime_error("cycle model: watchdog at cycle " + std::to_string(r.cycles) +
                                ": no progress for " + std::to_string(p.watchdog) + " cycles\n" +
                                thread_report(threads, p) + "\n" + r.report);
-    if (opt.interval != 0) {
-      const FigureCounts now = snapshot(k, chip);
-      if (now.cycle > last.cycle) out.series.push_back(compute_figures(last, now, p.clock_mhz));
-      last = now;
-    }
+    // --interval: the registry's time series, sampled where each span's run ends.
+    if (opt.interval != 0) k.stats().sample(k.now());
     if (opt.progress)
       opt.progress(k.now(), static_cast<int>(chip.packets_retired()), threads.packets());
   }
@@ -179,7 +229,7 @@ bool start_upload(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads
   memif::HostBus& host = chip.memory().host();
   host.upload(upload);
   out.upload_bytes = upload.bytes();
-  simulate(k, chip, threads, p, opt, out, [&] { return chip.finished() || host.stored(); });
+  simulate(k, chip, threads, p, opt, [&] { return chip.finished() || host.stored(); });
   if (!host.stored()) return true;
   out.upload_cycles = k.now();
   return false;
@@ -270,6 +320,15 @@ void collect_rgs(const memif::MemoryImage& image, int bank, const FigureCounts& 
       pixels > 0 ? static_cast<double>(end.shading_bytes + end.frame_bytes) / pixels : 0.0;
 }
 
+// The kernel's watchdog, evaluation order and idle skipping.
+hw::KernelConfig kernel_config(const CycleParams& p, const CycleRunOptions& opt) {
+  hw::KernelConfig kc;
+  kc.watchdog_cycles = p.watchdog;
+  kc.shuffle_seed = opt.shuffle_seed;
+  kc.idle_skip = opt.idle_skip;
+  return kc;
+}
+
 template <class F, int kLanes>
 CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParams& p,
                             const CycleRunOptions& opt, const memif::HostUpload* upload) {
@@ -287,11 +346,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   RecordedThreads<F, kLanes> threads(image, functional_params(p, opt.shading),
                                      p.pipelines * p.threads, opt.programs, opt.ahead_packets,
                                      opt.trace);
-  hw::KernelConfig kc;
-  kc.watchdog_cycles = p.watchdog;
-  kc.shuffle_seed = opt.shuffle_seed;
-  kc.idle_skip = opt.idle_skip;
-  hw::Kernel k(kc);
+  hw::Kernel k(kernel_config(p, opt));
   Chip chip(k, image, p, threads);
   if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
   std::unique_ptr<RunTracer> tracer;
@@ -303,12 +358,15 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   CycleFrame out;
   out.params = p;
   out.packets = static_cast<std::uint64_t>(threads.packets());
-  const FigureCounts start = snapshot(k, chip);
+  const FigureStats figure_stats(chip);
+  const FigureCounts start = snapshot(k, figure_stats);
   const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
-  simulate(k, chip, threads, p, opt, out);
+  simulate(k, chip, threads, p, opt);
   if (opt.vcd != nullptr) k.finish_trace();
   if (tracer) tracer->finish();
-  const FigureCounts end = snapshot(k, chip);
+  const FigureCounts end = snapshot(k, figure_stats);
+  if (opt.interval != 0)
+    out.series = interval_figures(k, figure_stats, start, opt.interval, p.clock_mhz);
   out.cycles = k.now();
   if (uploading) finish_upload(k, chip, p, out);
 

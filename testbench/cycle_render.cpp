@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
-#include <string_view>
 
 #include "testbench/heartbeat.h"
 
@@ -101,95 +100,6 @@ std::string rgs_text(const CycleFrame& c, const Table4Row* paper) {
 }
 
 }  // namespace
-
-void add_figures(nlohmann::json& j, const units::CycleFigures& f, bool sequence_row) {
-  for (int i = 0; i < units::kFigureCount; ++i) {
-    const units::FigureInfo& info = units::kFigures[i];
-    const char* name = sequence_row ? info.sequence_name : info.in_report ? info.name : nullptr;
-    if (name == nullptr) continue;
-    const std::string_view n = name;
-    const std::size_t dot = n.find('.');
-    j[std::string(n.substr(0, dot))][std::string(n.substr(dot + 1))] = f.at(i);
-  }
-}
-
-nlohmann::json cycle_report_json(const CycleFrame& c) {
-  nlohmann::json j;
-  add_figures(j, c.figures);
-  j["cycles"] = c.cycles;
-  j["fps"] = c.fps;
-  j["rgs"] = {{"shading_bytes", c.shading_bytes},
-              {"frame_buffer_bytes", c.frame_bytes},
-              {"shading_bytes_per_pixel", c.shading_bytes_per_pixel},
-              {"frame_bank", c.frame_bank}};
-  j["rays"] = c.rays;
-  j["rays_per_s"] = c.rays_per_s;
-  j["packets"] = c.packets;
-  j["cycles_per_packet"] = per(c.cycles, c.packets);
-  j["per_ray"] = {{"traversal_steps", per(c.per_ray_sum.traversal_steps, c.rays)},
-                  {"list_entries", per(c.per_ray_sum.list_entries, c.rays)},
-                  {"mailbox_skips", per(c.per_ray_sum.mailbox_skips, c.rays)},
-                  {"transformations", per(c.per_ray_sum.transformations, c.rays)},
-                  {"intersections", per(c.per_ray_sum.intersections, c.rays)}};
-  j["simd_efficiency"] = c.simd_efficiency;
-  j["host"] = {{"seconds", c.host_seconds},
-               {"sim_cycles_per_s", c.sim_cycles_per_s},
-               {"threads", c.host_threads},
-               {"programs", units::program_mode_name(c.programs)},
-               {"skipped_cycles", c.skipped_cycles}};
-  nlohmann::json units;
-  for (int i = 0; i < units::kTable4Units; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    units[units::kTable4UnitNames[i]] = {{"issue_cycles", c.issue_cycles[k]},
-                                         {"stall_cycles", c.stall_cycles[k]},
-                                         {"requests", c.requests[k]}};
-  }
-  j["units"] = units;
-  // Per DynRTP (one in the prototype): the packets the RGC handed it, its units' usage.
-  nlohmann::json pipes = nlohmann::json::array();
-  for (const CycleFrame::PipelineCount& pc : c.per_pipeline) {
-    nlohmann::json e;
-    e["packets"] = pc.packets;
-    for (int i = 0; i < units::kTable4Units; ++i)
-      e["usage"][units::kTable4UnitNames[i]] =
-          100.0 * per(pc.issue_cycles[static_cast<std::size_t>(i)], c.cycles);
-    pipes.push_back(e);
-  }
-  j["pipelines"] = pipes;
-  nlohmann::json caches;
-  for (int i = 0; i < units::kCacheUnits; ++i) {
-    const auto& cc = c.caches[static_cast<std::size_t>(i)];
-    caches[units::cache_unit_name(units::CacheUnit(i))] = {{"requests", cc.requests},
-                                                           {"hits", cc.hits},
-                                                           {"merges", cc.merges},
-                                                           {"misses", cc.misses},
-                                                           {"mem_bytes", cc.mem_bytes}};
-  }
-  j["caches"] = caches;
-  const units::UnitStats& u = c.frame.units;
-  j["ops"]["traversal_to_intersection"] = per(u.traversal_ops.total(), u.intersection_ops.total());
-  nlohmann::json conf;
-  for (const units::CycleParamInfo& p : units::describe(c.params))
-    conf[p.name] = {{"value", p.value}, {"unit", p.unit}, {"help", p.help}};
-  conf["depth.traversal"] = c.params.traversal_depth();
-  conf["depth.list"] = c.params.list_depth();
-  conf["depth.transformation"] = c.params.transformation_depth();
-  conf["depth.intersection"] = c.params.intersection_depth();
-  j["configuration"] = conf;
-  // The hw/ statistics registry in full: per unit, cache, path and memory client.
-  j["stats"] = nlohmann::json::parse(c.stats_json);
-  if (!c.series.empty()) {
-    nlohmann::json s = nlohmann::json::array();
-    for (const units::CycleFigures& f : c.series) {
-      nlohmann::json e;
-      add_figures(e, f);
-      e["cycle"] = f.cycle;
-      s.push_back(e);
-    }
-    j["time_series"] = s;
-  }
-  return j;
-}
 
 const std::vector<Table4Row>& paper_table4() {
   static const std::vector<Table4Row> rows = {

@@ -1,10 +1,9 @@
 // `saarcor render --model cycle` (docs/compare.md model 3): the cycle model's options
-// (--preset, --set KEY=VALUE, --interval, --vcd), its per-frame JSON report and the printout in
-// the layout of the paper's Table 4 (docs/cycle-model.md).
+// (--preset, --set KEY=VALUE, --interval, --vcd) and the printout in the layout of the paper's
+// Table 4 (docs/cycle-model.md).
 #pragma once
 
 #include <cstdint>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -46,14 +45,7 @@ CycleFrame run_cycle_render(const memif::MemoryImage& image, const units::Functi
                             const CycleRenderOptions& opts, bool heartbeat = true,
                             const units::RunTraceOptions& trace = {});
 
-// The figures of a span (units/figures.h kFigures) into `j` at their dotted names: those the
-// frame's report writes ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}), or with
-// `sequence_row` those a frame sequence's per-frame row writes, at their names there.
-void add_figures(nlohmann::json& j, const units::CycleFigures& f, bool sequence_row = false);
-
-// The per-frame report: cycles, fps, rays, rays_per_s, usage, cache_hit, bandwidth_mb_s, per_ray,
-// simd_efficiency, host, configuration, (time_series).
-nlohmann::json cycle_report_json(const CycleFrame& frame);
+// The per-frame JSON report and its statistics are written by testbench/report.h.
 
 // One row of the paper's Table 4 (1024x768, 90 MHz, one DynRTP, 64 threads).
 struct Table4Row {

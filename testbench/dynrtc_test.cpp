@@ -603,6 +603,24 @@ TEST(DynRtc, TimeSeriesAddsUpToTheFrame) {
   EXPECT_NEAR(busy / static_cast<double>(c.cycles), c.figures.usage(2), 1e-9);
 }
 
+// --interval is the registry's time series, sampled at every multiple of the interval and at the
+// frame's end; no figure or statistic of the frame moves with it.
+TEST(DynRtc, TimeSeriesIsTheRegistrysAndMovesNoFigure) {
+  const host::BuiltImage b = build("builtin:room", 32, 24);
+  const CycleFrame plain = run_cycle(b.image, prototype_params());
+  CycleRunOptions o;
+  o.interval = 4096;
+  const CycleFrame c = run_cycle(b.image, prototype_params(), o);
+  EXPECT_EQ(c.cycles, plain.cycles);
+  EXPECT_EQ(c.figures.value, plain.figures.value);
+  EXPECT_EQ(c.stats_json, plain.stats_json);
+  ASSERT_EQ(c.series.size(), (c.cycles + 4095) / 4096);
+  for (std::size_t i = 0; i + 1 < c.series.size(); ++i)
+    EXPECT_EQ(c.series[i].cycle, 4096 * (i + 1));
+  EXPECT_EQ(c.series.back().cycle, c.cycles);
+  EXPECT_TRUE(plain.series.empty());
+}
+
 // A statistic of the frame's hw/ registry (CycleFrame::stats_json) by its full name.
 double stat(const CycleFrame& c, const std::string& name) {
   const std::string key = "\"" + name + "\": {";

@@ -14,10 +14,11 @@
 #include "host/frame_upload.h"
 #include "host/tree_settings.h"
 #include "hw/kernel.h"
+#include "hw/stats.h"
 #include "memif/memory_system.h"
 #include "testbench/chip.h"
 #include "testbench/heartbeat.h"
-#include "testbench/run_dir.h"
+#include "testbench/report.h"
 #include "units/functional_model.h"
 
 namespace saarcor {
@@ -368,86 +369,6 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
 
 // ---- report ---------------------------------------------------------------------------------
 
-nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
-  nlohmann::json j;
-  j["scene"] = r.scene;
-  j["model"] = r.model;
-  j["resolution"] = {{"width", r.width}, {"height", r.height}};
-  j["frames"] = r.frames.size();
-  j["dt"] = r.dt;
-  j["top_level"] = r.frame_gap ? "one copy (every upload in a frame gap)" : "two copies";
-  j["instances"] = r.instances;
-  j["dynamic_instances"] = r.dynamic_instances;
-  j["objects"] = r.objects;
-  j["initial_load"] = {{"bytes", r.initial_load_bytes}};
-  j["top_level_copy_bytes"] = r.top_copy_bytes;
-  if (r.cycle) {
-    j["clock_mhz"] = r.clock_mhz;
-    j["hostbus_mb_s"] = r.bus_mb_s;
-    j["initial_load"]["cycles"] = r.initial_load_cycles;
-  }
-  nlohmann::json rows = nlohmann::json::array();
-  std::uint64_t bytes = 0, max_bytes = 0, top = 0, bottom = 0;
-  for (const SequenceFrame& f : r.frames) {
-    nlohmann::json e = {{"frame", f.index},
-                        {"time", f.time},
-                        {"frame_bank", f.frame_bank},
-                        {"top_copy", f.top_copy},
-                        {"top_rebuilt", f.top_rebuilt},
-                        {"moved_instances", f.moved_instances},
-                        {"top_level_builds", f.top_level_builds},
-                        {"bottom_level_builds", f.bottom_level_builds},
-                        {"upload_bytes", f.upload_bytes},
-                        {"upload_words", f.upload_words},
-                        {"upload_runs", f.upload_runs},
-                        {"upload_in_gap", f.gap},
-                        {"rays", f.rays},
-                        {"digest", f.digest}};
-    if (host_times) e["host_rebuild_ms"] = f.host_rebuild_seconds * 1e3;
-    if (r.cycle) {
-      e["upload_cycles"] = f.upload_cycles;
-      e["upload_hidden"] = f.hidden;
-      e["stall_cycles"] = f.stall_cycles;
-      e["start_cycle"] = f.start_cycle;
-      e["cycles"] = f.cycles;
-      e["fps"] = f.fps;
-      e["cycles_per_packet"] = f.cycles_per_packet;
-      add_figures(e, f.figures, true);
-      e["shading_bytes_per_pixel"] = f.shading_bytes_per_pixel;
-      e["bit_identical_to_functional_model"] = f.checked;
-    }
-    if (f.index > 0) {
-      bytes += f.upload_bytes;
-      max_bytes = std::max(max_bytes, f.upload_bytes);
-    }
-    if (f.index > 0) {  // frame 0's trees are the first build, not rebuilds
-      top += f.top_level_builds;
-      bottom += f.bottom_level_builds;
-    }
-    rows.push_back(e);
-  }
-  j["per_frame"] = rows;
-  const std::size_t n = r.frames.size();
-  nlohmann::json sum = {
-      {"upload_bytes_total", bytes},
-      {"upload_bytes_mean", n > 1 ? static_cast<double>(bytes) / (n - 1) : 0.0},
-      {"upload_bytes_max", max_bytes},
-      {"top_level_rebuilds", top},
-      {"bottom_level_rebuilds", bottom},
-      {"bottom_level_trees", r.frames.empty() ? 0 : r.frames.front().bottom_level_builds}};
-  if (r.cycle) {
-    sum["cycles"] = r.total_cycles();
-    sum["fps"] = r.fps();
-    sum["render_fps"] = r.render_fps();
-    sum["uploads_hidden"] = r.hidden_uploads();
-    sum["uploads_in_gaps"] = r.gaps();
-    sum["uploads"] = n > 0 ? n - 1 : 0;
-    sum["break_even_mb_s"] = r.break_even_mb_s();
-  }
-  j["summary"] = sum;
-  return j;
-}
-
 std::string sequence_table(const SequenceResult& r) {
   std::string s;
   char buf[400];
@@ -531,42 +452,6 @@ std::string sequence_table(const SequenceResult& r) {
   return s;
 }
 
-std::string sequence_csv(const SequenceResult& r) {
-  std::string s =
-      "frame,time,frame_bank,top_copy,top_rebuilt,moved_instances,top_level_builds,"
-      "bottom_level_builds,upload_bytes,upload_words,upload_runs,upload_in_gap";
-  if (r.cycle)
-    s += ",upload_cycles,upload_hidden,stall_cycles,start_cycle,cycles,fps,usage_traversal,"
-         "usage_list,usage_transformation,usage_intersection,cache_hit_traversal,cache_hit_list,"
-         "cache_hit_transformation,bandwidth_mb_s_dynrtc,cycles_per_packet,"
-         "bandwidth_mb_s_shading,shading_bytes_per_pixel";
-  s += ",rays,digest\n";
-  char buf[600];
-  for (const SequenceFrame& f : r.frames) {
-    std::snprintf(buf, sizeof buf,
-                  "%d,%.17g,%d,%d,%d,%u,%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64
-                  ",%d",
-                  f.index, f.time, f.frame_bank, f.top_copy, f.top_rebuilt ? 1 : 0,
-                  f.moved_instances, f.top_level_builds, f.bottom_level_builds, f.upload_bytes,
-                  f.upload_words, f.upload_runs, f.gap ? 1 : 0);
-    s += buf;
-    if (r.cycle) {
-      std::snprintf(buf, sizeof buf,
-                    ",%" PRIu64 ",%d,%" PRIu64 ",%" PRIu64 ",%" PRIu64
-                    ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
-                    f.upload_cycles, f.hidden ? 1 : 0, f.stall_cycles, f.start_cycle, f.cycles,
-                    f.fps, f.figures.usage(0), f.figures.usage(1), f.figures.usage(2),
-                    f.figures.usage(3), f.figures.cache_hit(0), f.figures.cache_hit(1),
-                    f.figures.cache_hit(2), f.figures.bw_dynrtc(), f.cycles_per_packet,
-                    f.figures.bw_rgs(), f.shading_bytes_per_pixel);
-      s += buf;
-    }
-    std::snprintf(buf, sizeof buf, ",%" PRIu64 ",%016" PRIx64 "\n", f.rays, f.digest);
-    s += buf;
-  }
-  return s;
-}
-
 // ---- bus sweep ------------------------------------------------------------------------------
 
 std::vector<double> parse_bus_sweep(const std::string& text) {
@@ -644,16 +529,6 @@ std::string bus_sweep_table(const std::vector<SequenceResult>& points) {
   return s;
 }
 
-nlohmann::json bus_sweep_json(const std::vector<SequenceResult>& points) {
-  nlohmann::json j = nlohmann::json::array();
-  for (const SequenceResult& p : points) {
-    nlohmann::json e = sequence_json(p);
-    e["hostbus_mb_s"] = p.bus_mb_s;
-    j.push_back(e);
-  }
-  return j;
-}
-
 // ---- the command ----------------------------------------------------------------------------
 
 namespace {
@@ -705,53 +580,73 @@ std::string numbered(const std::string& prefix, int index) {
   return prefix + buf + ".png";
 }
 
-nlohmann::json configuration(const RenderOptions& o, const RenderSettings& s, bool cycle) {
-  nlohmann::json c = {
-      {"time", o.time}, {"shadows", s.shadows}, {"depth", s.depth}, {"bank_mb", s.bank_mb}};
-  if (cycle)
-    for (const units::CycleParamInfo& p : units::describe(resolve_cycle_params(s.cycle)))
-      c["cycle"][p.name] = {{"value", p.value}, {"unit", p.unit}, {"help", p.help}};
-  host::ImageParams trees;
-  for (const std::string& kv : s.cycle.set)
-    if (host::is_tree_setting(kv)) host::apply_tree_setting(trees, kv);
-  for (const host::TreeSettingInfo& t : host::describe_tree_settings(trees))
-    c["trees"][t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
-  return c;
+// What a sequence (or a bus sweep) leaves: its report, host times, printout, statistics and CSV.
+struct SequenceOutput {
+  nlohmann::json report;
+  nlohmann::json host = nlohmann::json::object();
+  std::string printout, stats, csv;
+};
+
+SequenceOutput sequence_output(const RenderOptions& opts, const ModelSpec& model,
+                               const RenderSettings& settings, const SequenceOptions& so,
+                               const std::string& prefix,
+                               std::vector<std::pair<std::string, std::string>>& outputs) {
+  int written = 0;
+  const FrameSink sink = [&](const SequenceFrame& f, const Rgb8Image& image) {
+    write_rgb8(numbered(prefix, f.index), image);
+    ++written;
+  };
+  const SequenceResult r = run_sequence(opts.scene, model, settings, so, sink);
+  SequenceOutput out;
+  // A run folder keeps host times in host.json.
+  out.report = sequence_json(r, opts.out_dir.empty());
+  out.printout = sequence_table(r);
+  out.csv = sequence_csv(r);
+  out.stats = stats_text(sequence_stat_lines(r));
+  out.host = sequence_host_json(r);
+  char buf[300];
+  std::snprintf(buf, sizeof buf,
+                "  host: top-level rebuild at most %.2f ms per frame after the first (this host",
+                out.host["top_level_rebuild_seconds_max"].get<double>() * 1e3);
+  out.printout += buf;
+  if (r.cycle) {
+    std::snprintf(buf, sizeof buf, "; the shortest frame at the clock: %.2f ms",
+                  shortest_frame_ms(r));
+    out.printout += buf;
+  }
+  out.printout += ")\n";
+  outputs.push_back({"images", numbered(prefix, 0) + " .. " + numbered(prefix, written - 1)});
+  return out;
 }
 
-std::vector<StatLine> sequence_stats(const nlohmann::json& j) {
-  std::vector<StatLine> lines;
-  for (const auto& [k, v] : j["summary"].items())
-    lines.push_back({"sequence." + k,
-                     v.is_boolean() ? (v.get<bool>() ? 1.0 : 0.0) : v.get<double>(),
-                     "the sequence's " + k});
-  for (const nlohmann::json& f : j["per_frame"]) {
-    const std::string pre = "frame" + std::to_string(f["frame"].get<int>()) + ".";
-    for (const auto& [k, v] : f.items()) {
-      if (v.is_number())
-        lines.push_back({pre + k, v.get<double>(), k});
-      else if (v.is_boolean())
-        lines.push_back({pre + k, v.get<bool>() ? 1.0 : 0.0, k + " (1 = yes)"});
-    }
-  }
-  return lines;
+SequenceOutput bus_sweep_output(const RenderOptions& opts, const ModelSpec& model,
+                                const RenderSettings& settings, const SequenceOptions& so,
+                                const std::vector<double>& sweep) {
+  const std::vector<SequenceResult> points = run_bus_sweep(opts.scene, model, settings, so, sweep);
+  SequenceOutput out;
+  out.report["bus_sweep"] = bus_sweep_json(points);
+  out.printout = sequence_table(points.front()) + "bus sweep:\n" + bus_sweep_table(points);
+  // One block of statistics per bandwidth.
+  std::vector<std::pair<std::string, std::vector<StatLine>>> blocks;
+  for (const SequenceResult& p : points)
+    blocks.push_back({"host bus " + hw::json_number(p.bus_mb_s) + " MB/s", sequence_stat_lines(p)});
+  out.stats = stats_text_blocks(blocks);
+  return out;
 }
 
 }  // namespace
 
-int run_frame_sequence(const RenderOptions& opts) {
-  const ModelSpec model = parse_model(opts.model);
-  refuse_single_frame_options(opts);
-  SequenceOptions so = sequence_options(opts);
-  RenderSettings settings =
-      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
-  settings.cycle = opts.cycle;
+namespace {
+
+// The options a sequence refuses or needs, checked before any frame runs; the bus sweep's
+// bandwidths.
+std::vector<double> check_sequence(const RenderOptions& opts, const ModelSpec& model,
+                                   const RenderSettings& settings, const SequenceOptions& so) {
   if (model.kind != ModelKind::kCycle && opts.cycle.any_given())
     throw std::runtime_error(
         "--preset, --set (but kd.* keys), --interval, --host-threads and --vcd apply to --model "
         "cycle only");
-  const bool in_dir = !opts.out_dir.empty();
-  if (in_dir) {
+  if (!opts.out_dir.empty()) {
     check_out_dir(opts.out_dir);
     if (opts.out_given || !opts.report.empty())
       throw std::runtime_error("--out-dir names every file it writes: drop --out and --report");
@@ -768,71 +663,48 @@ int run_frame_sequence(const RenderOptions& opts) {
   if (!std::isfinite(opts.time) || opts.time < 0.0)
     throw std::runtime_error("bad --time " + std::to_string(opts.time) + ": expected seconds >= 0");
   check_options(model, so);
+  return sweep;
+}
 
-  nlohmann::json report;
-  std::string printout;
-  nlohmann::json host = nlohmann::json::object();
-  std::vector<std::pair<std::string, std::string>> outputs;
+}  // namespace
+
+int run_frame_sequence(const RenderOptions& opts) {
+  const ModelSpec model = parse_model(opts.model);
+  refuse_single_frame_options(opts);
+  SequenceOptions so = sequence_options(opts);
+  RenderSettings settings =
+      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
+  settings.cycle = opts.cycle;
+  const std::vector<double> sweep = check_sequence(opts, model, settings, so);
+  const bool in_dir = !opts.out_dir.empty();
   const std::string prefix =
       in_dir ? run_file(opts.out_dir, "frame_") : output_prefix(opts.out, {".png"}) + "_";
-  std::string csv;
-  if (!sweep.empty()) {
-    const std::vector<SequenceResult> points =
-        run_bus_sweep(opts.scene, model, settings, so, sweep);
-    report["bus_sweep"] = bus_sweep_json(points);
-    printout = sequence_table(points.front()) + "bus sweep:\n" + bus_sweep_table(points);
-  } else {
-    int written = 0;
-    const FrameSink sink = [&](const SequenceFrame& f, const Rgb8Image& image) {
-      write_rgb8(numbered(prefix, f.index), image);
-      ++written;
-    };
-    const SequenceResult r = run_sequence(opts.scene, model, settings, so, sink);
-    report = sequence_json(r, !in_dir);  // a run folder keeps host times in host.json
-    printout = sequence_table(r);
-    csv = sequence_csv(r);
-    nlohmann::json frames = nlohmann::json::array();
-    double rebuild_max = 0.0;
-    for (const SequenceFrame& f : r.frames) {
-      frames.push_back({{"frame", f.index},
-                        {"rebuild_seconds", f.host_rebuild_seconds},
-                        {"seconds", f.host_seconds}});
-      if (f.index > 0) rebuild_max = std::max(rebuild_max, f.host_rebuild_seconds);
-    }
-    host["per_frame"] = frames;
-    host["top_level_rebuild_seconds_max"] = rebuild_max;
-    char buf[300];
-    std::snprintf(buf, sizeof buf,
-                  "  host: top-level rebuild at most %.2f ms per frame after the first (this host",
-                  rebuild_max * 1e3);
-    printout += buf;
-    if (r.cycle) {
-      std::snprintf(buf, sizeof buf, "; the shortest frame at the clock: %.2f ms",
-                    shortest_frame_ms(r));
-      printout += buf;
-    }
-    printout += ")\n";
-    outputs.push_back({"images", numbered(prefix, 0) + " .. " + numbered(prefix, written - 1)});
-  }
-  report["configuration"] = configuration(opts, settings, model.kind == ModelKind::kCycle);
+  std::vector<std::pair<std::string, std::string>> outputs;
+  SequenceOutput out = sweep.empty() ? sequence_output(opts, model, settings, so, prefix, outputs)
+                                     : bus_sweep_output(opts, model, settings, so, sweep);
+  out.report["configuration"] =
+      sequence_configuration_json(opts.time, settings, model.kind == ModelKind::kCycle);
   if (in_dir) {
-    if (!csv.empty()) {
-      write_text_file(run_file(opts.out_dir, "frames.csv"), csv);
+    RunFolder f{opts.out_dir,
+                std::move(out.report),
+                {},
+                std::move(out.host),
+                std::move(out.stats),
+                opts.argv,
+                {}};
+    f.config = f.report["configuration"];
+    if (!out.csv.empty()) {
+      f.tables.push_back({"frames.csv", std::move(out.csv)});
       outputs.push_back({"csv", run_file(opts.out_dir, "frames.csv")});
     }
-    write_text_file(run_file(opts.out_dir, "report.json"), report.dump(2) + "\n");
-    write_text_file(run_file(opts.out_dir, "config.json"), report["configuration"].dump(2) + "\n");
-    write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
-    write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
-    if (report.contains("per_frame"))
-      write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text(sequence_stats(report)));
-    for (const char* f : {"report.json", "config.json", "command.txt", "host.json"})
-      outputs.push_back({f, run_file(opts.out_dir, f)});
+    write_run_folder(f);
+    for (const char* name : {"report.json", "config.json", "command.txt", "host.json"})
+      outputs.push_back({name, run_file(opts.out_dir, name)});
   } else if (!opts.report.empty()) {
-    write_text_file(opts.report, report.dump(2) + "\n");
+    write_text_file(opts.report, out.report.dump(2) + "\n");
     outputs.push_back({"report", opts.report});
   }
-  std::printf("%s", printout.c_str());
+  std::printf("%s", out.printout.c_str());
   for (const auto& [k, v] : outputs)
     std::printf("  %-11s %s\n", (k + ":").c_str(), v.c_str());
   return 0;

@@ -18,6 +18,7 @@
 
 #include "testbench/image_io.h"
 #include "testbench/render_cmd.h"
+#include "testbench/report.h"
 #include "units/figures.h"
 
 namespace saarcor {
@@ -108,12 +109,9 @@ SequenceResult run_sequence(const std::string& scene, const ModelSpec& model,
                             const RenderSettings& settings, const SequenceOptions& opts,
                             const FrameSink& sink = {});
 
-// The report (host timing only with host_times: each frame's top-level rebuild on this host, which
-// a run folder keeps in host.json), the per-frame table and summary as printed (with the host's
-// rebuild times), and the CSV of the frames (no host timing).
-nlohmann::json sequence_json(const SequenceResult& r, bool host_times = false);
+// The per-frame table and summary as printed (with the host's rebuild times). The report and the
+// CSV are testbench/report.h's (sequence_json, sequence_csv).
 std::string sequence_table(const SequenceResult& r);
-std::string sequence_csv(const SequenceResult& r);
 
 // --bus-sweep: the sequence once per host-bus bandwidth (MB/s); every point's frames must have
 // the first point's digests. Returns one result per bandwidth.
@@ -122,7 +120,6 @@ std::vector<SequenceResult> run_bus_sweep(const std::string& scene, const ModelS
                                           const SequenceOptions& opts,
                                           const std::vector<double>& mb_s);
 std::string bus_sweep_table(const std::vector<SequenceResult>& points);
-nlohmann::json bus_sweep_json(const std::vector<SequenceResult>& points);
 
 // "1,4,16.5" as bandwidths in (0, 10^6] MB/s; throws "bad --bus-sweep ..." otherwise.
 std::vector<double> parse_bus_sweep(const std::string& text);

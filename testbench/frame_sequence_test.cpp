@@ -317,6 +317,24 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
+// A bus sweep's run folder holds the files every run folder holds; its stats.txt has one block
+// per bandwidth.
+TEST(FrameSequenceCommand, BusSweepRunFolderHasItsStatistics) {
+  const fs::path d = scratch_dir("frames_bus");
+  fs::remove_all(d);
+  const auto r = run_saarcor(
+      "render builtin:dynamic --model cycle --res 16x12 --frames 2 --bus-sweep 1,132 --out-dir " +
+      d.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"report.json", "stats.txt", "config.json", "command.txt", "host.json"})
+    EXPECT_TRUE(fs::exists(d / f)) << f;
+  const std::string stats = slurp(d / "stats.txt");
+  EXPECT_NE(stats.find("# host bus 1 MB/s\n"), std::string::npos) << stats.substr(0, 300);
+  EXPECT_NE(stats.find("# host bus 132 MB/s\n"), std::string::npos);
+  EXPECT_NE(stats.find("\nsequence.uploads_hidden "), std::string::npos);
+  fs::remove_all(d);
+}
+
 TEST(FrameSequenceCommand, RunFolderHasNumberedFramesAndRerunsGiveTheSameBytes) {
   const fs::path d = scratch_dir("frames");
   const std::string args = "render builtin:dynamic --model cycle --res 16x12 --frames 3 ";
@@ -342,6 +360,32 @@ TEST(FrameSequenceCommand, RunFolderHasNumberedFramesAndRerunsGiveTheSameBytes) 
   EXPECT_EQ(j["summary"]["uploads_hidden"], 2);
   EXPECT_FALSE(j.contains("host"));
   EXPECT_TRUE(nlohmann::json::parse(slurp(d / "a" / "host.json")).contains("per_frame"));
+  // One row model (testbench/report.cpp kRowColumns): the JSON row, the CSV header and
+  // stats.txt name the same columns; the RGS's bandwidth (reads plus frame-buffer writes) is
+  // bandwidth_mb_s.rgs, the name units/figures.h gives it, never the render report's "shading"
+  // (the reads alone).
+  const nlohmann::json& row = j["per_frame"][1];
+  EXPECT_TRUE(row["bandwidth_mb_s"].contains("rgs"));
+  EXPECT_FALSE(row["bandwidth_mb_s"].contains("shading"));
+  const std::string csv = slurp(d / "a" / "frames.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_NE(header.find(",bandwidth_mb_s_rgs,"), std::string::npos) << header;
+  const std::string stats = slurp(d / "a" / "stats.txt");
+  std::size_t columns = 0;
+  for (const auto& [key, value] : row.items())
+    columns += value.is_object() ? value.size() : 1;
+  std::size_t frame1_lines = 0;
+  std::istringstream in(stats);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.starts_with("frame1.")) continue;
+    ++frame1_lines;
+    // Every line: "name  value  # description (unit)", both from the column's declaration.
+    EXPECT_NE(line.find("  # "), std::string::npos) << line;
+    EXPECT_EQ(line.back(), ')') << line;
+  }
+  EXPECT_EQ(frame1_lines, columns);
+  EXPECT_NE(stats.find("\nframe1.bandwidth_mb_s.rgs "), std::string::npos);
+  EXPECT_NE(stats.find("\nsequence.uploads_hidden "), std::string::npos);
   // --out PREFIX and --report without a folder; the fp24 model.
   const auto c = run_saarcor("render builtin:dynamic --res 8x6 --frames 2 --dt 0.5 --out " +
                              (d / "seq").string() + " --report " + (d / "seq.json").string());

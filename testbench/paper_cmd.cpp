@@ -13,6 +13,7 @@
 #include "testbench/heartbeat.h"
 #include "testbench/image_io.h"
 #include "testbench/render_cmd.h"
+#include "testbench/report.h"
 #include "testbench/task_pool.h"
 
 namespace saarcor {
@@ -36,10 +37,6 @@ const Table4Row* table4_row(const std::string& paper) {
   for (const Table4Row& r : paper_table4())
     if (paper == r.scene) return &r;
   return nullptr;
-}
-
-double ratio(const PaperFigure& f) {
-  return f.paper == 0.0 ? 0.0 : f.model / f.paper;
 }
 
 // The paper's cycles per 4-ray packet and Mrays/s at its fps and resolution (90 MHz).
@@ -133,19 +130,9 @@ nlohmann::json table_entry(int table, const PaperScene& ps, PreparedScene& prep,
   at_paper_res["fps"] = f.cycle["fps"].get<double>() * (s.res.width * s.res.height) / (pw * ph);
   const std::vector<PaperFigure> figs = table == 3 ? table3_figures(at_paper_res, ps.paper, pw, ph)
                                                    : table4_figures(at_paper_res, ps.paper, pw, ph);
-  nlohmann::json e;
-  e["table"] = table;
-  e["paper_scene"] = ps.paper;
-  e["scene"] = ps.spec;
-  e["kind"] = ps.reference ? "reference" : "stand-in";
-  e["resolution"] = std::to_string(s.res.width) + "x" + std::to_string(s.res.height);
-  e["paper_resolution"] = table == 3 ? "512x384" : "1024x768";
-  nlohmann::json fj = nlohmann::json::object();
-  for (const PaperFigure& g : figs)
-    fj[g.key] = {{"model", g.model}, {"paper", g.paper}, {"ratio", ratio(g)}};
-  e["figures"] = fj;
-  e["configuration"] = s.cycle.set;
-  e["report"] = f.cycle;
+  nlohmann::json e = paper_entry_json(
+      table, ps.paper, ps.spec, ps.reference,
+      std::to_string(s.res.width) + "x" + std::to_string(s.res.height), figs, s.cycle.set, f.cycle);
   return e;
 }
 
@@ -257,17 +244,7 @@ nlohmann::json run_paper_tables(const PaperOptions& opts) {
     }
   });
   pool.finish();
-  nlohmann::json entries = nlohmann::json::array();
-  for (nlohmann::json& scene_entries : per_scene) {
-    for (nlohmann::json& e : scene_entries) {
-      entries.push_back(std::move(e));
-    }
-  }
-  nlohmann::json j;
-  j["scale"] = opts.scale;
-  j["configuration"] = opts.set;  // each entry lists its own, the paper's filter included
-  j["entries"] = entries;
-  return j;
+  return paper_tables_json(opts.scale, opts.set, per_scene);
 }
 
 namespace {
@@ -400,28 +377,8 @@ nlohmann::json run_thread_curve(const PaperOptions& opts) {
     pool.frame_done();
   });
   pool.finish();
-  nlohmann::json rows = nlohmann::json::array();
-  double first = 0.0, last = 0.0;
-  for (std::size_t i = 0; i < counts.size(); ++i) {
-    const int t = counts[i];
-    const nlohmann::json& report = reports[i];
-    const double fps = report["fps"].get<double>();
-    if (t == 1) first = fps;
-    // The paper: nearly linear up to 32 threads, about +10 % from 32 to 64.
-    const double paper_step = t == 1 ? 1.0 : t <= 32 ? 2.0 : 1.10;
-    const double step = t == 1 ? 1.0 : fps / last;
-    rows.push_back({{"threads", t},
-                    {"fps", fps},
-                    {"speedup", fps / first},
-                    {"step", step},
-                    {"paper_step", paper_step},
-                    {"ratio", step / paper_step},
-                    {"usage", report["usage"]}});
-    last = fps;
-  }
-  return {{"scene", "builtin:room"},
-          {"resolution", std::to_string(s.res.width) + "x" + std::to_string(s.res.height)},
-          {"rows", rows}};
+  return thread_curve_json(counts, reports,
+                           std::to_string(s.res.width) + "x" + std::to_string(s.res.height));
 }
 
 std::string thread_curve_text(const nlohmann::json& curve) {

@@ -13,7 +13,7 @@
 #include "host/tree_settings.h"
 #include "testbench/heartbeat.h"
 #include "testbench/image_io.h"
-#include "testbench/run_dir.h"
+#include "testbench/report.h"
 
 namespace saarcor {
 namespace {
@@ -368,75 +368,7 @@ int run_precision(const PrecisionOptions& opts) {
   write_rgb8(png, plot_precision(rows, name + "  " + std::to_string(settings.res.width) + "x" +
                                            std::to_string(settings.res.height))
                       .image);
-  nlohmann::json j;
-  j["scene"] = opts.scene;
-  j["resolution"] = {{"width", settings.res.width}, {"height", settings.res.height}};
-  j["reference"] = "float";
-  nlohmann::json host;  // --out-dir: the frames' wall-clock seconds, apart from the results
-  std::vector<StatLine> stats;
-  for (const PrecisionRow& r : rows) {
-    nlohmann::json row;
-    row["mantissa"] = r.mantissa;
-    row["format"] = ff::format_name(ff::Format{7, r.mantissa});
-    row["same_triangle_pct"] = r.same_triangle_pct;
-    row["psnr_db"] = std::isfinite(r.psnr_db) ? nlohmann::json(r.psnr_db) : nlohmann::json();
-    row["t_rel_err_median"] = r.t_rel_err_median ? nlohmann::json(*r.t_rel_err_median) : nullptr;
-    row["t_rel_err_max"] = r.t_rel_err_max ? nlohmann::json(*r.t_rel_err_max) : nullptr;
-    row["mismatches"] = {{"hit_vs_miss", r.mismatches.hit_vs_miss},
-                         {"edge_tie", r.mismatches.edge_tie},
-                         {"grazing", r.mismatches.grazing},
-                         {"other", r.mismatches.other}};
-    if (in_dir) {
-      host["rows"].push_back({{"mantissa", r.mantissa}, {"seconds", r.seconds}});
-    } else {
-      row["seconds"] = r.seconds;
-    }
-    j["rows"].push_back(row);
-    const std::string m = "e7m" + std::to_string(r.mantissa) + ".";
-    const std::string of = " of Float<7," + std::to_string(r.mantissa) + "> against float";
-    stats.push_back({m + "same_triangle_pct", r.same_triangle_pct,
-                     "% of pixels hitting the same triangle" + of});
-    // Identical images have no finite PSNR; stats.txt carries the number, so infinity is left
-    // out rather than printed as a value no parser agrees on.
-    if (std::isfinite(r.psnr_db)) stats.push_back({m + "psnr_db", r.psnr_db, "image PSNR" + of});
-    if (r.t_rel_err_median)
-      stats.push_back(
-          {m + "t_rel_err_median", *r.t_rel_err_median, "median relative hit-distance error" + of});
-    if (r.t_rel_err_max)
-      stats.push_back(
-          {m + "t_rel_err_max", *r.t_rel_err_max, "largest relative hit-distance error" + of});
-    stats.push_back({m + "mismatches.hit_vs_miss", static_cast<double>(r.mismatches.hit_vs_miss),
-                     "pixels where one hits and the other misses"});
-    stats.push_back({m + "mismatches.edge_tie", static_cast<double>(r.mismatches.edge_tie),
-                     "different triangles, hit on a shared edge"});
-    stats.push_back({m + "mismatches.grazing", static_cast<double>(r.mismatches.grazing),
-                     "different triangles, grazing ray"});
-    stats.push_back({m + "mismatches.other", static_cast<double>(r.mismatches.other),
-                     "different triangles, other cause"});
-  }
-  if (in_dir) {
-    j["outputs"] = {{"plot", "precision.png"}, {"report", "report.json"},  {"stats", "stats.txt"},
-                    {"config", "config.json"}, {"command", "command.txt"}, {"host", "host.json"}};
-    // The study's whole configuration: the frame, the formats, and the tree keys every format's
-    // image is built with (at their defaults: the study has no --set).
-    host::ImageParams trees;
-    nlohmann::json config;
-    config["scene"] = opts.scene;
-    config["resolution"] = j["resolution"];
-    config["bank_mb"] = settings.bank_mb;
-    config["mantissa"] = {{"from", lo}, {"to", hi}};
-    config["exponent_bits"] = 7;
-    config["reference"] = "float";
-    config["shadows"] = settings.shadows;
-    config["depth"] = settings.depth;
-    for (const host::TreeSettingInfo& t : host::describe_tree_settings(trees))
-      config["trees"][t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
-    write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text(stats));
-    write_text_file(run_file(opts.out_dir, "config.json"), config.dump(2) + "\n");
-    write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
-    write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
-  }
-  write_text_file(json, j.dump(2) + "\n");
+  write_precision_report(json, opts.out_dir, opts.scene, settings, lo, hi, rows, opts.argv);
   std::printf("saarcor precision: %s, %dx%d, Float<7,m> against the float reference\n%s",
               opts.scene.c_str(), settings.res.width, settings.res.height,
               precision_table(rows).c_str());

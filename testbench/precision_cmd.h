@@ -52,8 +52,8 @@ struct PrecisionOptions {
   std::string res = "512x384";
   std::string out = "out/precision";  // PREFIX.png (plot), PREFIX.json (table)
   double bank_mb = 4.0;
-  // --out-dir DIR (testbench/run_dir.h): precision.png, report.json, stats.txt, config.json,
-  // command.txt, host.json; --out is refused with it.
+  // --out-dir DIR (testbench/report.h write_run_folder): precision.png, report.json, stats.txt,
+  // config.json, command.txt, host.json; --out is refused with it.
   std::string out_dir;
   bool out_given = false;         // --out was on the command line (not its default)
   std::vector<std::string> argv;  // the command line, for command.txt

@@ -20,7 +20,7 @@
 #include "testbench/heartbeat.h"
 #include "testbench/hit_exr.h"
 #include "testbench/image_io.h"
-#include "testbench/run_dir.h"
+#include "testbench/report.h"
 #include "units/functional_model.h"
 #include "units/request_trace.h"
 
@@ -46,11 +46,6 @@ std::uint32_t float_bits(float f) {
   std::uint32_t b;
   std::memcpy(&b, &f, 4);
   return b;
-}
-
-std::string describe_format(ff::Format f) {
-  return "Float<" + std::to_string(f.exp_bits) + "," + std::to_string(f.man_bits) + "> (" +
-         ff::format_name(f) + ")";
 }
 
 // ---- float reference ---------------------------------------------------------------------------
@@ -84,16 +79,6 @@ PixelHit to_pixel_hit(const host::FloatHit& h, std::uint32_t instance_id, const 
   return p;
 }
 
-nlohmann::json counter_json(const std::vector<std::pair<const char*, std::uint64_t>>& totals,
-                            std::uint64_t rays) {
-  nlohmann::json j;
-  for (const auto& [name, total] : totals) {
-    j[name] = {{"total", total},
-               {"per_ray", rays ? static_cast<double>(total) / static_cast<double>(rays) : 0.0}};
-  }
-  return j;
-}
-
 FrameResult render_float_frame(const PreparedScene& prep, const RenderSettings& settings) {
   FrameResult r;
   r.model = "float";
@@ -112,13 +97,8 @@ FrameResult render_float_frame(const PreparedScene& prep, const RenderSettings& 
   r.image.rgb = frame.rgb;
   const host::FloatTraceStats& s = frame.stats;
   r.rays = s.rays;
-  r.counters["per_ray"] = counter_json({{"traversal_steps", s.traversal_steps},
-                                        {"leaves", s.leaves},
-                                        {"list_entries", s.list_entries},
-                                        {"mailbox_skips", s.mailbox_skips},
-                                        {"transformations", s.transformations},
-                                        {"intersections", s.intersections}},
-                                       s.rays);
+  r.counter_stats = float_counter_stats(s);
+  r.counters = nest(r.counter_stats);
   r.counters["note"] = "float reference: counters of primary rays; binary32 ops are not counted";
   return r;
 }
@@ -204,11 +184,6 @@ PixelHit functional_pixel_hit(const units::FrameSink::Pixel& p, ff::Format f,
   return h;
 }
 
-nlohmann::json ops_json(const ff::OpCounts& c) {
-  return {{"add", c.add},   {"mul", c.mul}, {"div", c.div},
-          {"sqrt", c.sqrt}, {"cmp", c.cmp}, {"total", c.total()}};
-}
-
 FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene& prep,
                                     const RenderSettings& settings) {
   FrameResult r;
@@ -236,41 +211,8 @@ FrameResult render_functional_frame(const ModelSpec& model, const PreparedScene&
   r.image.width = frame.width;
   r.image.height = frame.height;
   r.image.rgb = frame.rgb;
-  nlohmann::json per_kind;
-  for (int k = 0; k < units::kRayKinds; ++k) {
-    const units::RayCounters& c = frame.by_kind[k];
-    const std::uint64_t n = frame.rays_issued[k];
-    r.rays += n;
-    nlohmann::json j = counter_json({{"traversal_steps", c.traversal_steps},
-                                     {"list_entries", c.list_entries},
-                                     {"mailbox_skips", c.mailbox_skips},
-                                     {"transformations", c.transformations},
-                                     {"intersections", c.intersections}},
-                                    n);
-    j["rays_issued"] = n;
-    j["rays_returned"] = frame.rays_returned[k];
-    per_kind[units::ray_kind_name(static_cast<units::RayKind>(k))] = j;
-  }
-  r.counters["per_ray"] = per_kind;
-  const units::UnitStats& u = frame.units;
-  r.counters["ops"] = {{"traversal", ops_json(u.traversal_ops)},
-                       {"transformation", ops_json(u.transformation_ops)},
-                       {"intersection", ops_json(u.intersection_ops)},
-                       {"rgs", ops_json(u.rgs_ops)}};
-  r.counters["units"] = {{"traversal_steps", u.traversal_steps},
-                         {"inner_steps", u.inner_steps},
-                         {"clip_steps", u.clip_steps},
-                         {"clips", u.clips},
-                         {"exit_only_clips", u.exit_only_clips},
-                         {"list_steps", u.list_steps},
-                         {"transformation_steps", u.transformation_steps},
-                         {"shading_transformation_steps", u.shading_transformation_steps},
-                         {"intersection_packets", u.intersection_packets},
-                         {"sub_packets", u.sub_packets},
-                         {"stack_drops", u.stack_drops},
-                         {"empty_leaf_steps", u.empty_leaf_steps},
-                         {"packets", u.packets},
-                         {"requests", u.requests}};
+  r.counter_stats = functional_counter_stats(frame, r.rays);
+  r.counters = nest(r.counter_stats);
   return r;
 }
 
@@ -295,14 +237,14 @@ FrameResult render_cycle_frame(const ModelSpec& model, const PreparedScene& prep
   r.rays = c.rays;
   r.cycle = cycle_report_json(c);
   // The trees are part of the configuration an architect sweeps (kd.* keys).
-  for (const host::TreeSettingInfo& t : host::describe_tree_settings(prep.built.params))
-    r.cycle["configuration"][t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
+  r.cycle["configuration"].update(tree_configuration_json(prep.built.params));
   r.table4 = table4_text(c, prep.spec);
-  r.counters["per_ray"] = r.cycle["per_ray"];
-  r.counters["ops"] = {{"traversal", ops_json(c.frame.units.traversal_ops)},
-                       {"transformation", ops_json(c.frame.units.transformation_ops)},
-                       {"intersection", ops_json(c.frame.units.intersection_ops)},
-                       {"rgs", ops_json(c.frame.units.rgs_ops)}};
+  // The per-ray counters of the frame report and the float units' op counts.
+  for (ReportStat& st : cycle_stats(c))
+    if (st.name.starts_with("per_ray.")) r.counter_stats.push_back(std::move(st));
+  for (ReportStat& st : op_stats(c.frame.units))
+    r.counter_stats.push_back(std::move(st));
+  r.counters = nest(r.counter_stats);
   return r;
 }
 
@@ -655,63 +597,17 @@ PixelHit cycle_pixel(const ModelSpec& model, const PreparedScene& prep, RenderSe
   return h;
 }
 
-// --out-dir: the report without host timing, which goes to host.json; the configuration alone;
-// every statistic one per line; the command line. File names in the report are relative to the
-// folder, so a run folder reads the same wherever it is moved.
-void write_run_files(const RenderOptions& opts, nlohmann::json report, const FrameResult& frame,
-                     std::vector<std::pair<std::string, std::string>>& outputs) {
-  nlohmann::json host;
-  host["seconds"] = report["seconds"];
-  host["rays_per_second"] = report["rays_per_second"];
-  host["load_seconds"] = report["configuration"]["load_seconds"];
-  host["build_seconds"] = report["configuration"]["build_seconds"];
-  report.erase("seconds");
-  report.erase("rays_per_second");
-  report["configuration"].erase("load_seconds");
-  report["configuration"].erase("build_seconds");
-  if (report.contains("host")) host["cycle_model"] = take_cycle_host(report);
-  outputs.push_back({"report", run_file(opts.out_dir, "report.json")});
-  outputs.push_back({"stats", run_file(opts.out_dir, "stats.txt")});
-  outputs.push_back({"config", run_file(opts.out_dir, "config.json")});
-  outputs.push_back({"command", run_file(opts.out_dir, "command.txt")});
-  outputs.push_back({"host", run_file(opts.out_dir, "host.json")});
-  nlohmann::json names;
-  for (const auto& [k, v] : outputs)
-    names[k] = std::filesystem::path(v).filename().string();
-  report["outputs"] = names;
-
-  nlohmann::json config = report["configuration"];
-  config["scene"] = report["scene"];
-  config["model"] = report["model"];
-  config["resolution"] = report["resolution"];
-  std::vector<StatLine> stats;
-  if (!frame.cycle.is_null()) {
-    append_cycle_stats(stats, frame.cycle);
-  } else {
-    stats.push_back({"rays", static_cast<double>(frame.rays), "rays traced (count)"});
-    append_counter_stats(stats, frame.counters);
-  }
-
-  write_text_file(run_file(opts.out_dir, "report.json"), report.dump(2) + "\n");
-  write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text(stats));
-  write_text_file(run_file(opts.out_dir, "config.json"), config.dump(2) + "\n");
-  write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
-  write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
-}
-
 }  // namespace
 
-int run_render(const RenderOptions& opts) {
-  if (opts.frames_given) return run_frame_sequence(opts);
-  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty())
-    throw std::runtime_error("--fps, --dt, --frame-gap and --bus-sweep need --frames N");
-  const ModelSpec model = parse_model(opts.model);
-  RenderSettings settings =
-      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
-  settings.cycle = opts.cycle;
-  int threads = 0;  // the cycle model's threads over all DynRTPs (--konata-threads)
+namespace {
+
+// The render's options checked before the scene loads (a bad one costs no render): the model's
+// own options, --pixel, the traces, the output names. Returns the cycle model's threads over all
+// DynRTPs (--konata-threads; 0 for the other models).
+int check_render_options(const RenderOptions& opts, const ModelSpec& model,
+                         const std::optional<PixelCoord>& pixel) {
+  int threads = 0;
   if (model.kind == ModelKind::kCycle) {
-    // A bad --preset/--set fails before the scene loads.
     const units::CycleParams cp = resolve_cycle_params(opts.cycle);
     threads = cp.pipelines * cp.threads;
   } else if (opts.cycle.any_given()) {
@@ -719,12 +615,8 @@ int run_render(const RenderOptions& opts) {
         "--preset, --set (but kd.* keys), --interval, --host-threads and --vcd apply to --model "
         "cycle only");
   }
-  std::optional<PixelCoord> pixel;
-  if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
   check_trace_options(opts.trace, model, pixel.has_value());
-  // Output names are checked before the work, so a bad one costs no render.
-  const bool in_dir = !opts.out_dir.empty();
-  if (in_dir) {
+  if (!opts.out_dir.empty()) {
     check_out_dir(opts.out_dir);
     if (opts.out_given || !opts.report.empty() || !opts.hits.empty())
       throw std::runtime_error(
@@ -734,50 +626,49 @@ int run_render(const RenderOptions& opts) {
   } else if (opts.hits_asked && opts.hits.empty()) {
     throw std::runtime_error("bad --hits: expected a file name FILE.exr (or --out-dir DIR)");
   }
-  const std::string out =
-      in_dir ? run_file(opts.out_dir, "image") : output_prefix(opts.out, {".png", ".exr"});
+  if (opts.out_dir.empty()) output_prefix(opts.out, {".png", ".exr"});  // throws on a bad --out
   if (!opts.hits.empty() && !opts.hits.ends_with(".exr")) {
     throw std::runtime_error("bad --hits '" + opts.hits + "': a hit EXR file name ends in .exr");
   }
   if (!opts.report.empty() && !opts.report.ends_with(".json")) {
     throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
   }
+  return threads;
+}
 
-  TraceFiles traces(opts.trace, threads);  // opened now: an unwritable one costs no render
-  settings.trace = traces.run;
-
-  const ff::Format format =
-      model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
-  const PreparedScene prep = prepare_scene(opts.scene, settings, format);
-
-  if (pixel) {
-    std::vector<std::string> cycle_lines;
-    const PixelHit h = model.kind == ModelKind::kCycle
-                           ? cycle_pixel(model, prep, settings, *pixel, cycle_lines)
-                           : trace_pixel(model, prep, settings, *pixel);
-    std::printf("saarcor render %s --model %s --res %dx%d --time %g\n%s", opts.scene.c_str(),
-                model.name.c_str(), settings.res.width, settings.res.height, settings.time,
-                format_pixel_hit(*pixel, h).c_str());
-    if (model.kind == ModelKind::kFunctional) {
-      // Every unit request of the pixel's packet, in the order the thread program made them.
-      const units::PixelTrace t =
-          units::trace_pixel(prep.built.image, functional_params(settings), pixel->x, pixel->y);
-      for (const std::string& line : t.log)
-        std::printf("  %s\n", line.c_str());
-    }
-    // The cycle model: every request of the pixel's packet with the cycle a unit issued it.
-    for (const std::string& line : cycle_lines)
+// --pixel x,y: the pixel's hit record and every unit request of its packet.
+void print_pixel(const RenderOptions& opts, const ModelSpec& model, const PreparedScene& prep,
+                 const RenderSettings& settings, PixelCoord pixel) {
+  std::vector<std::string> cycle_lines;
+  const PixelHit h = model.kind == ModelKind::kCycle
+                         ? cycle_pixel(model, prep, settings, pixel, cycle_lines)
+                         : trace_pixel(model, prep, settings, pixel);
+  std::printf("saarcor render %s --model %s --res %dx%d --time %g\n%s", opts.scene.c_str(),
+              model.name.c_str(), settings.res.width, settings.res.height, settings.time,
+              format_pixel_hit(pixel, h).c_str());
+  if (model.kind == ModelKind::kFunctional) {
+    // Every unit request of the pixel's packet, in the order the thread program made them.
+    const units::PixelTrace t =
+        units::trace_pixel(prep.built.image, functional_params(settings), pixel.x, pixel.y);
+    for (const std::string& line : t.log)
       std::printf("  %s\n", line.c_str());
-    return 0;
   }
+  // The cycle model: every request of the pixel's packet with the cycle a unit issued it.
+  for (const std::string& line : cycle_lines)
+    std::printf("  %s\n", line.c_str());
+}
 
-  progress("rendering " + std::to_string(settings.res.width) + "x" +
-           std::to_string(settings.res.height) + " with the " + model.name + " model");
-  const FrameResult frame = render_model(model, prep, settings);
-
+// The frame's image (and float EXR), hit EXR and report, each added to `outputs`.
+void write_frame_outputs(const RenderOptions& opts, const ModelSpec& model,
+                         const PreparedScene& prep, const RenderSettings& settings,
+                         const FrameResult& frame, TraceFiles& traces,
+                         std::vector<std::pair<std::string, std::string>>& outputs) {
+  const bool in_dir = !opts.out_dir.empty();
+  const std::string out =
+      in_dir ? run_file(opts.out_dir, "image") : output_prefix(opts.out, {".png", ".exr"});
   const std::string png = out + ".png";
   write_rgb8(png, frame.image);
-  std::vector<std::pair<std::string, std::string>> outputs = {{"image", png}};
+  outputs.push_back({"image", png});
   traces.finish(outputs);
   if (opts.exr) {
     const std::string exr = out + ".exr";
@@ -790,54 +681,46 @@ int run_render(const RenderOptions& opts) {
     write_hit_exr(hits, frame.hits);
     outputs.push_back({"hits", hits});
   }
-  const double rays_per_s = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
-  const std::string report = in_dir ? run_file(opts.out_dir, "report.json") : opts.report;
-  if (!report.empty()) {
-    nlohmann::json j;
-    j["scene"] = opts.scene;
-    j["model"] = model.name;
-    j["resolution"] = {{"width", settings.res.width}, {"height", settings.res.height}};
-    j["seconds"] = frame.seconds;
-    j["rays"] = frame.rays;
-    j["rays_per_second"] = rays_per_s;
-    j["counters"] = frame.counters;
-    const auto& st = prep.built.stats;
-    j["configuration"] = {{"time", settings.time},
-                          {"shadows", settings.shadows},
-                          {"depth", settings.depth},
-                          {"image_format", describe_format(prep.built.params.format)},
-                          {"bank_words", prep.built.params.bank_words},
-                          {"bank_mb", settings.bank_mb},
-                          {"instances", prep.scene.instances.size()},
-                          {"objects", prep.scene.objects.size()},
-                          {"triangles_unique", prep.scene.unique_triangles()},
-                          {"triangles_instanced", prep.scene.instanced_triangles()},
-                          {"triangles_dropped", st.dropped_triangles},
-                          {"scene_bytes", st.scene_bytes()},
-                          {"light_defaulted", prep.scene.light_defaulted},
-                          {"load_seconds", prep.load_seconds},
-                          {"build_seconds", prep.build_seconds}};
-    if (!frame.cycle.is_null()) {  // the cycle model's figures at the top, its parameters inside
-      nlohmann::json c = frame.cycle;
-      j["configuration"]["cycle"] = c["configuration"];
-      c.erase("configuration");
-      j.update(c);
-    } else {  // the other models read the same trees: their keys are configuration too
-      for (const host::TreeSettingInfo& t : host::describe_tree_settings(prep.built.params))
-        j["configuration"]["trees"][t.name] = {
-            {"value", t.value}, {"unit", t.unit}, {"help", t.help}};
-    }
-    if (in_dir) {
-      write_run_files(opts, j, frame, outputs);
-    } else {
-      nlohmann::json out;
-      for (const auto& [k, v] : outputs)
-        out[k] = v;
-      j["outputs"] = out;
-      write_text_file(report, j.dump(2) + "\n");
-      outputs.push_back({"report", report});
-    }
+  if (in_dir) {
+    write_render_folder(opts.out_dir,
+                        render_report_json(opts.scene, model.name, frame, prep, settings), frame,
+                        opts.argv, outputs);
+  } else if (!opts.report.empty()) {
+    write_render_report(opts.report,
+                        render_report_json(opts.scene, model.name, frame, prep, settings), outputs);
   }
+}
+
+}  // namespace
+
+int run_render(const RenderOptions& opts) {
+  if (opts.frames_given) return run_frame_sequence(opts);
+  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty())
+    throw std::runtime_error("--fps, --dt, --frame-gap and --bus-sweep need --frames N");
+  const ModelSpec model = parse_model(opts.model);
+  RenderSettings settings =
+      frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
+  settings.cycle = opts.cycle;
+  std::optional<PixelCoord> pixel;
+  if (!opts.pixel.empty()) pixel = parse_pixel(opts.pixel, settings.res);
+  const int threads = check_render_options(opts, model, pixel);
+  TraceFiles traces(opts.trace, threads);  // opened now: an unwritable one costs no render
+  settings.trace = traces.run;
+
+  const ff::Format format =
+      model.kind != ModelKind::kFloat ? ff::Format{7, model.mantissa} : ff::kFp24;
+  const PreparedScene prep = prepare_scene(opts.scene, settings, format);
+  if (pixel) {
+    print_pixel(opts, model, prep, settings, *pixel);
+    return 0;
+  }
+
+  progress("rendering " + std::to_string(settings.res.width) + "x" +
+           std::to_string(settings.res.height) + " with the " + model.name + " model");
+  const FrameResult frame = render_model(model, prep, settings);
+  std::vector<std::pair<std::string, std::string>> outputs;
+  write_frame_outputs(opts, model, prep, settings, frame, traces, outputs);
+  const double rays_per_s = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
   std::printf("saarcor render: %s, model %s, %dx%d, %.3f s, %" PRIu64 " rays (%.3g rays/s)\n",
               opts.scene.c_str(), model.name.c_str(), settings.res.width, settings.res.height,
               frame.seconds, frame.rays, rays_per_s);

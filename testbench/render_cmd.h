@@ -18,6 +18,7 @@
 #include "host/scene.h"
 #include "testbench/cycle_render.h"
 #include "testbench/hit_buffer.h"
+#include "testbench/report.h"
 
 namespace saarcor {
 
@@ -100,8 +101,9 @@ struct FrameResult {
   double seconds = 0.0;     // the model's run time (wall clock)
   std::uint64_t rays = 0;   // rays traced (primary, plus shadow and secondary when on)
   nlohmann::json counters;  // per-ray counters and op counts, totals and per ray
-  nlohmann::json cycle;     // --model cycle: the per-frame report (cycle_report_json)
-  std::string table4;       // --model cycle: the Table 4 printout
+  std::vector<ReportStat> counter_stats;  // the same with their declarations (stats.txt)
+  nlohmann::json cycle;                   // --model cycle: the per-frame report (cycle_report_json)
+  std::string table4;                     // --model cycle: the Table 4 printout
 };
 
 // Runs the model on a prepared scene. The functional model needs the image built in
@@ -159,9 +161,9 @@ struct RenderOptions {
   double bank_mb = 4.0;
   CycleRenderOptions cycle;
   TraceOptions trace;
-  // --out-dir DIR (testbench/run_dir.h): image.png, image.exr (--exr), hits.exr (--hits without
-  // a file name), report.json, stats.txt, config.json, command.txt, host.json; --out, --report and
-  // a --hits file name are refused with it (the folder names every file).
+  // --out-dir DIR (testbench/report.h write_run_folder): image.png, image.exr (--exr), hits.exr
+  // (--hits without a file name), report.json, stats.txt, config.json, command.txt, host.json;
+  // --out, --report and a --hits file name are refused with it (the folder names every file).
   std::string out_dir;
   bool out_given = false;         // --out was on the command line (not its default)
   bool hits_asked = false;        // --hits was on the command line, with or without a file name

@@ -2,7 +2,7 @@
 // `sweep` and `precision` run twice into two folders write the same bytes in every file but
 // host.json (and command.txt, which names the folder), hit EXR and float EXR included, with
 // report, configuration and statistics that agree with each other.
-#include "testbench/run_dir.h"
+#include "testbench/report.h"
 
 #include <gtest/gtest.h>
 
@@ -62,6 +62,24 @@ nlohmann::json read_json(const fs::path& p) {
   return nlohmann::json::parse(f);
 }
 
+// Every statistic of stats.txt carries a description and a unit from its declaration:
+// "name  value  # description (unit)".
+void expect_every_line_declared(const std::string& stats) {
+  std::istringstream in(stats);
+  std::size_t checked = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line.starts_with("----------") || line.starts_with("# ")) continue;
+    const std::size_t hash = line.find("  # ");
+    ASSERT_NE(hash, std::string::npos) << line;
+    const std::string desc = line.substr(hash + 4);
+    EXPECT_TRUE(desc.size() > 4 && desc.back() == ')' && desc.find(" (") != std::string::npos &&
+                desc.find(" (") > 0)
+        << line;
+    ++checked;
+  }
+  EXPECT_GT(checked, 0u);
+}
+
 TEST(RunDir, CommandLineQuotesWhatAShellWouldSplit) {
   EXPECT_EQ(command_line_text({"saarcor", "render", "builtin:room", "--res", "64x48"}),
             "saarcor render builtin:room --res 64x48\n");
@@ -70,8 +88,8 @@ TEST(RunDir, CommandLineQuotesWhatAShellWouldSplit) {
 }
 
 TEST(RunDir, StatsTextIsGem5Style) {
-  const std::string s = stats_text({{"frame.cycles", 34755, "simulated cycles (cycles)"},
-                                    {"frame.fps", 2589.5554603, "frames per second"}});
+  const std::string s = stats_text({{"frame.cycles", 34755, "simulated cycles", "cycles"},
+                                    {"frame.fps", 2589.5554603, "frames per second", ""}});
   EXPECT_EQ(s,
             "\n---------- Begin Simulation Statistics ----------\n"
             "frame.cycles                                                            34755  # "
@@ -117,6 +135,7 @@ TEST(RunDir, RenderRerunGivesTheSameBytes) {
     EXPECT_NE(stats.find("\n" + name + " "), std::string::npos) << name;
   }
   EXPECT_GT(lines, 20u);
+  expect_every_line_declared(stats);
 }
 
 TEST(RunDir, FunctionalRenderListsItsCountersAndTrees) {
@@ -133,7 +152,9 @@ TEST(RunDir, FunctionalRenderListsItsCountersAndTrees) {
   const std::string stats = slurp(d / "stats.txt");
   EXPECT_NE(stats.find("\nrays "), std::string::npos);
   EXPECT_NE(stats.find("ops.intersection.div"), std::string::npos);
-  EXPECT_NE(stats.find("# ray-triangle intersection tests, per ray"), std::string::npos);
+  EXPECT_NE(stats.find("# ray-triangle intersection tests, per ray (tests/ray)"),
+            std::string::npos);
+  expect_every_line_declared(stats);
 }
 
 TEST(RunDir, SweepRerunGivesTheSameBytes) {
@@ -149,6 +170,7 @@ TEST(RunDir, SweepRerunGivesTheSameBytes) {
   EXPECT_FALSE(read_json(a / "report.json")["points"][0]["report"].contains("host"));
   const std::string stats = slurp(a / "stats.txt");
   EXPECT_NE(stats.find("# point 2 of 2: threads=4\n"), std::string::npos) << stats.substr(0, 300);
+  expect_every_line_declared(stats);
 }
 
 TEST(RunDir, PrecisionRerunGivesTheSameBytes) {

@@ -21,7 +21,7 @@
 #include "testbench/heartbeat.h"
 #include "testbench/image_io.h"
 #include "testbench/mpi_ranks.h"
-#include "testbench/run_dir.h"
+#include "testbench/report.h"
 #include "testbench/task_pool.h"
 #include "units/cycle_params.h"
 
@@ -245,170 +245,6 @@ void set_speedups(SweepResult& sweep) {
     p.speedup = first / p.cycle["cycles"].get<double>();
 }
 
-nlohmann::json sweep_points_json(const SweepResult& sweep) {
-  nlohmann::json a = nlohmann::json::array();
-  for (const SweepPoint& p : sweep.points)
-    a.push_back({{"index", p.index}, {"settings", p.settings}, {"cycle", p.cycle}});
-  return a;
-}
-
-std::vector<SweepPoint> sweep_points_from_json(const nlohmann::json& j) {
-  std::vector<SweepPoint> points;
-  for (const nlohmann::json& e : j) {
-    SweepPoint p;
-    p.index = e.at("index").get<std::size_t>();
-    p.settings = e.at("settings").get<std::vector<std::string>>();
-    p.cycle = e.at("cycle");
-    points.push_back(std::move(p));
-  }
-  return points;
-}
-
-namespace {
-
-// The point's value of each axis, in axis order ("threads=4" -> "4").
-std::vector<std::string> point_values(const SweepPoint& p) {
-  std::vector<std::string> v;
-  for (const std::string& kv : p.settings) {
-    v.push_back(kv.substr(kv.find('=') + 1));
-  }
-  return v;
-}
-
-struct Column {
-  const char* name;    // CSV header
-  const char* head;    // table header
-  const char* format;  // printf format of the table cell
-  double (*get)(const SweepPoint&);
-};
-
-double fig(const SweepPoint& p, const char* group, const char* key) {
-  return p.cycle[group][key].get<double>();
-}
-
-const std::vector<Column>& columns() {
-  static const std::vector<Column> c = {
-      {"cycles", "cycles", "%10.0f",
-       [](const SweepPoint& p) { return p.cycle["cycles"].get<double>(); }},
-      {"fps", "fps", "%8.1f", [](const SweepPoint& p) { return p.cycle["fps"].get<double>(); }},
-      {"mrays_per_s", "Mrays/s", "%8.2f",
-       [](const SweepPoint& p) { return p.cycle["rays_per_s"].get<double>() / 1e6; }},
-      {"speedup", "speed-up", "%8.2f", [](const SweepPoint& p) { return p.speedup; }},
-      {"usage_traversal", "trav%", "%6.0f",
-       [](const SweepPoint& p) { return fig(p, "usage", "traversal"); }},
-      {"usage_list", "list%", "%6.0f", [](const SweepPoint& p) { return fig(p, "usage", "list"); }},
-      {"usage_transformation", "xfrm%", "%6.0f",
-       [](const SweepPoint& p) { return fig(p, "usage", "transformation"); }},
-      {"usage_intersection", "int%", "%6.0f",
-       [](const SweepPoint& p) { return fig(p, "usage", "intersection"); }},
-      {"cache_hit_traversal", "hit-trav%", "%10.1f",
-       [](const SweepPoint& p) { return fig(p, "cache_hit", "traversal"); }},
-      {"cache_hit_list", "hit-list%", "%10.1f",
-       [](const SweepPoint& p) { return fig(p, "cache_hit", "list"); }},
-      {"cache_hit_transformation", "hit-xfrm%", "%10.1f",
-       [](const SweepPoint& p) { return fig(p, "cache_hit", "transformation"); }},
-      {"bandwidth_mb_s_total", "MB/s", "%7.0f",
-       [](const SweepPoint& p) { return fig(p, "bandwidth_mb_s", "total"); }},
-      {"cycles_per_packet", "cyc/pkt", "%8.1f",
-       [](const SweepPoint& p) { return p.cycle["cycles_per_packet"].get<double>(); }},
-      {"simd_efficiency", "SIMD", "%6.2f",
-       [](const SweepPoint& p) { return p.cycle["simd_efficiency"].get<double>(); }},
-  };
-  return c;
-}
-
-}  // namespace
-
-std::string sweep_table(const SweepResult& sweep) {
-  std::string s;
-  char buf[64];
-  for (const SweepAxis& a : sweep.axes) {
-    std::snprintf(buf, sizeof buf, "%*s ", static_cast<int>(std::max<std::size_t>(a.key.size(), 6)),
-                  a.key.c_str());
-    s += buf;
-  }
-  for (const Column& c : columns()) {
-    char probe[64];
-    const int width = std::snprintf(probe, sizeof probe, c.format, 0.0);
-    std::snprintf(buf, sizeof buf, " %*s", width, c.head);
-    s += buf;
-  }
-  s += "\n";
-  for (const SweepPoint& p : sweep.points) {
-    const std::vector<std::string> v = point_values(p);
-    for (std::size_t a = 0; a < v.size(); ++a) {
-      const int width = static_cast<int>(std::max<std::size_t>(sweep.axes[a].key.size(), 6));
-      std::snprintf(buf, sizeof buf, "%*s ", width, v[a].c_str());
-      s += buf;
-    }
-    for (const Column& c : columns()) {
-      s += ' ';
-      std::snprintf(buf, sizeof buf, c.format, c.get(p));
-      s += buf;
-    }
-    s += "\n";
-  }
-  return s;
-}
-
-std::string sweep_csv(const SweepResult& sweep) {
-  const bool shard = sweep.shards > 1;
-  std::string s = shard ? "point,points," : "";
-  for (const SweepAxis& a : sweep.axes) {
-    s += a.key + ",";
-  }
-  for (const Column& c : columns()) {
-    s += std::string(c.name) + (&c == &columns().back() ? "\n" : ",");
-  }
-  char buf[64];
-  for (const SweepPoint& p : sweep.points) {
-    if (shard) s += std::to_string(p.index) + "," + std::to_string(sweep.total_points) + ",";
-    for (const std::string& v : point_values(p)) {
-      s += v + ",";
-    }
-    for (const Column& c : columns()) {
-      std::snprintf(buf, sizeof buf, "%.17g", c.get(p));
-      s += std::string(buf) + (&c == &columns().back() ? "\n" : ",");
-    }
-  }
-  return s;
-}
-
-nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
-  nlohmann::json j;
-  j["scene"] = opts.scene;
-  j["resolution"] = opts.res;
-  j["preset"] = opts.preset;
-  j["set"] = opts.set;
-  nlohmann::json vary = nlohmann::json::object();
-  for (const SweepAxis& a : sweep.axes) {
-    vary[a.key] = a.values;
-  }
-  j["vary"] = vary;
-  j["model"] = opts.model;
-  j["functional_model"] = sweep.functional_model;
-  j["bit_identical_to_functional_model"] = true;  // run_sweep_points throws otherwise
-  j["functional_rays"] = sweep.functional_rays;
-  if (sweep.shards > 1) {
-    j["shard"] = std::to_string(sweep.shard + 1) + "/" + std::to_string(sweep.shards);
-    j["total_points"] = sweep.total_points;
-  }
-  nlohmann::json points = nlohmann::json::array();
-  for (const SweepPoint& p : sweep.points) {
-    nlohmann::json e;
-    if (sweep.shards > 1) e["index"] = p.index;
-    const std::vector<std::string> v = point_values(p);
-    for (std::size_t a = 0; a < v.size(); ++a) {
-      e["values"][sweep.axes[a].key] = v[a];
-    }
-    e["speedup"] = p.speedup;
-    e["report"] = p.cycle;
-    points.push_back(std::move(e));
-  }
-  j["points"] = points;
-  return j;
-}
-
 namespace {
 
 // A CSV's lines and cells (the sweep's own CSVs: no quoting, one row a line).
@@ -440,50 +276,6 @@ std::string csv_line(const std::vector<std::string>& cells, std::size_t from) {
   for (std::size_t i = from; i < cells.size(); ++i)
     s += cells[i] + (i + 1 == cells.size() ? "\n" : ",");
   return s;
-}
-
-// --out-dir for a sweep: the CSV, the report without host timing (host.json has it), each point's
-// resolved configuration (config.json), each point's statistics as one block (stats.txt) and the
-// command line.
-void write_sweep_dir(const SweepOptions& opts, const SweepResult& sweep, const RenderSettings& rs,
-                     int jobs, int ranks) {
-  nlohmann::json report = sweep_json(sweep, opts);
-  nlohmann::json host;
-  host["jobs"] = jobs;
-  host["mpi_ranks"] = ranks;
-  nlohmann::json config;
-  config["scene"] = opts.scene;
-  config["model"] = opts.model;
-  config["resolution"] = opts.res;
-  config["time"] = rs.time;
-  config["shadows"] = rs.shadows;
-  config["depth"] = rs.depth;
-  config["bank_mb"] = rs.bank_mb;
-  config["preset"] = opts.preset;
-  config["set"] = opts.set;
-  for (const SweepAxis& a : sweep.axes)
-    config["vary"].push_back({{"key", a.key}, {"values", a.values}});
-  if (sweep.shards > 1) config["shard"] = report["shard"];
-  std::vector<std::pair<std::string, std::vector<StatLine>>> blocks;
-  for (std::size_t i = 0; i < sweep.points.size(); ++i) {
-    nlohmann::json& point = report["points"][i];
-    host["points"].push_back(
-        {{"values", point["values"]}, {"host", take_cycle_host(point["report"])}});
-    config["points"].push_back(
-        {{"values", point["values"]}, {"configuration", point["report"]["configuration"]}});
-    std::vector<StatLine> lines;
-    append_cycle_stats(lines, sweep.points[i].cycle);
-    blocks.push_back({"point " + std::to_string(sweep.points[i].index + 1) + " of " +
-                          std::to_string(sweep.total_points) + ": " +
-                          join_words(sweep.points[i].settings),
-                      std::move(lines)});
-  }
-  write_text_file(run_file(opts.out_dir, "sweep.csv"), sweep_csv(sweep));
-  write_text_file(run_file(opts.out_dir, "report.json"), report.dump(2) + "\n");
-  write_text_file(run_file(opts.out_dir, "stats.txt"), stats_text_blocks(blocks));
-  write_text_file(run_file(opts.out_dir, "config.json"), config.dump(2) + "\n");
-  write_text_file(run_file(opts.out_dir, "command.txt"), command_line_text(opts.argv));
-  write_text_file(run_file(opts.out_dir, "host.json"), host.dump(2) + "\n");
 }
 
 }  // namespace
@@ -567,6 +359,76 @@ int run_sweep_merge(const SweepMergeOptions& opts) {
   return 0;
 }
 
+namespace {
+
+// Under mpirun: every rank sends rank 0 its points (or its error); rank 0 gets the first failing
+// rank's error or every rank's points, in sweep order. Returns false on the other ranks.
+bool gather_ranks(MpiRanks& ranks, std::string& error, SweepResult& sweep) {
+  const std::vector<std::string> all = ranks.gather(sweep_rank_message(error, sweep).dump());
+  if (ranks.rank() != 0) return false;
+  std::vector<SweepPoint> points;
+  for (std::size_t r = 0; r < all.size() && error.empty(); ++r) {
+    const nlohmann::json j = nlohmann::json::parse(all[r]);
+    if (j.contains("error")) {
+      error = j["error"].get<std::string>();
+      break;
+    }
+    for (SweepPoint& p : sweep_points_from_json(j["points"]))
+      points.push_back(std::move(p));
+  }
+  if (error.empty()) {
+    std::ranges::sort(points, {}, &SweepPoint::index);
+    sweep.points = std::move(points);
+    sweep.shard = 0;
+    sweep.shards = 1;
+    set_speedups(sweep);
+  }
+  return true;
+}
+
+// --report, --csv and --out-dir checked (one line naming the option).
+void check_sweep_outputs(const SweepOptions& opts) {
+  if (!opts.report.empty() && !opts.report.ends_with(".json")) {
+    throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
+  }
+  if (!opts.csv.empty() && !opts.csv.ends_with(".csv")) {
+    throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
+  }
+  if (!opts.out_dir.empty()) {
+    check_out_dir(opts.out_dir);
+    if (!opts.csv.empty() || !opts.report.empty())
+      throw std::runtime_error(
+          "--out-dir names every file it writes (sweep.csv, report.json): drop --csv and "
+          "--report");
+  }
+}
+
+// The sweep's summary line, where its files went and its table.
+void print_sweep(const SweepOptions& opts, const SweepResult& sweep, const RenderSettings& settings,
+                 std::size_t count) {
+  const std::string shard =
+      sweep.shards > 1 ? ", shard " + opts.shard + ": " + std::to_string(sweep.points.size()) : "";
+  std::printf(
+      "saarcor sweep: %s, model %s, %dx%d, %zu points%s, every one bit-identical to the "
+      "functional %s model (hit records and image, %" PRIu64 " rays)\n",
+      opts.scene.c_str(), opts.model.c_str(), settings.res.width, settings.res.height, count,
+      shard.c_str(), sweep.functional_model.c_str(), sweep.functional_rays);
+  if (!opts.out_dir.empty()) {
+    std::printf(
+        "  run folder: %s (sweep.csv, report.json, stats.txt, config.json, command.txt, "
+        "host.json)\n",
+        opts.out_dir.c_str());
+  }
+  if (!opts.report.empty()) {
+    std::printf("  report:    %s\n", opts.report.c_str());
+  }
+  if (!opts.csv.empty()) {
+    std::printf("  csv:       %s\n", opts.csv.c_str());
+  }
+}
+
+}  // namespace
+
 int run_sweep(const SweepOptions& opts) {
   // Under mpirun every rank runs this; rank 0 gathers and alone prints and writes. Every failure
   // of any rank, bad input included, reaches rank 0 as text, so no rank waits for a dead one and
@@ -592,19 +454,7 @@ int run_sweep(const SweepOptions& opts) {
     }
     // Every bad input fails here, before the scene loads and before any frame runs.
     count = sweep_points(axes, settings.cycle).size();
-    if (!opts.report.empty() && !opts.report.ends_with(".json")) {
-      throw std::runtime_error("bad --report '" + opts.report + "': expected a .json file name");
-    }
-    if (!opts.csv.empty() && !opts.csv.ends_with(".csv")) {
-      throw std::runtime_error("bad --csv '" + opts.csv + "': expected a .csv file name");
-    }
-    if (!opts.out_dir.empty()) {
-      check_out_dir(opts.out_dir);
-      if (!opts.csv.empty() || !opts.report.empty())
-        throw std::runtime_error(
-            "--out-dir names every file it writes (sweep.csv, report.json): drop --csv and "
-            "--report");
-    }
+    check_sweep_outputs(opts);
     const bool per_core = jobs == 0;
     jobs = resolve_jobs(jobs);
     SweepRun run;
@@ -625,62 +475,17 @@ int run_sweep(const SweepOptions& opts) {
   } catch (const std::exception& e) {
     error = e.what();
   }
-  if (ranks.size() > 1) {
-    nlohmann::json mine;
-    if (!error.empty()) {
-      mine["error"] = error;
-    } else {
-      mine["points"] = sweep_points_json(sweep);
-    }
-    const std::vector<std::string> all = ranks.gather(mine.dump());
-    if (ranks.rank() != 0) return error.empty() ? 0 : 1;
-    // The first failing rank's error; otherwise every rank's points, in sweep order.
-    std::vector<SweepPoint> points;
-    for (std::size_t r = 0; r < all.size() && error.empty(); ++r) {
-      const nlohmann::json j = nlohmann::json::parse(all[r]);
-      if (j.contains("error")) {
-        error = j["error"].get<std::string>();
-        break;
-      }
-      for (SweepPoint& p : sweep_points_from_json(j["points"]))
-        points.push_back(std::move(p));
-    }
-    if (error.empty()) {
-      std::ranges::sort(points, {}, &SweepPoint::index);
-      sweep.points = std::move(points);
-      sweep.shard = 0;
-      sweep.shards = 1;
-      set_speedups(sweep);
-    }
-  }
+  if (ranks.size() > 1 && !gather_ranks(ranks, error, sweep)) return error.empty() ? 0 : 1;
   if (!error.empty()) throw std::runtime_error(error);
 
-  if (!opts.out_dir.empty()) write_sweep_dir(opts, sweep, settings, jobs, ranks.size());
+  if (!opts.out_dir.empty()) write_sweep_folder(opts, sweep, settings, jobs, ranks.size());
   if (!opts.report.empty()) {
     write_text_file(opts.report, sweep_json(sweep, opts).dump(2) + "\n");
   }
   if (!opts.csv.empty()) {
     write_text_file(opts.csv, sweep_csv(sweep));
   }
-  const std::string shard =
-      sweep.shards > 1 ? ", shard " + opts.shard + ": " + std::to_string(sweep.points.size()) : "";
-  std::printf(
-      "saarcor sweep: %s, model %s, %dx%d, %zu points%s, every one bit-identical to the "
-      "functional %s model (hit records and image, %" PRIu64 " rays)\n",
-      opts.scene.c_str(), opts.model.c_str(), settings.res.width, settings.res.height, count,
-      shard.c_str(), sweep.functional_model.c_str(), sweep.functional_rays);
-  if (!opts.out_dir.empty()) {
-    std::printf(
-        "  run folder: %s (sweep.csv, report.json, stats.txt, config.json, command.txt, "
-        "host.json)\n",
-        opts.out_dir.c_str());
-  }
-  if (!opts.report.empty()) {
-    std::printf("  report:    %s\n", opts.report.c_str());
-  }
-  if (!opts.csv.empty()) {
-    std::printf("  csv:       %s\n", opts.csv.c_str());
-  }
+  print_sweep(opts, sweep, settings, count);
   std::printf("%s", sweep_table(sweep).c_str());
   return 0;
 }

@@ -51,8 +51,8 @@ struct SweepOptions {
   // over the ranks on this host). The rows are the same for every count.
   int jobs = 0;
   std::string shard;  // "K/N": only the points of shard K of N (1 <= K <= N), for array jobs
-  // --out-dir DIR (testbench/run_dir.h): sweep.csv, report.json, stats.txt, config.json,
-  // command.txt, host.json; --csv and --report are refused with it.
+  // --out-dir DIR (testbench/report.h write_run_folder): sweep.csv, report.json, stats.txt,
+  // config.json, command.txt, host.json; --csv and --report are refused with it.
   std::string out_dir;
   std::vector<std::string> argv;  // the command line, for command.txt
 };
@@ -104,10 +104,8 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
 // Every point's speed-up over the first point held (the sweep's first point in a whole sweep).
 void set_speedups(SweepResult& sweep);
 
-// The points of a result as JSON ({"index", "settings", "cycle"} each) and back: what MPI ranks
-// send rank 0 (doubles survive the round trip bit for bit).
-nlohmann::json sweep_points_json(const SweepResult& sweep);
-std::vector<SweepPoint> sweep_points_from_json(const nlohmann::json& j);
+// The points as JSON and back (MPI ranks), the printed table, the CSV and the JSON report are
+// testbench/report.h's (sweep_points_json, sweep_table, sweep_csv, sweep_json).
 
 // Shard CSVs (named for the messages) -> the CSV of the whole sweep, byte for byte the one a
 // single process writes: rows in point order, speed-ups over point 0 recomputed from the cycles.
@@ -120,12 +118,6 @@ struct SweepMergeOptions {
   std::string out;                 // the merged CSV
 };
 int run_sweep_merge(const SweepMergeOptions& opts);
-
-// The printed table, the CSV text (a shard's with the columns point and points first) and the
-// JSON report of a sweep.
-std::string sweep_table(const SweepResult& sweep);
-std::string sweep_csv(const SweepResult& sweep);
-nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts);
 
 // Returns 0; throws std::runtime_error with one line on bad input (before any frame runs) or on
 // a point whose results differ from the functional model's. Files are written only at the end.

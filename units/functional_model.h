@@ -19,24 +19,40 @@
 
 namespace saarcor::units {
 
-// Work and float ops of one frame, per unit (paper Table 2 names the units).
-struct UnitStats {
+// Work and float ops of one frame, per unit (paper Table 2 names the units): the units' own
+// counts as the thread program kept them, and the frame's packets and requests.
+struct UnitStats : UnitCounts {
   ff::OpCounts traversal_ops, transformation_ops, intersection_ops, rgs_ops;
-  std::uint64_t traversal_steps = 0;
-  std::uint64_t inner_steps = 0;
-  std::uint64_t clip_steps = 0;
-  std::uint64_t clips = 0;            // box clips (scene and object boxes)
-  std::uint64_t exit_only_clips = 0;  // of them, exit faces only (3 steps)
-  std::uint64_t list_steps = 0;
-  std::uint64_t transformation_steps = 0;
-  std::uint64_t shading_transformation_steps = 0;
-  std::uint64_t intersection_packets = 0;
-  std::uint64_t sub_packets = 0;
-  std::uint64_t stack_drops = 0;       // stack entries dropped at the pop (every ray terminated)
-  std::uint64_t empty_leaf_steps = 0;  // of traversal_steps, on leaves without items
-  std::uint64_t packets = 0;           // primary packets handed out by the RGC
-  std::uint64_t requests = 0;          // thread-program requests served (all units)
+  std::uint64_t packets = 0;   // primary packets handed out by the RGC
+  std::uint64_t requests = 0;  // thread-program requests served (all units)
 };
+
+// The frame's own counters, declared once (units/program_types.h CounterDecl).
+inline constexpr CounterDecl<UnitStats> kFrameCounterDecls[] = {
+    {"packets", "packets", "ray packets", &UnitStats::packets},
+    {"requests", "requests", "thread-program requests served (all units)", &UnitStats::requests},
+};
+
+// The float units' op counters (paper Table 2's adders, multipliers, dividers, comparators), per
+// unit; "total" is their sum (ff::OpCounts::total).
+struct OpUnitDecl {
+  const char* name;
+  ff::OpCounts UnitStats::*member;
+};
+inline constexpr OpUnitDecl kOpUnitDecls[] = {
+    {"traversal", &UnitStats::traversal_ops},
+    {"transformation", &UnitStats::transformation_ops},
+    {"intersection", &UnitStats::intersection_ops},
+    {"rgs", &UnitStats::rgs_ops},
+};
+inline constexpr CounterDecl<ff::OpCounts> kOpCounterDecls[] = {
+    {"add", "ops", "floating-point additions and subtractions", &ff::OpCounts::add},
+    {"mul", "ops", "floating-point multiplications", &ff::OpCounts::mul},
+    {"div", "ops", "floating-point divisions", &ff::OpCounts::div},
+    {"sqrt", "ops", "floating-point square roots", &ff::OpCounts::sqrt},
+    {"cmp", "ops", "floating-point comparisons", &ff::OpCounts::cmp},
+};
+inline constexpr const char* kOpTotalDesc = "floating-point operations, all kinds";
 
 struct FunctionalFrame {
   ff::Format format = ff::kFp24;
@@ -104,22 +120,11 @@ PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& 
 template <class F>
 void collect_frame(FunctionalFrame& frame, const PipelineUnits<F>& u, FrameSink& sink) {
   UnitStats& s = frame.units;
+  static_cast<UnitCounts&>(s) = u;
   s.traversal_ops = u.traversal_ops;
   s.transformation_ops = u.transformation_ops;
   s.intersection_ops = u.intersection_ops;
   s.rgs_ops = u.rgs_ops;
-  s.traversal_steps = u.traversal_steps;
-  s.inner_steps = u.inner_steps;
-  s.clip_steps = u.clip_steps;
-  s.clips = u.clips;
-  s.exit_only_clips = u.exit_only_clips;
-  s.list_steps = u.list_steps;
-  s.transformation_steps = u.transformation_steps;
-  s.shading_transformation_steps = u.shading_transformation_steps;
-  s.intersection_packets = u.intersection_packets;
-  s.sub_packets = u.sub_packets;
-  s.stack_drops = u.stack_drops;
-  s.empty_leaf_steps = u.empty_leaf_steps;
   frame.by_kind = sink.by_kind;
   frame.rays_issued = sink.rays_issued;
   frame.rays_returned = sink.rays_returned;

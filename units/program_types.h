@@ -67,6 +67,29 @@ struct RayCounters {
   friend bool operator==(const RayCounters&, const RayCounters&) = default;
 };
 
+// A counter declared once (gem5's ADD_STAT): the name every report gives it, its unit, one line of
+// description, and where it lives. The reports, stats.txt and the copies between the models all
+// follow these tables, so a counter added to a struct and its table is reported everywhere.
+template <class S>
+struct CounterDecl {
+  const char* name;
+  const char* unit;
+  const char* desc;
+  std::uint64_t S::*member;
+};
+
+inline constexpr CounterDecl<RayCounters> kRayCounterDecls[] = {
+    {"traversal_steps", "steps", "kd-tree traversal steps (inner, leaf and clip)",
+     &RayCounters::traversal_steps},
+    {"list_entries", "entries", "list entries read (objects and triangles)",
+     &RayCounters::list_entries},
+    {"mailbox_skips", "entries", "list entries skipped by the mailbox",
+     &RayCounters::mailbox_skips},
+    {"transformations", "steps", "rays transformed (into object or unit-triangle space)",
+     &RayCounters::transformations},
+    {"intersections", "tests", "ray-triangle intersection tests", &RayCounters::intersections},
+};
+
 enum class RayKind : std::uint8_t {
   kPrimary = 0,
   kShadow = 1,
@@ -226,10 +249,46 @@ class UnitTap {
   virtual void intersection(int lane, const Ray<F>& ray, const Candidate<F>& c) = 0;
 };
 
+// Work counted per unit, in the unit's own steps: the thread program counts it in PipelineUnits
+// and the frame reports it (UnitStats) as the same struct.
+struct UnitCounts {
+  std::uint64_t traversal_steps = 0;       // kd-node steps (inner + leaf + empty)
+  std::uint64_t inner_steps = 0;           // steps on inner nodes (P add, P div, 3P cmp)
+  std::uint64_t clip_steps = 0;            // box-face steps (P add, P div, P (+P) cmp)
+  std::uint64_t clips = 0;                 // box clips (scene box or object box)
+  std::uint64_t exit_only_clips = 0;       // of them, exit faces only (origins inside the box)
+  std::uint64_t list_steps = 0;            // list entries fetched
+  std::uint64_t transformation_steps = 0;  // ray transformation steps (generation, object, tri)
+  std::uint64_t shading_transformation_steps = 0;  // normal and dot-product steps of the RGS
+  std::uint64_t intersection_packets = 0;          // packets intersected (P rays each)
+  std::uint64_t sub_packets = 0;       // masked sub-packets from mixed direction signs (D27)
+  std::uint64_t stack_drops = 0;       // stack entries dropped at the pop: every ray terminated
+  std::uint64_t empty_leaf_steps = 0;  // of traversal_steps, on leaves without items
+};
+
+inline constexpr CounterDecl<UnitCounts> kUnitCounterDecls[] = {
+    {"traversal_steps", "steps", "kd-tree traversal steps (inner, leaf and clip)",
+     &UnitCounts::traversal_steps},
+    {"inner_steps", "steps", "inner-node steps of the traversal unit", &UnitCounts::inner_steps},
+    {"clip_steps", "steps", "box-clip steps of the traversal unit", &UnitCounts::clip_steps},
+    {"clips", "clips", "box clips", &UnitCounts::clips},
+    {"exit_only_clips", "clips", "box clips on the exit faces only", &UnitCounts::exit_only_clips},
+    {"list_steps", "steps", "list unit steps", &UnitCounts::list_steps},
+    {"transformation_steps", "steps", "transformation unit steps",
+     &UnitCounts::transformation_steps},
+    {"shading_transformation_steps", "steps", "transformation unit steps for shading",
+     &UnitCounts::shading_transformation_steps},
+    {"intersection_packets", "packets", "packets through the intersection unit",
+     &UnitCounts::intersection_packets},
+    {"sub_packets", "packets", "packets split by the traversal", &UnitCounts::sub_packets},
+    {"stack_drops", "entries", "traversal stack entries dropped", &UnitCounts::stack_drops},
+    {"empty_leaf_steps", "steps", "steps into empty leaves", &UnitCounts::empty_leaf_steps},
+};
+
 // The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is
 // decision D10's optional shading helper (cosines: mul, sqrt, div; the refraction factor mu).
 template <class F>
-class PipelineUnits {
+class PipelineUnits : public UnitCounts {
  public:
   explicit PipelineUnits(ff::Mode mode = {})
       : traversal(mode, &traversal_ops),
@@ -257,20 +316,6 @@ class PipelineUnits {
     c.div += div;
     c.cmp += cmp;
   }
-
-  // Work counted per unit, in the unit's own steps.
-  std::uint64_t traversal_steps = 0;       // kd-node steps (inner + leaf + empty)
-  std::uint64_t inner_steps = 0;           // steps on inner nodes (P add, P div, 3P cmp)
-  std::uint64_t clip_steps = 0;            // box-face steps (P add, P div, P (+P) cmp)
-  std::uint64_t clips = 0;                 // box clips (scene box or object box)
-  std::uint64_t exit_only_clips = 0;       // of them, exit faces only (origins inside the box)
-  std::uint64_t list_steps = 0;            // list entries fetched
-  std::uint64_t transformation_steps = 0;  // ray transformation steps (generation, object, tri)
-  std::uint64_t shading_transformation_steps = 0;  // normal and dot-product steps of the RGS
-  std::uint64_t intersection_packets = 0;          // packets intersected (P rays each)
-  std::uint64_t sub_packets = 0;       // masked sub-packets from mixed direction signs (D27)
-  std::uint64_t stack_drops = 0;       // stack entries dropped at the pop: every ray terminated
-  std::uint64_t empty_leaf_steps = 0;  // of traversal_steps, on leaves without items
 };
 
 // Where a thread's results go: the frame the RGC hands pixels from.

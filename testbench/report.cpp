@@ -1,0 +1,1148 @@
+// The report module (testbench/report.h): the statistics' places in the reports, the JSON and
+// stats.txt made from them, and the run folder's one writer.
+#include "testbench/report.h"
+
+#include <algorithm>
+#include <array>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <string_view>
+
+#include "host/tree_settings.h"
+#include "testbench/frame_sequence.h"
+#include "testbench/image_io.h"
+#include "testbench/paper_cmd.h"
+#include "testbench/precision_cmd.h"
+#include "testbench/render_cmd.h"
+#include "testbench/sweep_cmd.h"
+
+namespace saarcor {
+namespace {
+
+bool shell_safe(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+         std::string_view("_@%+=:,./-").find(c) != std::string_view::npos;
+}
+
+std::string format_value(double v) {
+  char buf[64];
+  // Integers (counts, cycles) exactly; the rest at gem5's six decimals.
+  if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 9007199254740992.0)
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+
+void append_lines(std::string& s, const std::vector<StatLine>& lines) {
+  for (const StatLine& l : lines) {
+    const std::string desc = l.unit.empty() ? l.desc : l.desc + " (" + l.unit + ")";
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "%-56s %20s  # %s\n", l.name.c_str(),
+                  format_value(l.value).c_str(), desc.c_str());
+    s += buf;
+  }
+}
+
+double num(const nlohmann::json& j) {
+  if (j.is_boolean()) return j.get<bool>() ? 1.0 : 0.0;
+  return j.is_number() ? j.get<double>() : 0.0;
+}
+
+double per(std::uint64_t a, std::uint64_t b) {
+  return b == 0 ? 0.0 : static_cast<double>(a) / static_cast<double>(b);
+}
+
+// A counter's total and its mean per ray ({name}.total, {name}.per_ray).
+void add_counter(std::vector<ReportStat>& out, const std::string& name, const char* unit,
+                 const char* desc, std::uint64_t total, std::uint64_t rays) {
+  out.push_back({name + ".total", unit, std::string(desc) + ", total", total});
+  out.push_back({name + ".per_ray", std::string(unit) + "/ray", std::string(desc) + ", per ray",
+                 per(total, rays)});
+}
+
+}  // namespace
+
+// ---- statistics --------------------------------------------------------------------------------
+
+nlohmann::json nest(const std::vector<ReportStat>& stats) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const ReportStat& s : stats) {
+    nlohmann::json* at = &j;
+    std::size_t from = 0;
+    for (std::size_t dot = s.name.find('.'); dot != std::string::npos;
+         from = dot + 1, dot = s.name.find('.', from))
+      at = &(*at)[s.name.substr(from, dot - from)];
+    (*at)[s.name.substr(from)] = s.value;
+  }
+  return j;
+}
+
+const nlohmann::json& json_at(const nlohmann::json& j, const std::string& dotted) {
+  static const nlohmann::json null;
+  const nlohmann::json* at = &j;
+  std::size_t from = 0;
+  while (true) {
+    const std::size_t dot = dotted.find('.', from);
+    const std::string key = dotted.substr(from, dot == std::string::npos ? dot : dot - from);
+    if (!at->is_object() || !at->contains(key)) return null;
+    at = &(*at)[key];
+    if (dot == std::string::npos) return *at;
+    from = dot + 1;
+  }
+}
+
+std::vector<StatLine> stat_lines(const std::vector<ReportStat>& stats, const std::string& prefix) {
+  std::vector<StatLine> lines;
+  lines.reserve(stats.size());
+  for (const ReportStat& s : stats)
+    lines.push_back({prefix + s.name, num(s.value), s.desc, s.unit});
+  return lines;
+}
+
+std::string stats_text(const std::vector<StatLine>& lines) {
+  std::string s = "\n---------- Begin Simulation Statistics ----------\n";
+  append_lines(s, lines);
+  s += "\n---------- End Simulation Statistics   ----------\n";
+  return s;
+}
+
+std::string stats_text_blocks(
+    const std::vector<std::pair<std::string, std::vector<StatLine>>>& blocks) {
+  std::string s;
+  for (const auto& [title, lines] : blocks) {
+    s += "\n---------- Begin Simulation Statistics ----------\n# " + title + "\n";
+    append_lines(s, lines);
+    s += "\n---------- End Simulation Statistics   ----------\n";
+  }
+  return s;
+}
+
+// ---- the models' counters ----------------------------------------------------------------------
+
+std::vector<ReportStat> op_stats(const units::UnitStats& u) {
+  std::vector<ReportStat> out;
+  for (const units::OpUnitDecl& unit : units::kOpUnitDecls) {
+    const ff::OpCounts& ops = u.*unit.member;
+    const std::string pre = std::string("ops.") + unit.name + ".";
+    for (const auto& d : units::kOpCounterDecls)
+      out.push_back({pre + d.name, d.unit, d.desc, ops.*d.member});
+    out.push_back({pre + "total", "ops", units::kOpTotalDesc, ops.total()});
+  }
+  return out;
+}
+
+std::vector<ReportStat> functional_counter_stats(const units::FunctionalFrame& frame,
+                                                 std::uint64_t& rays) {
+  std::vector<ReportStat> out;
+  rays = 0;
+  for (int k = 0; k < units::kRayKinds; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    const units::RayCounters& c = frame.by_kind[kk];
+    const std::uint64_t n = frame.rays_issued[kk];
+    rays += n;
+    const std::string pre =
+        std::string("per_ray.") + units::ray_kind_name(static_cast<units::RayKind>(k)) + ".";
+    for (const auto& d : units::kRayCounterDecls)
+      add_counter(out, pre + d.name, d.unit, d.desc, c.*d.member, n);
+    out.push_back({pre + "rays_issued", "rays", "rays issued", n});
+    out.push_back({pre + "rays_returned", "rays", "rays returned", frame.rays_returned[kk]});
+  }
+  for (ReportStat& s : op_stats(frame.units))
+    out.push_back(std::move(s));
+  for (const auto& d : units::kUnitCounterDecls)
+    out.push_back({std::string("units.") + d.name, d.unit, d.desc, frame.units.*d.member});
+  for (const auto& d : units::kFrameCounterDecls)
+    out.push_back({std::string("units.") + d.name, d.unit, d.desc, frame.units.*d.member});
+  return out;
+}
+
+std::vector<ReportStat> float_counter_stats(const host::FloatTraceStats& s) {
+  // host::FloatTraceStats counts what the functional model's RayCounters count, and the leaves.
+  const struct {
+    const char* name;
+    const char* unit;
+    const char* desc;
+    std::uint64_t value;
+  } counters[] = {
+      {"traversal_steps", "steps", "kd-tree traversal steps (inner, leaf and clip)",
+       s.traversal_steps},
+      {"leaves", "leaves", "kd-tree leaves visited", s.leaves},
+      {"list_entries", "entries", "list entries read (objects and triangles)", s.list_entries},
+      {"mailbox_skips", "entries", "list entries skipped by the mailbox", s.mailbox_skips},
+      {"transformations", "steps", "rays transformed (into object or unit-triangle space)",
+       s.transformations},
+      {"intersections", "tests", "ray-triangle intersection tests", s.intersections},
+  };
+  std::vector<ReportStat> out;
+  for (const auto& c : counters)
+    add_counter(out, std::string("per_ray.") + c.name, c.unit, c.desc, c.value, s.rays);
+  return out;
+}
+
+// ---- the cycle model's frame report ------------------------------------------------------------
+
+namespace {
+
+// A statistic of the cycle model's frame report: its place, unit, description and its formula
+// over the frame.
+struct CycleStatDecl {
+  std::string name, unit, desc;
+  std::function<nlohmann::json(const CycleFrame&)> value;
+};
+
+void frame_decls(std::vector<CycleStatDecl>& d) {
+  d.push_back({"cycles", "cycles", "simulated cycles of the frame",
+               [](const CycleFrame& c) { return nlohmann::json(c.cycles); }});
+  d.push_back({"fps", "frames/s", "frames per second at the modelled clock",
+               [](const CycleFrame& c) { return nlohmann::json(c.fps); }});
+  d.push_back({"rays", "rays", "rays traced, all kinds",
+               [](const CycleFrame& c) { return nlohmann::json(c.rays); }});
+  d.push_back({"rays_per_s", "rays/s", "rays per second at the modelled clock",
+               [](const CycleFrame& c) { return nlohmann::json(c.rays_per_s); }});
+  d.push_back({"packets", "packets", "ray packets",
+               [](const CycleFrame& c) { return nlohmann::json(c.packets); }});
+  d.push_back({"cycles_per_packet", "cycles", "cycles per packet",
+               [](const CycleFrame& c) { return nlohmann::json(per(c.cycles, c.packets)); }});
+  d.push_back({"simd_efficiency", "ratio", "active rays per packet step / packet width",
+               [](const CycleFrame& c) { return nlohmann::json(c.simd_efficiency); }});
+  // The Table 4 figures the report writes (units/figures.h), each with its own declaration.
+  for (int i = 0; i < units::kFigureCount; ++i) {
+    const units::FigureInfo& f = units::kFigures[i];
+    if (!f.in_report) continue;
+    d.push_back({f.name, f.unit, f.help,
+                 [i](const CycleFrame& c) { return nlohmann::json(c.figures.at(i)); }});
+  }
+}
+
+// The RGS's traffic (docs/shading.md "Shading traffic") and the per-ray counters.
+void rgs_and_ray_decls(std::vector<CycleStatDecl>& d) {
+  d.push_back({"rgs.shading_bytes", "bytes", "shading-bank bytes the RGS read",
+               [](const CycleFrame& c) { return nlohmann::json(c.shading_bytes); }});
+  d.push_back({"rgs.frame_buffer_bytes", "bytes", "frame-buffer bytes the RGS wrote",
+               [](const CycleFrame& c) { return nlohmann::json(c.frame_bytes); }});
+  d.push_back({"rgs.shading_bytes_per_pixel", "bytes/pixel",
+               "shading reads and frame-buffer writes over the pixels",
+               [](const CycleFrame& c) { return nlohmann::json(c.shading_bytes_per_pixel); }});
+  d.push_back({"rgs.frame_bank", "bank", "the frame-buffer bank the frame was written into",
+               [](const CycleFrame& c) { return nlohmann::json(c.frame_bank); }});
+  for (const auto& r : units::kRayCounterDecls)
+    d.push_back({std::string("per_ray.") + r.name, std::string(r.unit) + "/ray",
+                 std::string(r.desc) + ", per ray", [m = r.member](const CycleFrame& c) {
+                   return nlohmann::json(per(c.per_ray_sum.*m, c.rays));
+                 }});
+  d.push_back({"ops.traversal_to_intersection", "ratio",
+               "traversal float ops over intersection float ops", [](const CycleFrame& c) {
+                 const units::UnitStats& u = c.frame.units;
+                 return nlohmann::json(per(u.traversal_ops.total(), u.intersection_ops.total()));
+               }});
+}
+
+// Per unit of Table 4 and per cache, summed over the DynRTPs.
+void unit_and_cache_decls(std::vector<CycleStatDecl>& d) {
+  using Counts = std::array<std::uint64_t, units::kTable4Units>;
+  const struct {
+    const char* key;
+    const char* unit;
+    const char* desc;
+    Counts CycleFrame::*member;
+  } per_unit[] = {
+      {"issue_cycles", "cycles", "cycles the unit issued a step", &CycleFrame::issue_cycles},
+      {"stall_cycles", "cycles", "cycles the unit was stalled", &CycleFrame::stall_cycles},
+      {"requests", "requests", "thread-program requests the unit served", &CycleFrame::requests},
+  };
+  for (int i = 0; i < units::kTable4Units; ++i)
+    for (const auto& u : per_unit)
+      d.push_back({std::string("units.") + units::kTable4UnitNames[i] + "." + u.key, u.unit, u.desc,
+                   [i, m = u.member](const CycleFrame& c) {
+                     return nlohmann::json((c.*m)[static_cast<std::size_t>(i)]);
+                   }});
+  using Cache = CycleFrame::CacheCount;
+  const struct {
+    const char* key;
+    const char* unit;
+    const char* desc;
+    std::uint64_t Cache::*member;
+  } per_cache[] = {
+      {"requests", "requests", "packet requests to the cache", &Cache::requests},
+      {"hits", "requests", "requests served from a present line", &Cache::hits},
+      {"merges", "requests", "requests merged into an outstanding miss", &Cache::merges},
+      {"misses", "requests", "requests that fetched their line", &Cache::misses},
+      {"mem_bytes", "bytes", "bytes the cache read from memory", &Cache::mem_bytes},
+  };
+  for (int i = 0; i < units::kCacheUnits; ++i)
+    for (const auto& k : per_cache)
+      d.push_back(
+          {std::string("caches.") + units::cache_unit_name(units::CacheUnit(i)) + "." + k.key,
+           k.unit, k.desc, [i, m = k.member](const CycleFrame& c) {
+             return nlohmann::json(c.caches[static_cast<std::size_t>(i)].*m);
+           }});
+}
+
+const std::vector<CycleStatDecl>& cycle_decls() {
+  static const std::vector<CycleStatDecl> decls = [] {
+    std::vector<CycleStatDecl> d;
+    frame_decls(d);
+    rgs_and_ray_decls(d);
+    unit_and_cache_decls(d);
+    return d;
+  }();
+  return decls;
+}
+
+// Per DynRTP (one in the prototype): the packets the RGC handed it, its units' usage.
+nlohmann::json pipelines_json(const CycleFrame& c) {
+  nlohmann::json pipes = nlohmann::json::array();
+  for (const CycleFrame::PipelineCount& pc : c.per_pipeline) {
+    nlohmann::json e;
+    e["packets"] = pc.packets;
+    for (int i = 0; i < units::kTable4Units; ++i)
+      e["usage"][units::kTable4UnitNames[i]] =
+          100.0 * per(pc.issue_cycles[static_cast<std::size_t>(i)], c.cycles);
+    pipes.push_back(e);
+  }
+  return pipes;
+}
+
+// Every cycle-model key resolved, with the unit depths they give.
+nlohmann::json cycle_configuration_json(const units::CycleParams& p) {
+  nlohmann::json conf;
+  for (const units::CycleParamInfo& i : units::describe(p))
+    conf[i.name] = {{"value", i.value}, {"unit", i.unit}, {"help", i.help}};
+  conf["depth.traversal"] = p.traversal_depth();
+  conf["depth.list"] = p.list_depth();
+  conf["depth.transformation"] = p.transformation_depth();
+  conf["depth.intersection"] = p.intersection_depth();
+  return conf;
+}
+
+// The figures of a span (units/figures.h kFigures) the frame's report writes, into `j` at their
+// dotted names ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}).
+void add_figures(nlohmann::json& j, const units::CycleFigures& f) {
+  for (int i = 0; i < units::kFigureCount; ++i) {
+    const units::FigureInfo& info = units::kFigures[i];
+    if (!info.in_report) continue;
+    const std::string_view n = info.name;
+    const std::size_t dot = n.find('.');
+    j[std::string(n.substr(0, dot))][std::string(n.substr(dot + 1))] = f.at(i);
+  }
+}
+
+}  // namespace
+
+std::vector<ReportStat> cycle_stats(const CycleFrame& c) {
+  std::vector<ReportStat> out;
+  for (const CycleStatDecl& d : cycle_decls())
+    out.push_back({d.name, d.unit, d.desc, d.value(c)});
+  return out;
+}
+
+nlohmann::json cycle_report_json(const CycleFrame& c) {
+  nlohmann::json j = nest(cycle_stats(c));
+  j["host"] = {{"seconds", c.host_seconds},
+               {"sim_cycles_per_s", c.sim_cycles_per_s},
+               {"threads", c.host_threads},
+               {"programs", units::program_mode_name(c.programs)},
+               {"skipped_cycles", c.skipped_cycles}};
+  j["pipelines"] = pipelines_json(c);
+  j["configuration"] = cycle_configuration_json(c.params);
+  // The hw/ statistics registry in full: per unit, cache, path and memory client.
+  j["stats"] = nlohmann::json::parse(c.stats_json);
+  if (!c.series.empty()) {
+    nlohmann::json s = nlohmann::json::array();
+    for (const units::CycleFigures& f : c.series) {
+      nlohmann::json e;
+      add_figures(e, f);
+      e["cycle"] = f.cycle;
+      s.push_back(e);
+    }
+    j["time_series"] = s;
+  }
+  return j;
+}
+
+std::vector<StatLine> cycle_stat_lines(const nlohmann::json& cycle) {
+  std::vector<StatLine> lines;
+  for (const CycleStatDecl& d : cycle_decls())
+    lines.push_back({"frame." + d.name, num(json_at(cycle, d.name)), d.desc, d.unit});
+  // The registry's statistics carry their declarations in the report (hw/stats.h).
+  if (cycle.contains("stats"))
+    for (const auto& [name, s] : cycle["stats"].items())
+      lines.push_back({name, num(s["value"]), s.value("desc", ""), s.value("unit", "")});
+  return lines;
+}
+
+// ---- frame sequences ---------------------------------------------------------------------------
+
+namespace {
+
+// One column of a frame sequence's per-frame rows, declared once: its JSON key (dotted: nested)
+// and CSV column ('.' -> '_'), unit, description and value. The rows are written from this table
+// as JSON (report.json), CSV (frames.csv) and statistics (stats.txt).
+struct RowColumn {
+  const char* name;
+  const char* unit;
+  const char* desc;
+  bool cycle_only;  // timed: the cycle model's rows only
+  bool in_csv;      // frames.csv has it
+  nlohmann::json (*value)(const SequenceFrame&);
+};
+
+using Row = const SequenceFrame&;
+// A Table 4 figure of the frame, as units/figures.h declares it.
+template <int kFigure>
+constexpr RowColumn figure_column() {
+  const units::FigureInfo& f = units::kFigures[kFigure];
+  return {f.name, f.unit, f.help,
+          true,   true,   [](Row r) { return nlohmann::json(r.figures.at(kFigure)); }};
+}
+
+constexpr RowColumn kRowColumns[] = {
+    {"frame", "frame", "the frame's index", false, true,
+     [](Row f) { return nlohmann::json(f.index); }},
+    {"time", "s", "animation time", false, true, [](Row f) { return nlohmann::json(f.time); }},
+    {"frame_bank", "bank", "the frame-buffer bank written", false, true,
+     [](Row f) { return nlohmann::json(f.frame_bank); }},
+    {"top_copy", "copy", "the top-level copy the frame reads", false, true,
+     [](Row f) { return nlohmann::json(f.top_copy); }},
+    {"top_rebuilt", "bool", "the top-level tree was rebuilt (1 = yes)", false, true,
+     [](Row f) { return nlohmann::json(f.top_rebuilt); }},
+    {"moved_instances", "instances", "instances moved since the previous frame", false, true,
+     [](Row f) { return nlohmann::json(f.moved_instances); }},
+    {"top_level_builds", "trees", "top-level trees built for the frame", false, true,
+     [](Row f) { return nlohmann::json(f.top_level_builds); }},
+    {"bottom_level_builds", "trees", "bottom-level trees built for the frame", false, true,
+     [](Row f) { return nlohmann::json(f.bottom_level_builds); }},
+    {"upload_bytes", "bytes", "bytes uploaded: changed SRAM words and the registers", false, true,
+     [](Row f) { return nlohmann::json(f.upload_bytes); }},
+    {"upload_words", "words", "changed SRAM words uploaded", false, true,
+     [](Row f) { return nlohmann::json(f.upload_words); }},
+    {"upload_runs", "runs", "runs of consecutive words uploaded", false, true,
+     [](Row f) { return nlohmann::json(f.upload_runs); }},
+    {"upload_in_gap", "bool", "the upload waited for the previous frame's end (1 = yes)", false,
+     true, [](Row f) { return nlohmann::json(f.gap); }},
+    {"upload_cycles", "cycles", "from the previous frame's start until the upload was stored", true,
+     true, [](Row f) { return nlohmann::json(f.upload_cycles); }},
+    {"upload_hidden", "bool", "the upload was done within the previous frame (1 = yes)", true, true,
+     [](Row f) { return nlohmann::json(f.hidden); }},
+    {"stall_cycles", "cycles", "cycles the frame started after the previous frame's end", true,
+     true, [](Row f) { return nlohmann::json(f.stall_cycles); }},
+    {"start_cycle", "cycles", "the frame's start on the sequence's clock", true, true,
+     [](Row f) { return nlohmann::json(f.start_cycle); }},
+    {"cycles", "cycles", "simulated cycles of the frame", true, true,
+     [](Row f) { return nlohmann::json(f.cycles); }},
+    {"fps", "frames/s", "frames per second rendering alone, at the modelled clock", true, true,
+     [](Row f) { return nlohmann::json(f.fps); }},
+    figure_column<units::figure_index("usage.traversal")>(),
+    figure_column<units::figure_index("usage.list")>(),
+    figure_column<units::figure_index("usage.transformation")>(),
+    figure_column<units::figure_index("usage.intersection")>(),
+    figure_column<units::figure_index("cache_hit.traversal")>(),
+    figure_column<units::figure_index("cache_hit.list")>(),
+    figure_column<units::figure_index("cache_hit.transformation")>(),
+    figure_column<units::figure_index("bandwidth_mb_s.dynrtc")>(),
+    {"cycles_per_packet", "cycles", "cycles per packet", true, true,
+     [](Row f) { return nlohmann::json(f.cycles_per_packet); }},
+    figure_column<units::figure_index("bandwidth_mb_s.rgs")>(),
+    {"shading_bytes_per_pixel", "bytes/pixel",
+     "shading reads and frame-buffer writes over the pixels", true, true,
+     [](Row f) { return nlohmann::json(f.shading_bytes_per_pixel); }},
+    {"bit_identical_to_functional_model", "bool",
+     "hit records and image equal to the functional model's (1 = yes)", true, false,
+     [](Row f) { return nlohmann::json(f.checked); }},
+    {"rays", "rays", "rays traced, all kinds", false, true,
+     [](Row f) { return nlohmann::json(f.rays); }},
+    {"digest", "hash", "FNV-1a of the hit records and the image", false, true,
+     [](Row f) { return nlohmann::json(f.digest); }},
+};
+
+std::vector<ReportStat> row_stats(const SequenceFrame& f, bool cycle) {
+  std::vector<ReportStat> out;
+  for (const RowColumn& c : kRowColumns)
+    if (cycle || !c.cycle_only) out.push_back({c.name, c.unit, c.desc, c.value(f)});
+  return out;
+}
+
+// The sequence's summary, declared once.
+std::vector<ReportStat> summary_stats(const SequenceResult& r) {
+  std::uint64_t bytes = 0, max_bytes = 0, top = 0, bottom = 0;
+  for (const SequenceFrame& f : r.frames) {
+    if (f.index == 0) continue;  // frame 0's upload is the initial load, its trees the first build
+    bytes += f.upload_bytes;
+    max_bytes = std::max(max_bytes, f.upload_bytes);
+    top += f.top_level_builds;
+    bottom += f.bottom_level_builds;
+  }
+  const std::size_t n = r.frames.size();
+  std::vector<ReportStat> s = {
+      {"upload_bytes_total", "bytes", "bytes uploaded after frame 0", bytes},
+      {"upload_bytes_mean", "bytes", "bytes uploaded per frame after frame 0",
+       n > 1 ? static_cast<double>(bytes) / (n - 1) : 0.0},
+      {"upload_bytes_max", "bytes", "largest upload after frame 0", max_bytes},
+      {"top_level_rebuilds", "trees", "top-level trees rebuilt after frame 0", top},
+      {"bottom_level_rebuilds", "trees", "bottom-level trees rebuilt after frame 0", bottom},
+      {"bottom_level_trees", "trees", "bottom-level trees built for frame 0",
+       r.frames.empty() ? 0 : r.frames.front().bottom_level_builds}};
+  if (!r.cycle) return s;
+  s.push_back({"cycles", "cycles", "the sequence from frame 0's start to the last frame's end",
+               r.total_cycles()});
+  s.push_back({"fps", "frames/s", "frames per second with the uploads", r.fps()});
+  s.push_back({"render_fps", "frames/s", "frames per second rendering alone", r.render_fps()});
+  s.push_back(
+      {"uploads_hidden", "uploads", "uploads done within the previous frame", r.hidden_uploads()});
+  s.push_back({"uploads_in_gaps", "uploads", "uploads that waited for a frame's end", r.gaps()});
+  s.push_back({"uploads", "uploads", "uploads after frame 0", n > 0 ? n - 1 : 0});
+  s.push_back({"break_even_mb_s", "MB/s", "the lowest bus bandwidth every upload fits behind",
+               r.break_even_mb_s()});
+  return s;
+}
+
+std::string csv_cell(const RowColumn& c, const nlohmann::json& v) {
+  char buf[40];
+  if (std::string_view(c.name) == "digest")
+    std::snprintf(buf, sizeof buf, "%016" PRIx64, v.get<std::uint64_t>());
+  else if (v.is_boolean())
+    return v.get<bool>() ? "1" : "0";
+  else if (v.is_number_float())
+    std::snprintf(buf, sizeof buf, "%.17g", v.get<double>());
+  else
+    return v.dump();
+  return buf;
+}
+
+}  // namespace
+
+nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
+  nlohmann::json j;
+  j["scene"] = r.scene;
+  j["model"] = r.model;
+  j["resolution"] = {{"width", r.width}, {"height", r.height}};
+  j["frames"] = r.frames.size();
+  j["dt"] = r.dt;
+  j["top_level"] = r.frame_gap ? "one copy (every upload in a frame gap)" : "two copies";
+  j["instances"] = r.instances;
+  j["dynamic_instances"] = r.dynamic_instances;
+  j["objects"] = r.objects;
+  j["initial_load"] = {{"bytes", r.initial_load_bytes}};
+  j["top_level_copy_bytes"] = r.top_copy_bytes;
+  if (r.cycle) {
+    j["clock_mhz"] = r.clock_mhz;
+    j["hostbus_mb_s"] = r.bus_mb_s;
+    j["initial_load"]["cycles"] = r.initial_load_cycles;
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  for (const SequenceFrame& f : r.frames) {
+    nlohmann::json e = nest(row_stats(f, r.cycle));
+    if (host_times) e["host_rebuild_ms"] = f.host_rebuild_seconds * 1e3;
+    rows.push_back(e);
+  }
+  j["per_frame"] = rows;
+  j["summary"] = nest(summary_stats(r));
+  return j;
+}
+
+std::string sequence_csv(const SequenceResult& r) {
+  std::string s;
+  for (const RowColumn& c : kRowColumns) {
+    if (!c.in_csv || (c.cycle_only && !r.cycle)) continue;
+    std::string name = c.name;
+    std::ranges::replace(name, '.', '_');
+    s += (s.empty() ? "" : ",") + name;
+  }
+  s += "\n";
+  for (const SequenceFrame& f : r.frames) {
+    std::string line;
+    for (const RowColumn& c : kRowColumns) {
+      if (!c.in_csv || (c.cycle_only && !r.cycle)) continue;
+      line += (line.empty() ? "" : ",") + csv_cell(c, c.value(f));
+    }
+    s += line + "\n";
+  }
+  return s;
+}
+
+nlohmann::json bus_sweep_json(const std::vector<SequenceResult>& points) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const SequenceResult& p : points) {
+    nlohmann::json e = sequence_json(p);
+    e["hostbus_mb_s"] = p.bus_mb_s;
+    j.push_back(e);
+  }
+  return j;
+}
+
+nlohmann::json sequence_host_json(const SequenceResult& r) {
+  nlohmann::json frames = nlohmann::json::array();
+  double rebuild_max = 0.0;
+  for (const SequenceFrame& f : r.frames) {
+    frames.push_back({{"frame", f.index},
+                      {"rebuild_seconds", f.host_rebuild_seconds},
+                      {"seconds", f.host_seconds}});
+    if (f.index > 0) rebuild_max = std::max(rebuild_max, f.host_rebuild_seconds);
+  }
+  return {{"per_frame", frames}, {"top_level_rebuild_seconds_max", rebuild_max}};
+}
+
+nlohmann::json sequence_configuration_json(double time, const RenderSettings& s, bool cycle) {
+  nlohmann::json c = {
+      {"time", time}, {"shadows", s.shadows}, {"depth", s.depth}, {"bank_mb", s.bank_mb}};
+  if (cycle)
+    for (const units::CycleParamInfo& p : units::describe(resolve_cycle_params(s.cycle)))
+      c["cycle"][p.name] = {{"value", p.value}, {"unit", p.unit}, {"help", p.help}};
+  host::ImageParams trees;
+  for (const std::string& kv : s.cycle.set)
+    if (host::is_tree_setting(kv)) host::apply_tree_setting(trees, kv);
+  c["trees"] = tree_configuration_json(trees);
+  return c;
+}
+
+std::vector<StatLine> sequence_stat_lines(const SequenceResult& r) {
+  std::vector<StatLine> lines = stat_lines(summary_stats(r), "sequence.");
+  for (const SequenceFrame& f : r.frames)
+    for (StatLine& l : stat_lines(row_stats(f, r.cycle), "frame" + std::to_string(f.index) + "."))
+      lines.push_back(std::move(l));
+  return lines;
+}
+
+// ---- sweeps -----------------------------------------------------------------------------------
+
+nlohmann::json sweep_points_json(const SweepResult& sweep) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const SweepPoint& p : sweep.points)
+    a.push_back({{"index", p.index}, {"settings", p.settings}, {"cycle", p.cycle}});
+  return a;
+}
+
+std::vector<SweepPoint> sweep_points_from_json(const nlohmann::json& j) {
+  std::vector<SweepPoint> points;
+  for (const nlohmann::json& e : j) {
+    SweepPoint p;
+    p.index = e.at("index").get<std::size_t>();
+    p.settings = e.at("settings").get<std::vector<std::string>>();
+    p.cycle = e.at("cycle");
+    points.push_back(std::move(p));
+  }
+  return points;
+}
+
+namespace {
+
+// The point's value of each axis, in axis order ("threads=4" -> "4").
+std::vector<std::string> point_values(const SweepPoint& p) {
+  std::vector<std::string> v;
+  for (const std::string& kv : p.settings) {
+    v.push_back(kv.substr(kv.find('=') + 1));
+  }
+  return v;
+}
+
+// A column of the sweep's table and CSV: a statistic of the point's frame report (by its name in
+// cycle_stats' declarations) over a divisor, or the point's speed-up over the first (no stat).
+struct SweepColumn {
+  const char* name;    // CSV header
+  const char* head;    // table header
+  const char* format;  // printf format of the table cell
+  const char* stat;
+  double divisor;
+};
+
+constexpr SweepColumn kSweepColumns[] = {
+    {"cycles", "cycles", "%10.0f", "cycles", 1.0},
+    {"fps", "fps", "%8.1f", "fps", 1.0},
+    {"mrays_per_s", "Mrays/s", "%8.2f", "rays_per_s", 1e6},
+    {"speedup", "speed-up", "%8.2f", nullptr, 1.0},
+    {"usage_traversal", "trav%", "%6.0f", "usage.traversal", 1.0},
+    {"usage_list", "list%", "%6.0f", "usage.list", 1.0},
+    {"usage_transformation", "xfrm%", "%6.0f", "usage.transformation", 1.0},
+    {"usage_intersection", "int%", "%6.0f", "usage.intersection", 1.0},
+    {"cache_hit_traversal", "hit-trav%", "%10.1f", "cache_hit.traversal", 1.0},
+    {"cache_hit_list", "hit-list%", "%10.1f", "cache_hit.list", 1.0},
+    {"cache_hit_transformation", "hit-xfrm%", "%10.1f", "cache_hit.transformation", 1.0},
+    {"bandwidth_mb_s_total", "MB/s", "%7.0f", "bandwidth_mb_s.total", 1.0},
+    {"cycles_per_packet", "cyc/pkt", "%8.1f", "cycles_per_packet", 1.0},
+    {"simd_efficiency", "SIMD", "%6.2f", "simd_efficiency", 1.0},
+};
+
+double column_value(const SweepColumn& c, const SweepPoint& p) {
+  if (c.stat == nullptr) return p.speedup;
+  return json_at(p.cycle, c.stat).get<double>() / c.divisor;
+}
+
+}  // namespace
+
+std::string sweep_table(const SweepResult& sweep) {
+  std::string s;
+  char buf[64];
+  for (const SweepAxis& a : sweep.axes) {
+    std::snprintf(buf, sizeof buf, "%*s ", static_cast<int>(std::max<std::size_t>(a.key.size(), 6)),
+                  a.key.c_str());
+    s += buf;
+  }
+  for (const SweepColumn& c : kSweepColumns) {
+    char probe[64];
+    const int width = std::snprintf(probe, sizeof probe, c.format, 0.0);
+    std::snprintf(buf, sizeof buf, " %*s", width, c.head);
+    s += buf;
+  }
+  s += "\n";
+  for (const SweepPoint& p : sweep.points) {
+    const std::vector<std::string> v = point_values(p);
+    for (std::size_t a = 0; a < v.size(); ++a) {
+      const int width = static_cast<int>(std::max<std::size_t>(sweep.axes[a].key.size(), 6));
+      std::snprintf(buf, sizeof buf, "%*s ", width, v[a].c_str());
+      s += buf;
+    }
+    for (const SweepColumn& c : kSweepColumns) {
+      s += ' ';
+      std::snprintf(buf, sizeof buf, c.format, column_value(c, p));
+      s += buf;
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+std::string sweep_csv(const SweepResult& sweep) {
+  const bool shard = sweep.shards > 1;
+  std::string s = shard ? "point,points," : "";
+  for (const SweepAxis& a : sweep.axes) {
+    s += a.key + ",";
+  }
+  for (const SweepColumn& c : kSweepColumns) {
+    s += std::string(c.name) + (&c == &kSweepColumns[std::size(kSweepColumns) - 1] ? "\n" : ",");
+  }
+  char buf[64];
+  for (const SweepPoint& p : sweep.points) {
+    if (shard) s += std::to_string(p.index) + "," + std::to_string(sweep.total_points) + ",";
+    for (const std::string& v : point_values(p)) {
+      s += v + ",";
+    }
+    for (const SweepColumn& c : kSweepColumns) {
+      std::snprintf(buf, sizeof buf, "%.17g", column_value(c, p));
+      s += std::string(buf) + (&c == &kSweepColumns[std::size(kSweepColumns) - 1] ? "\n" : ",");
+    }
+  }
+  return s;
+}
+
+nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
+  nlohmann::json j;
+  j["scene"] = opts.scene;
+  j["resolution"] = opts.res;
+  j["preset"] = opts.preset;
+  j["set"] = opts.set;
+  nlohmann::json vary = nlohmann::json::object();
+  for (const SweepAxis& a : sweep.axes) {
+    vary[a.key] = a.values;
+  }
+  j["vary"] = vary;
+  j["model"] = opts.model;
+  j["functional_model"] = sweep.functional_model;
+  j["bit_identical_to_functional_model"] = true;  // run_sweep_points throws otherwise
+  j["functional_rays"] = sweep.functional_rays;
+  if (sweep.shards > 1) {
+    j["shard"] = std::to_string(sweep.shard + 1) + "/" + std::to_string(sweep.shards);
+    j["total_points"] = sweep.total_points;
+  }
+  nlohmann::json points = nlohmann::json::array();
+  for (const SweepPoint& p : sweep.points) {
+    nlohmann::json e;
+    if (sweep.shards > 1) e["index"] = p.index;
+    const std::vector<std::string> v = point_values(p);
+    for (std::size_t a = 0; a < v.size(); ++a) {
+      e["values"][sweep.axes[a].key] = v[a];
+    }
+    e["speedup"] = p.speedup;
+    e["report"] = p.cycle;
+    points.push_back(std::move(e));
+  }
+  j["points"] = points;
+  return j;
+}
+
+nlohmann::json sweep_rank_message(const std::string& error, const SweepResult& sweep) {
+  nlohmann::json mine;
+  if (!error.empty()) {
+    mine["error"] = error;
+  } else {
+    mine["points"] = sweep_points_json(sweep);
+  }
+  return mine;
+}
+
+// --out-dir for a sweep: the CSV, the report without host timing (host.json has it), each point's
+// resolved configuration (config.json), each point's statistics as one block (stats.txt) and the
+// command line.
+void write_sweep_folder(const SweepOptions& opts, const SweepResult& sweep,
+                        const RenderSettings& rs, int jobs, int ranks) {
+  nlohmann::json report = sweep_json(sweep, opts);
+  nlohmann::json host;
+  host["jobs"] = jobs;
+  host["mpi_ranks"] = ranks;
+  nlohmann::json config;
+  config["scene"] = opts.scene;
+  config["model"] = opts.model;
+  config["resolution"] = opts.res;
+  config["time"] = rs.time;
+  config["shadows"] = rs.shadows;
+  config["depth"] = rs.depth;
+  config["bank_mb"] = rs.bank_mb;
+  config["preset"] = opts.preset;
+  config["set"] = opts.set;
+  for (const SweepAxis& a : sweep.axes)
+    config["vary"].push_back({{"key", a.key}, {"values", a.values}});
+  if (sweep.shards > 1) config["shard"] = report["shard"];
+  std::vector<std::pair<std::string, std::vector<StatLine>>> blocks;
+  for (std::size_t i = 0; i < sweep.points.size(); ++i) {
+    nlohmann::json& point = report["points"][i];
+    host["points"].push_back(
+        {{"values", point["values"]}, {"host", take_cycle_host(point["report"])}});
+    config["points"].push_back(
+        {{"values", point["values"]}, {"configuration", point["report"]["configuration"]}});
+    blocks.push_back({"point " + std::to_string(sweep.points[i].index + 1) + " of " +
+                          std::to_string(sweep.total_points) + ": " +
+                          join_words(sweep.points[i].settings),
+                      cycle_stat_lines(sweep.points[i].cycle)});
+  }
+  write_run_folder({opts.out_dir,
+                    std::move(report),
+                    std::move(config),
+                    std::move(host),
+                    stats_text_blocks(blocks),
+                    opts.argv,
+                    {{"sweep.csv", sweep_csv(sweep)}}});
+}
+
+// ---- precision ------------------------------------------------------------------------------
+
+namespace {
+
+// One format's row of the precision report.
+nlohmann::json precision_row_json(const PrecisionRow& r) {
+  nlohmann::json row;
+  row["mantissa"] = r.mantissa;
+  row["format"] = ff::format_name(ff::Format{7, r.mantissa});
+  row["same_triangle_pct"] = r.same_triangle_pct;
+  row["psnr_db"] = std::isfinite(r.psnr_db) ? nlohmann::json(r.psnr_db) : nlohmann::json();
+  row["t_rel_err_median"] = r.t_rel_err_median ? nlohmann::json(*r.t_rel_err_median) : nullptr;
+  row["t_rel_err_max"] = r.t_rel_err_max ? nlohmann::json(*r.t_rel_err_max) : nullptr;
+  row["mismatches"] = {{"hit_vs_miss", r.mismatches.hit_vs_miss},
+                       {"edge_tie", r.mismatches.edge_tie},
+                       {"grazing", r.mismatches.grazing},
+                       {"other", r.mismatches.other}};
+  return row;
+}
+
+// One format's statistics (stats.txt), named eM.NAME.
+void precision_row_stats(const PrecisionRow& r, std::vector<StatLine>& stats) {
+  const std::string m = "e7m" + std::to_string(r.mantissa) + ".";
+  const std::string of = " of Float<7," + std::to_string(r.mantissa) + "> against float";
+  stats.push_back({m + "same_triangle_pct", r.same_triangle_pct,
+                   "% of pixels hitting the same triangle" + of, "%"});
+  // Identical images have no finite PSNR; stats.txt carries the number, so infinity is left
+  // out rather than printed as a value no parser agrees on.
+  if (std::isfinite(r.psnr_db))
+    stats.push_back({m + "psnr_db", r.psnr_db, "image PSNR" + of, "dB"});
+  if (r.t_rel_err_median)
+    stats.push_back({m + "t_rel_err_median", *r.t_rel_err_median,
+                     "median relative hit-distance error" + of, "ratio"});
+  if (r.t_rel_err_max)
+    stats.push_back({m + "t_rel_err_max", *r.t_rel_err_max,
+                     "largest relative hit-distance error" + of, "ratio"});
+  stats.push_back({m + "mismatches.hit_vs_miss", static_cast<double>(r.mismatches.hit_vs_miss),
+                   "pixels where one hits and the other misses", "pixels"});
+  stats.push_back({m + "mismatches.edge_tie", static_cast<double>(r.mismatches.edge_tie),
+                   "different triangles, hit on a shared edge", "pixels"});
+  stats.push_back({m + "mismatches.grazing", static_cast<double>(r.mismatches.grazing),
+                   "different triangles, grazing ray", "pixels"});
+  stats.push_back({m + "mismatches.other", static_cast<double>(r.mismatches.other),
+                   "different triangles, other cause", "pixels"});
+}
+
+}  // namespace
+
+void write_precision_report(const std::string& json, const std::string& out_dir,
+                            const std::string& scene, const RenderSettings& settings, int lo,
+                            int hi, const std::vector<PrecisionRow>& rows,
+                            const std::vector<std::string>& argv) {
+  const bool in_dir = !out_dir.empty();
+  nlohmann::json j;
+  j["scene"] = scene;
+  j["resolution"] = {{"width", settings.res.width}, {"height", settings.res.height}};
+  j["reference"] = "float";
+  nlohmann::json host;  // --out-dir: the frames' wall-clock seconds, apart from the results
+  std::vector<StatLine> stats;
+  for (const PrecisionRow& r : rows) {
+    nlohmann::json row = precision_row_json(r);
+    if (in_dir) {
+      host["rows"].push_back({{"mantissa", r.mantissa}, {"seconds", r.seconds}});
+    } else {
+      row["seconds"] = r.seconds;
+    }
+    j["rows"].push_back(row);
+    precision_row_stats(r, stats);
+  }
+  if (!in_dir) {
+    write_text_file(json, j.dump(2) + "\n");
+    return;
+  }
+  j["outputs"] = {{"plot", "precision.png"}, {"report", "report.json"},  {"stats", "stats.txt"},
+                  {"config", "config.json"}, {"command", "command.txt"}, {"host", "host.json"}};
+  // The study's whole configuration: the frame, the formats, and the tree keys every format's
+  // image is built with (at their defaults: the study has no --set).
+  nlohmann::json config;
+  config["scene"] = scene;
+  config["resolution"] = j["resolution"];
+  config["bank_mb"] = settings.bank_mb;
+  config["mantissa"] = {{"from", lo}, {"to", hi}};
+  config["exponent_bits"] = 7;
+  config["reference"] = "float";
+  config["shadows"] = settings.shadows;
+  config["depth"] = settings.depth;
+  config["trees"] = tree_configuration_json(host::ImageParams{});
+  write_run_folder({out_dir, j, std::move(config), std::move(host), stats_text(stats), argv, {}});
+}
+
+// ---- the paper's tables ---------------------------------------------------------------------
+
+namespace {
+
+// A figure's model value over the paper's (0 where the paper has none).
+double paper_ratio(const PaperFigure& f) {
+  return f.paper == 0.0 ? 0.0 : f.model / f.paper;
+}
+
+}  // namespace
+
+nlohmann::json paper_entry_json(int table, const std::string& paper, const std::string& scene,
+                                bool reference, const std::string& resolution,
+                                const std::vector<PaperFigure>& figures,
+                                const std::vector<std::string>& settings,
+                                const nlohmann::json& cycle) {
+  nlohmann::json e;
+  e["table"] = table;
+  e["paper_scene"] = paper;
+  e["scene"] = scene;
+  e["kind"] = reference ? "reference" : "stand-in";
+  e["resolution"] = resolution;
+  e["paper_resolution"] = table == 3 ? "512x384" : "1024x768";
+  nlohmann::json fj = nlohmann::json::object();
+  for (const PaperFigure& g : figures)
+    fj[g.key] = {{"model", g.model}, {"paper", g.paper}, {"ratio", paper_ratio(g)}};
+  e["figures"] = fj;
+  e["configuration"] = settings;
+  e["report"] = cycle;
+  return e;
+}
+
+nlohmann::json paper_tables_json(int scale, const std::vector<std::string>& set,
+                                 std::vector<nlohmann::json>& per_scene) {
+  nlohmann::json entries = nlohmann::json::array();
+  for (nlohmann::json& scene_entries : per_scene)
+    for (nlohmann::json& e : scene_entries)
+      entries.push_back(std::move(e));
+  nlohmann::json j;
+  j["scale"] = scale;
+  j["configuration"] = set;  // each entry lists its own, the paper's filter included
+  j["entries"] = entries;
+  return j;
+}
+
+nlohmann::json thread_curve_json(const std::vector<int>& counts,
+                                 const std::vector<nlohmann::json>& reports,
+                                 const std::string& resolution) {
+  nlohmann::json rows = nlohmann::json::array();
+  double first = 0.0, last = 0.0;
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const int t = counts[i];
+    const nlohmann::json& report = reports[i];
+    const double fps = report["fps"].get<double>();
+    if (t == 1) first = fps;
+    // The paper: nearly linear up to 32 threads, about +10 % from 32 to 64.
+    const double paper_step = t == 1 ? 1.0 : t <= 32 ? 2.0 : 1.10;
+    const double step = t == 1 ? 1.0 : fps / last;
+    rows.push_back({{"threads", t},
+                    {"fps", fps},
+                    {"speedup", fps / first},
+                    {"step", step},
+                    {"paper_step", paper_step},
+                    {"ratio", step / paper_step},
+                    {"usage", report["usage"]}});
+    last = fps;
+  }
+  return {{"scene", "builtin:room"}, {"resolution", resolution}, {"rows", rows}};
+}
+
+// ---- the run folder ----------------------------------------------------------------------------
+
+std::string command_line_text(const std::vector<std::string>& argv) {
+  std::string s;
+  for (const std::string& w : argv) {
+    if (!s.empty()) s += ' ';
+    bool safe = !w.empty();
+    for (char c : w)
+      safe = safe && shell_safe(c);
+    if (safe) {
+      s += w;
+      continue;
+    }
+    s += '\'';
+    for (char c : w)
+      s += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    s += '\'';
+  }
+  return s + "\n";
+}
+
+void check_out_dir(const std::string& dir) {
+  if (dir.empty()) throw std::runtime_error("bad --out-dir '': expected a folder name");
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+    throw std::runtime_error("bad --out-dir '" + dir + "': a file of that name exists");
+}
+
+std::string run_file(const std::string& dir, const std::string& name) {
+  return (std::filesystem::path(dir) / name).string();
+}
+
+nlohmann::json take_cycle_host(nlohmann::json& cycle) {
+  nlohmann::json host = cycle.contains("host") ? cycle["host"] : nlohmann::json::object();
+  cycle.erase("host");
+  return host;
+}
+
+void write_run_folder(const RunFolder& f) {
+  for (const auto& [name, text] : f.tables)
+    write_text_file(run_file(f.dir, name), text);
+  write_text_file(run_file(f.dir, "report.json"), f.report.dump(2) + "\n");
+  write_text_file(run_file(f.dir, "stats.txt"), f.stats);
+  write_text_file(run_file(f.dir, "config.json"), f.config.dump(2) + "\n");
+  write_text_file(run_file(f.dir, "command.txt"), command_line_text(f.argv));
+  write_text_file(run_file(f.dir, "host.json"), f.host.dump(2) + "\n");
+}
+
+void list_run_folder(const RunFolder& f,
+                     std::vector<std::pair<std::string, std::string>>& outputs) {
+  for (const char* key : {"report", "stats", "config", "command", "host"}) {
+    const std::string_view k = key;
+    const char* file = k == "report"    ? "report.json"
+                       : k == "stats"   ? "stats.txt"
+                       : k == "config"  ? "config.json"
+                       : k == "command" ? "command.txt"
+                                        : "host.json";
+    outputs.push_back({key, run_file(f.dir, file)});
+  }
+}
+
+// ---- render ------------------------------------------------------------------------------------
+
+std::string describe_format(ff::Format f) {
+  return "Float<" + std::to_string(f.exp_bits) + "," + std::to_string(f.man_bits) + "> (" +
+         ff::format_name(f) + ")";
+}
+
+nlohmann::json tree_configuration_json(const host::ImageParams& trees) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const host::TreeSettingInfo& t : host::describe_tree_settings(trees))
+    j[t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
+  return j;
+}
+
+namespace {
+
+// The frame, the image and the scene as render's report configures them.
+nlohmann::json render_configuration(const PreparedScene& prep, const RenderSettings& settings) {
+  const auto& st = prep.built.stats;
+  return {{"time", settings.time},
+          {"shadows", settings.shadows},
+          {"depth", settings.depth},
+          {"image_format", describe_format(prep.built.params.format)},
+          {"bank_words", prep.built.params.bank_words},
+          {"bank_mb", settings.bank_mb},
+          {"instances", prep.scene.instances.size()},
+          {"objects", prep.scene.objects.size()},
+          {"triangles_unique", prep.scene.unique_triangles()},
+          {"triangles_instanced", prep.scene.instanced_triangles()},
+          {"triangles_dropped", st.dropped_triangles},
+          {"scene_bytes", st.scene_bytes()},
+          {"light_defaulted", prep.scene.light_defaulted},
+          {"load_seconds", prep.load_seconds},
+          {"build_seconds", prep.build_seconds}};
+}
+
+}  // namespace
+
+nlohmann::json render_report_json(const std::string& scene, const std::string& model,
+                                  const FrameResult& frame, const PreparedScene& prep,
+                                  const RenderSettings& settings) {
+  nlohmann::json j;
+  j["scene"] = scene;
+  j["model"] = model;
+  j["resolution"] = {{"width", settings.res.width}, {"height", settings.res.height}};
+  j["seconds"] = frame.seconds;
+  j["rays"] = frame.rays;
+  j["rays_per_second"] = frame.seconds > 0 ? static_cast<double>(frame.rays) / frame.seconds : 0;
+  j["counters"] = frame.counters;
+  j["configuration"] = render_configuration(prep, settings);
+  if (!frame.cycle.is_null()) {  // the cycle model's figures at the top, its parameters inside
+    nlohmann::json c = frame.cycle;
+    j["configuration"]["cycle"] = c["configuration"];
+    c.erase("configuration");
+    j.update(c);
+  } else {  // the other models read the same trees: their keys are configuration too
+    j["configuration"]["trees"] = tree_configuration_json(prep.built.params);
+  }
+  return j;
+}
+
+void write_render_report(const std::string& path, nlohmann::json report,
+                         std::vector<std::pair<std::string, std::string>>& outputs) {
+  nlohmann::json out;
+  for (const auto& [k, v] : outputs)
+    out[k] = v;
+  report["outputs"] = out;
+  write_text_file(path, report.dump(2) + "\n");
+  outputs.push_back({"report", path});
+}
+
+void write_render_folder(const std::string& dir, nlohmann::json report, const FrameResult& frame,
+                         const std::vector<std::string>& argv,
+                         std::vector<std::pair<std::string, std::string>>& outputs) {
+  RunFolder f;
+  f.dir = dir;
+  f.argv = argv;
+  f.host["seconds"] = report["seconds"];
+  f.host["rays_per_second"] = report["rays_per_second"];
+  f.host["load_seconds"] = report["configuration"]["load_seconds"];
+  f.host["build_seconds"] = report["configuration"]["build_seconds"];
+  report.erase("seconds");
+  report.erase("rays_per_second");
+  report["configuration"].erase("load_seconds");
+  report["configuration"].erase("build_seconds");
+  if (report.contains("host")) f.host["cycle_model"] = take_cycle_host(report);
+  list_run_folder(f, outputs);
+  nlohmann::json names;
+  for (const auto& [k, v] : outputs)
+    names[k] = std::filesystem::path(v).filename().string();
+  report["outputs"] = names;
+  f.config = report["configuration"];
+  f.config["scene"] = report["scene"];
+  f.config["model"] = report["model"];
+  f.config["resolution"] = report["resolution"];
+  std::vector<StatLine> stats;
+  if (!frame.cycle.is_null()) {
+    stats = cycle_stat_lines(frame.cycle);
+  } else {
+    stats.push_back({"rays", static_cast<double>(frame.rays), "rays traced, all kinds", "rays"});
+    for (StatLine& l : stat_lines(frame.counter_stats))
+      stats.push_back(std::move(l));
+  }
+  f.stats = stats_text(stats);
+  f.report = std::move(report);
+  write_run_folder(f);
+}
+
+}  // namespace saarcor
