@@ -102,6 +102,8 @@ int CycleUnit::issue() {
 int CycleUnit::receive() {
   if (cache_responses_ == nullptr || !cache_responses_->can_pop()) return 0;
   const ThreadToken t = cache_responses_->peek().label.tag;
+  if (observer_ != nullptr) [[unlikely]]
+    observer_->cache_response(now(), id_, cache_responses_->peek());
   cache_responses_->drop();
   if (--waiting_[t] == 0) {
     --waiting_threads_;
@@ -132,11 +134,16 @@ int CycleUnit::accept(ThreadPath* from) {
   }
   // One cache request per cycle (a matrix's rows go out over consecutive cycles, D32).
   if (!cache_requests_->can_push()) {
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->cache_blocked(now(), id_);
     stall();
     return 0;
   }
-  cache_requests_->push(
-      {fetch_next_, {static_cast<std::uint16_t>(unit_index(id_)), fetch_thread_}});
+  const memif::CacheRequest req{fetch_next_,
+                                {static_cast<std::uint16_t>(unit_index(id_)), fetch_thread_}};
+  cache_requests_->push(req);
+  if (observer_ != nullptr) [[unlikely]]
+    observer_->cache_request(now(), id_, req);
   ++fetch_next_;
   if (--fetch_left_ == 0) {
     fetching_ = false;

@@ -88,6 +88,13 @@ class UnitObserver {
                       std::uint64_t done_at) = 0;
   // t left the pipeline: pushed on the path to its next unit (queued follows), or retired.
   virtual void left(std::uint64_t cycle, ThreadToken t) = 0;
+  // The cache port of `unit` (the boundary record, units/boundary.h): a request pushed, a
+  // response taken, a request held back because the cache's request queue was full.
+  virtual void cache_request(std::uint64_t /*cycle*/, UnitId /*unit*/,
+                             const memif::CacheRequest& /*r*/) {}
+  virtual void cache_response(std::uint64_t /*cycle*/, UnitId /*unit*/,
+                              const memif::CacheResponse& /*r*/) {}
+  virtual void cache_blocked(std::uint64_t /*cycle*/, UnitId /*unit*/) {}
 };
 
 class CycleUnit : public hw::Module {

@@ -32,6 +32,8 @@ class ListStep {
   // The entry the next request reads, and its rays.
   std::uint32_t next(Level level) const { return cursor(level).next; }
   std::uint64_t mask(Level level) const { return cursor(level).mask; }
+  // The end of the level's list (the boundary record's payload on path c, units/boundary_list.h).
+  std::uint32_t end(Level level) const { return cursor(level).end; }
 
   // A packet leaves its mailbox behind (D28: a mailbox belongs to one packet's rays).
   void clear() { mailbox_.clear(); }

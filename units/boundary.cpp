@@ -1,0 +1,146 @@
+// The model's side of the boundary record (units/boundary.h).
+#include "units/boundary.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace saarcor::units {
+namespace {
+
+constexpr const char* kRequestFields[] = {"phase", "item", "mask"};
+constexpr const char* kCacheRequestFields[] = {"address", "requester", "tag"};
+constexpr const char* kCacheResponseFields[] = {"address", "word0", "word1", "word2",
+                                                "word3",   "word4", "word5", "word6"};
+
+}  // namespace
+
+const char* boundary_port_name(BoundaryPort p) {
+  constexpr const char* kNames[] = {"input",          "side_band",     "cache_request",
+                                    "cache_response", "cache_blocked", "output"};
+  return kNames[static_cast<int>(p)];
+}
+
+std::string format_boundary(const BoundaryEvent& e) {
+  std::ostringstream s;
+  s << "cycle " << e.cycle << " dynrtp" << e.dynrtp << " " << unit_name(e.unit) << " "
+    << boundary_port_name(e.port) << " thread " << e.thread;
+  if (e.port == BoundaryPort::kInput) s << " from " << unit_name(e.path);
+  if (e.port == BoundaryPort::kOutput) s << " to " << unit_name(e.path);
+  for (int k = 0; k < e.fields; ++k) {
+    char v[32];
+    std::snprintf(v, sizeof v, "%llx", static_cast<unsigned long long>(e.field[k]));
+    s << " " << (e.names != nullptr ? e.names[k] : "?") << "=" << v;
+  }
+  return s.str();
+}
+
+namespace {
+void request_fields(const Request& r, BoundaryEvent& e) {
+  e.fields = 3;
+  e.names = kRequestFields;
+  e.field[0] = static_cast<std::uint64_t>(r.phase);
+  e.field[1] = r.item;
+  e.field[2] = r.mask;
+}
+}  // namespace
+
+void RequestPayload::input(UnitId, UnitId, ThreadToken t, BoundaryEvent& e) {
+  request_fields(threads_.request(t), e);
+}
+void RequestPayload::output(UnitId, ThreadToken t, BoundaryEvent& e) {
+  request_fields(threads_.request(t), e);
+}
+
+BoundaryRecorder::BoundaryRecorder(const ThreadTable& threads, int threads_per_pipeline,
+                                   std::vector<UnitId> units, BoundaryPayload& payload, Sink sink)
+    : threads_(threads),
+      per_pipeline_(threads_per_pipeline < 1 ? 1 : threads_per_pipeline),
+      payload_(payload),
+      sink_(std::move(sink)),
+      at_(static_cast<std::size_t>(threads.size()), UnitId::kRgs),
+      leaving_(static_cast<std::size_t>(threads.size())) {
+  for (UnitId u : units)
+    record_[static_cast<std::size_t>(unit_index(u))] = true;
+}
+
+BoundaryEvent BoundaryRecorder::event(std::uint64_t cycle, UnitId unit, BoundaryPort port,
+                                      ThreadToken t) const {
+  BoundaryEvent e;
+  e.cycle = cycle;
+  e.dynrtp = static_cast<int>(t) / per_pipeline_;
+  e.unit = unit;
+  e.port = port;
+  e.thread = t;
+  return e;
+}
+
+void BoundaryRecorder::queued(std::uint64_t cycle, UnitId to, ThreadToken t) {
+  BoundaryEvent side;
+  if (payload_.side_band(to, at_[t], t, side) && recorded(side.unit)) {
+    BoundaryEvent e = event(cycle, side.unit, BoundaryPort::kSideBand, t);
+    e.path = at_[t];
+    e.fields = side.fields;
+    e.field = side.field;
+    e.names = side.names;
+    sink_(e);
+  }
+  if (!recorded(to)) return;
+  BoundaryEvent e = event(cycle, to, BoundaryPort::kInput, t);
+  e.path = at_[t];
+  payload_.input(to, at_[t], t, e);
+  sink_(e);
+}
+
+void BoundaryRecorder::accepted(std::uint64_t, UnitId unit, ThreadToken t, int) {
+  at_[t] = unit;
+}
+
+void BoundaryRecorder::issued(std::uint64_t cycle, UnitId unit, ThreadToken t, const Request& r,
+                              int, std::uint64_t) {
+  at_[t] = unit;
+  payload_.issued(unit, t, r);
+  if (!recorded(unit)) return;
+  BoundaryEvent& out = leaving_[t];
+  out = event(cycle, unit, BoundaryPort::kOutput, t);
+  payload_.output(unit, t, out);
+}
+
+void BoundaryRecorder::left(std::uint64_t cycle, ThreadToken t) {
+  if (!recorded(at_[t])) return;
+  BoundaryEvent e = leaving_[t];
+  e.cycle = cycle;
+  e.path = threads_.request(t).unit;
+  sink_(e);
+}
+
+void BoundaryRecorder::cache_request(std::uint64_t cycle, UnitId unit,
+                                     const memif::CacheRequest& r) {
+  if (!recorded(unit)) return;
+  BoundaryEvent e = event(cycle, unit, BoundaryPort::kCacheRequest, r.label.tag);
+  e.fields = 3;
+  e.names = kCacheRequestFields;
+  e.field[0] = r.index;
+  e.field[1] = r.label.requester;
+  e.field[2] = r.label.tag;
+  sink_(e);
+}
+
+void BoundaryRecorder::cache_response(std::uint64_t cycle, UnitId unit,
+                                      const memif::CacheResponse& r) {
+  if (!recorded(unit)) return;
+  BoundaryEvent e = event(cycle, unit, BoundaryPort::kCacheResponse, r.label.tag);
+  const int words = r.count < kBoundaryFields - 1 ? r.count : kBoundaryFields - 1;
+  e.fields = 1 + words;
+  e.names = kCacheResponseFields;
+  e.field[0] = r.index;
+  for (int k = 0; k < words; ++k)
+    e.field[static_cast<std::size_t>(k) + 1] = r.words[static_cast<std::size_t>(k)];
+  sink_(e);
+}
+
+void BoundaryRecorder::cache_blocked(std::uint64_t cycle, UnitId unit) {
+  if (!recorded(unit)) return;
+  sink_(event(cycle, unit, BoundaryPort::kCacheBlocked, 0));
+}
+
+}  // namespace saarcor::units

@@ -1,0 +1,127 @@
+// The model's side of the boundary record (units/boundary.h): a list unit alone with mock
+// neighbours (the shape of units/unit_timing_test.cpp) emits one event per port event, in the
+// cycles the unit's timing rules give. Latencies as in unit_timing_test.cpp: a path is a channel
+// of latency 1, a cache hit is poppable hit_latency cycles after its push, a ready thread issues
+// one cycle later, and leaves the pipeline `depth` cycles after its issue.
+#include "units/boundary.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hw/kernel.h"
+#include "memif/memory_system.h"
+#include "memif/test_traffic.h"
+#include "units/cycle_params.h"
+#include "units/dynrtc_units.h"
+#include "units/unit_testing.h"
+
+namespace saarcor::units {
+namespace {
+
+constexpr int kPathLatency = 1;
+constexpr int kReadyToIssue = 1;
+constexpr std::uint64_t kMask = 0xF;
+
+// Pushes thread `thread` on `path` at cycle `at` and tells the observer, as a sending unit's
+// leave() does.
+class Source : public hw::Module {
+ public:
+  Source(hw::Kernel& k, ThreadPath& path, UnitObserver& o,
+         std::vector<std::pair<std::uint64_t, ThreadToken>> script)
+      : hw::Module(k, "t.source"), path_(path), o_(o), script_(std::move(script)) {
+    produces(path_);
+  }
+  int evaluate() override {
+    if (next_ == script_.size() || script_[next_].first > now()) return 0;
+    path_.push(script_[next_].second);
+    o_.queued(now(), UnitId::kList, script_[next_].second);
+    ++next_;
+    return 1;
+  }
+  std::uint64_t next_wakeup(std::uint64_t now) const override {
+    return next_ == script_.size() ? hw::kNever : std::max(now + 1, script_[next_].first);
+  }
+
+ private:
+  ThreadPath& path_;
+  UnitObserver& o_;
+  std::vector<std::pair<std::uint64_t, ThreadToken>> script_;
+  std::size_t next_ = 0;
+};
+
+class Drain : public hw::Module {
+ public:
+  Drain(hw::Kernel& k, ThreadPath& p) : hw::Module(k, "t.drain"), p_(p) { consumes(p_); }
+  int evaluate() override {
+    if (!p_.can_pop()) return 0;
+    p_.pop();
+    ++got;
+    return 1;
+  }
+  int got = 0;
+
+ private:
+  ThreadPath& p_;
+};
+
+// Thread 0 misses entry 11 (warming the line); thread 1 asks for it at cycle 100 and hits: its
+// five events (input, cache request, response, output) in the cycles of the rules.
+TEST(BoundaryRecord, ListUnitEventsInTheCyclesOfTheTimingRules) {
+  memif::MemoryImage img = memif::testing::random_scene_image(ff::kFp24, 2);
+  hw::Kernel k;
+  memif::MemorySystem mi(k, img);
+  memif::Cache& cache = mi.cache(0, memif::ItemType::kList);
+  const Request entry{UnitId::kList, Phase::kList, 11, 1, kMask};
+  const Request next{UnitId::kTransformation, Phase::kTransformObject, 30, 5, kMask};
+  testing::ScriptedThreads threads(k, {{entry, next}, {entry, next}});
+  const int depth = prototype_params().list_depth();
+  auto& lu = k.make<ListUnit>("t.list", threads, depth, cache);
+  ThreadPath& c = k.make_channel<ThreadToken>("t.path_c", 8, kPathLatency);
+  ThreadPath& d = k.make_channel<ThreadToken>("t.path_d", 8, kPathLatency);
+  lu.add_input(&c);
+  lu.set_output(UnitId::kTransformation, &d);
+  RequestPayload payload(threads);
+  std::vector<BoundaryEvent> got;
+  BoundaryRecorder rec(threads, 2, {UnitId::kList}, payload,
+                       [&](const BoundaryEvent& e) { got.push_back(e); });
+  lu.set_observer(&rec);
+  const std::uint64_t pushed = 100;
+  Source src(k, c, rec, {{0, 0}, {pushed, 1}});
+  Drain drain(k, d);
+  k.run_to_completion([&] { return drain.got == 2; }, 1000);
+
+  std::vector<BoundaryEvent> t1;
+  for (const BoundaryEvent& e : got)
+    if (e.thread == 1) t1.push_back(e);
+  ASSERT_EQ(t1.size(), 4u);
+  const int hit = cache.config().hit_latency;
+  const std::uint64_t accepted = pushed + kPathLatency;
+  const std::uint64_t answered = accepted + static_cast<std::uint64_t>(hit);
+  const std::uint64_t left =
+      answered + static_cast<std::uint64_t>(kReadyToIssue) + static_cast<std::uint64_t>(depth);
+  EXPECT_EQ(t1[0].port, BoundaryPort::kInput);
+  EXPECT_EQ(t1[0].cycle, pushed);
+  EXPECT_EQ(t1[0].path, UnitId::kRgs);  // (the source stands in for a unit never seen)
+  EXPECT_EQ(t1[0].field[1], 11u);       // item
+  EXPECT_EQ(t1[1].port, BoundaryPort::kCacheRequest);
+  EXPECT_EQ(t1[1].cycle, accepted);
+  EXPECT_EQ(t1[1].field[0], 11u);
+  EXPECT_EQ(t1[1].field[1], static_cast<std::uint64_t>(unit_index(UnitId::kList)));
+  EXPECT_EQ(t1[2].port, BoundaryPort::kCacheResponse);
+  EXPECT_EQ(t1[2].cycle, answered);
+  ASSERT_EQ(t1[2].fields, 2);
+  EXPECT_EQ(t1[2].field[1], img.list_entry(11));  // the SRAM word
+  EXPECT_EQ(t1[3].port, BoundaryPort::kOutput);
+  EXPECT_EQ(t1[3].cycle, left);
+  EXPECT_EQ(t1[3].path, UnitId::kTransformation);
+  EXPECT_EQ(t1[3].field[0], static_cast<std::uint64_t>(Phase::kTransformObject));
+  EXPECT_EQ(format_boundary(t1[3]),
+            "cycle " + std::to_string(left) +
+                " dynrtp0 list output thread 1 to transformation phase=4 item=1e mask=f");
+}
+
+}  // namespace
+}  // namespace saarcor::units
