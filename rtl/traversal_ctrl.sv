@@ -92,6 +92,7 @@ module traversal_ctrl #(
     input  logic [      31:0] is_w0,
     input  logic [      31:0] is_w1,
     output logic              is_busy,
+    output logic              is_chain,  // the face issued now is followed by another (a chain)
     // Leaving threads. dest 0: own loop (out_node is the next node), 1: a leaf's list to the list
     // unit (first, end, mask, level), 2: back to the top level's list (the object is done),
     // 3: the RGS (path g). Port 2 carries the pops that dropped entries.
@@ -212,6 +213,7 @@ module traversal_ctrl #(
   assign in_axis = in_clip ? 2'(in_face[2:1]) : is_w0[1:0];
   logic in_last_face;
   assign in_last_face = in_clip && ({1'b0, in_face} + (stride2_r[in_t] ? 4'd2 : 4'd1) >= 4'd6);
+  assign is_chain = in_clip && !in_last_face;
 
   logic [W-1:0] l_split[P], l_o[P], l_d[P], l_tn[P], l_tf[P];
   logic [P-1:0] term;
@@ -535,7 +537,10 @@ module traversal_ctrl #(
       for (int t = 0; t < THREADS; t++) begin
         face_r[t] <= 3'd7;
         size_r[t] <= '0;
+        base_r[t] <= '0;
         level_r[t] <= 1'b0;
+        ngroups_r[t] <= '0;
+        group_r[t] <= '0;
       end
     end else begin
       // Lane loads and hit updates.
