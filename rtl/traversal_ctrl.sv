@@ -147,8 +147,8 @@ module traversal_ctrl #(
   logic [P-1:0] st_mask_m[Entries];
   logic [W-1:0] st_tn_m[Entries][P], st_tf_m[Entries][P];
 
-  function automatic logic [W-1:0] fld(input logic [3*W-1:0] v, input int k);
-    return v[k*W+:W];
+  function automatic logic [W-1:0] fld(input logic [3*W-1:0] v, input logic [1:0] k);
+    fld = k == 2'd0 ? v[W-1:0] : (k == 2'd1 ? v[2*W-1:W] : v[3*W-1:2*W]);
   endfunction
 
   // The comparator of the float operators, combinational (fp_cmp_core): a < b, a == b, and the
@@ -157,41 +157,40 @@ module traversal_ctrl #(
     // {nan, flushed encoding}
     logic [E-1:0] ex;
     ex = x[W-2-:E];
-    if (ex == '1) return {x[W-2:0] != PosInf[W-2:0], x};
-    if (ex == '0 && FLUSH) return {1'b0, x[W-1], {(W - 1) {1'b0}}};
-    return {1'b0, x};
+    if (ex == '1) flush_mag = {x[W-2:0] != PosInf[W-2:0], x};
+    else if (ex == '0 && FLUSH) flush_mag = {1'b0, x[W-1], {(W - 1) {1'b0}}};
+    else flush_mag = {1'b0, x};
   endfunction
   function automatic logic f_nan(input logic [W-1:0] x);
     logic [W:0] f;
     f = flush_mag(x);
-    return f[W];
+    f_nan = f[W];
   endfunction
   function automatic logic f_lt(input logic [W-1:0] a, input logic [W-1:0] b);
     logic [W:0] fa, fb;
     logic sa, sb, zeros;
     fa = flush_mag(a);
     fb = flush_mag(b);
-    if (fa[W] | fb[W]) return 1'b0;
     sa = fa[W-1];
     sb = fb[W-1];
     zeros = (fa[W-2:0] == '0) && (fb[W-2:0] == '0);
-    if (zeros) return 1'b0;
-    if (sa ^ sb) return sa;
-    return sa ? (fa[W-2:0] > fb[W-2:0]) : (fa[W-2:0] < fb[W-2:0]);
+    if (fa[W] | fb[W] | zeros) f_lt = 1'b0;
+    else if (sa ^ sb) f_lt = sa;
+    else f_lt = sa ? (fa[W-2:0] > fb[W-2:0]) : (fa[W-2:0] < fb[W-2:0]);
   endfunction
   function automatic logic [W-1:0] f_flush(input logic [W-1:0] x);
     /* verilator lint_off UNUSEDSIGNAL */
     logic [W:0] f;
     /* verilator lint_on UNUSEDSIGNAL */
     f = flush_mag(x);
-    return f[W-1:0];
+    f_flush = f[W-1:0];
   endfunction
   // fixedfloat's max(a, b) = (a < b) ? b : a and min(a, b) = (b < a) ? b : a, flushed.
   function automatic logic [W-1:0] f_max(input logic [W-1:0] a, input logic [W-1:0] b);
-    return f_lt(a, b) ? f_flush(b) : f_flush(a);
+    f_max = f_lt(a, b) ? f_flush(b) : f_flush(a);
   endfunction
   function automatic logic [W-1:0] f_min(input logic [W-1:0] a, input logic [W-1:0] b);
-    return f_lt(b, a) ? f_flush(b) : f_flush(a);
+    f_min = f_lt(b, a) ? f_flush(b) : f_flush(a);
   endfunction
 
   // ---- issue: the lanes' operands -----------------------------------------------------------
@@ -223,8 +222,8 @@ module traversal_ctrl #(
       logic [W-1:0] lo, hi;
       l_o[i] = level_r[in_t] ? oo[in_t][i][in_axis] : wo[in_t][i][in_axis];
       l_d[i] = level_r[in_t] ? od[in_t][i][in_axis] : wd[in_t][i][in_axis];
-      lo = level_r[in_t] ? blo_r[in_t][in_axis] : fld(scene_lo, int'(in_axis));
-      hi = level_r[in_t] ? bhi_r[in_t][in_axis] : fld(scene_hi, int'(in_axis));
+      lo = level_r[in_t] ? blo_r[in_t][in_axis] : fld(scene_lo, in_axis);
+      hi = level_r[in_t] ? bhi_r[in_t][in_axis] : fld(scene_hi, in_axis);
       entry = ~in_face[0];
       lo_face = entry != l_d[i][W-1];
       if (in_clip) begin
@@ -287,6 +286,7 @@ module traversal_ctrl #(
     logic              neg;
   } ctl_t;
   ctl_t c_in, c_q;
+  localparam int CtlW = TW + 7 + 30 + 32 + NODE_W + 2 + P + 1;  // $bits(ctl_t)
   always_comb begin
     c_in.thread = in_t;
     c_in.clip = in_clip;
@@ -303,7 +303,7 @@ module traversal_ctrl #(
     c_in.neg = in_neg;
   end
   logic q_valid;
-  fp_stage #(.W($bits(ctl_t)), .N(Depth)) u_ctl (.clk, .d(c_in), .q(c_q));
+  fp_stage #(.W(CtlW), .N(Depth)) u_ctl (.clk, .d(c_in), .q(c_q));
   fp_valid #(.N(Depth)) u_qv (.clk, .rst, .d(in_fire), .q(q_valid));
 
   // ---- the last stage: the step's outcome ----------------------------------------------------
@@ -391,7 +391,7 @@ module traversal_ctrl #(
   logic [TW-1:0] pq_head, pq_tail;
   logic pop_phase2_r[THREADS];
   function automatic logic [TW-1:0] next_slot(input logic [TW-1:0] x);
-    return (32'(x) == THREADS - 1) ? '0 : x + 1'b1;
+    next_slot = (32'(x) == THREADS - 1) ? '0 : x + 1'b1;
   endfunction  // the done-drops are over, the termination drops run
   logic pe_valid, pe_from_stage;
   logic [TW-1:0] pe_t;
@@ -518,8 +518,8 @@ module traversal_ctrl #(
       for (int k = 0; k < 3; k++) begin
         logic [W-1:0] o, lo, hi;
         o = st_bottom ? oo[st_thread][i][k] : wo[st_thread][i][k];
-        lo = st_bottom ? fld(st_lo, k) : fld(scene_lo, k);
-        hi = st_bottom ? fld(st_hi, k) : fld(scene_hi, k);
+        lo = st_bottom ? fld(st_lo, 2'(k)) : fld(scene_lo, 2'(k));
+        hi = st_bottom ? fld(st_hi, 2'(k)) : fld(scene_hi, 2'(k));
         // !(o >= lo && o <= hi): o >= lo is !(o < lo) only when neither is NaN.
         if (in_mask && (f_nan(o) || f_lt(o, lo) || f_lt(hi, o))) st_inside = 1'b0;
       end
@@ -547,11 +547,11 @@ module traversal_ctrl #(
       if (ld_valid) begin
         for (int k = 0; k < 3; k++) begin
           if (ld_object) begin
-            oo[ld_thread][ld_lane][k] <= fld(ld_o, k);
-            od[ld_thread][ld_lane][k] <= fld(ld_d, k);
+            oo[ld_thread][ld_lane][k] <= fld(ld_o, 2'(k));
+            od[ld_thread][ld_lane][k] <= fld(ld_d, 2'(k));
           end else begin
-            wo[ld_thread][ld_lane][k] <= fld(ld_o, k);
-            wd[ld_thread][ld_lane][k] <= fld(ld_d, k);
+            wo[ld_thread][ld_lane][k] <= fld(ld_o, 2'(k));
+            wd[ld_thread][ld_lane][k] <= fld(ld_d, 2'(k));
           end
         end
         if (!ld_object) begin
@@ -573,8 +573,8 @@ module traversal_ctrl #(
           tgroup_r[st_thread] <= group_r[st_thread];
           tbase_r[st_thread] <= base_r[st_thread];
           for (int k = 0; k < 3; k++) begin
-            blo_r[st_thread][k] <= fld(st_lo, k);
-            bhi_r[st_thread][k] <= fld(st_hi, k);
+            blo_r[st_thread][k] <= fld(st_lo, 2'(k));
+            bhi_r[st_thread][k] <= fld(st_hi, 2'(k));
           end
           root_r[st_thread] <= st_root;
           cmask_r[st_thread] <= st_mask;

@@ -21,6 +21,8 @@ module traversal_threads #(
     parameter int THREADS         = 64,
     parameter int STACK           = 64,
     parameter int NODE_W          = 28,
+    parameter bit SKIP_EMPTY      = 1'b1,
+    parameter bit EXIT_ONLY       = 1'b1,
     parameter bit FAULT_PRIO_SWAP = 1'b0,
     localparam int W              = E + M + 1,
     localparam int TW             = THREADS > 1 ? $clog2(THREADS) : 1,
@@ -88,8 +90,21 @@ module traversal_threads #(
     // The issue slot, for tests: the thread issued this cycle.
     output logic              iss_valid,
     output logic [    TW-1:0] iss_thread,
-    output logic              overflow
+    output logic              overflow,
+    // The parameters, as constants: a test pins them to the cycle model's table.
+    output logic [      15:0] par_packet,
+    output logic [      15:0] par_threads,
+    output logic [      15:0] par_stack,
+    output logic [      15:0] par_depth,
+    output logic              par_skip_empty,
+    output logic              par_exit_only
 );
+  assign par_packet = 16'(P);
+  assign par_threads = 16'(THREADS);
+  assign par_stack = 16'(STACK);
+  assign par_depth = 16'(LAT_ADD + LAT_DIV + LAT_CMP);
+  assign par_skip_empty = SKIP_EMPTY;
+  assign par_exit_only = EXIT_ONLY;
   localparam int Depth = LAT_ADD + LAT_DIV + LAT_CMP;
   localparam int Inputs = 6;  // loop, loop (late pops), f, list, RGS, b
 
@@ -124,7 +139,8 @@ module traversal_threads #(
 
   traversal_ctrl #(
       .E(E), .M(M), .LAT_ADD(LAT_ADD), .LAT_DIV(LAT_DIV), .LAT_CMP(LAT_CMP), .P(P),
-      .THREADS(THREADS), .STACK(STACK), .NODE_W(NODE_W)
+      .THREADS(THREADS), .STACK(STACK), .NODE_W(NODE_W), .SKIP_EMPTY(SKIP_EMPTY),
+      .EXIT_ONLY(EXIT_ONLY)
   ) u_core (
       .clk, .rst, .scene_lo, .scene_hi, .top_root,
       .ld_valid, .ld_thread, .ld_lane, .ld_object, .ld_o, .ld_d, .ld_tbest, .ld_lane_valid,

@@ -249,6 +249,23 @@ TEST(RtlTraversalThreads, HigherPriorityPathIsIssuedFirst) {
             pushed + kPathLatency + kReadyToIssue + static_cast<std::uint64_t>(depth()));
 }
 
+// The SystemVerilog defaults are the cycle model's table (units/cycle_params.cpp): packet width,
+// threads, stack entries, the depth from lat.add + lat.div + lat.cmp, traversal.skip_empty and
+// clip.exit_only (only clip.faces_per_step = 1 is built).
+TEST(RtlTraversalThreads, ParametersAreTheCycleModelsDefaults) {
+  const units::CycleParams p = units::prototype_params();
+  auto top = std::make_unique<Vtraversal_threads>();
+  top->eval();
+  EXPECT_EQ(top->par_packet, p.packet);
+  EXPECT_EQ(top->par_threads, p.threads);
+  EXPECT_EQ(top->par_stack, p.stack);
+  EXPECT_EQ(top->par_depth, p.traversal_depth());
+  EXPECT_EQ(top->par_skip_empty, p.skip_empty ? 1 : 0);
+  EXPECT_EQ(top->par_exit_only, p.clip_exit_only ? 1 : 0);
+  EXPECT_EQ(p.clip_faces_per_step, 1);
+  top->final();
+}
+
 TEST(RtlTraversalThreadsFaults, SwappedPrioritiesAreCaughtAtTheFirstIssue) {
   const Packet pk;
   const auto good = two_paths<Vtraversal_threads>(pk);
