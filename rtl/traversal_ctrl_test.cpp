@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "Vtraversal_ctrl.h"
+#include "Vtraversal_ctrl_p1.h"
+#include "Vtraversal_ctrl_p16.h"
 #include "Vtraversal_ctrl_pop_off.h"
 #include "Vtraversal_ctrl_short.h"
 #include "host/image_builder.h"
@@ -21,30 +23,34 @@
 namespace saarcor::rtl::testing {
 namespace {
 
-// `packets` 2x2 primary packets spread evenly over the frame, one after another on threads
-// 0, 1, 2, ... (mod 64), through the RTL and the model.
-template <class V>
-TravRun run_scene(const std::string& spec, int packets, int depth, bool reference = false) {
+// `packets` primary packets (square tiles of P pixels) spread evenly over the frame, one after
+// another on threads 0, 1, 2, ... (mod 64), through the RTL and the model.
+template <class V, int kL = kLanes>
+TravRun run_scene(const std::string& spec, int packets, int depth, bool reference = false,
+                  int p = kLanes) {
   const host::BuiltImage built = host::build_image(host::load_scene(spec));
   const memif::MemoryImage& image = built.image;
   units::FunctionalParams fp;
-  fp.packet = kLanes;
+  fp.packet = p;
   fp.reference_datapath = reference;
   units::PipelineUnits<F> pu(fp.mode);
   units::FrameSink sink;
   const auto w = static_cast<int>(image.registers().width);
   const auto h = static_cast<int>(image.registers().height);
   sink.reset(w, h);
-  TravHarness<V> rtl(image, {depth});
-  const int tiles = (w / 2) * (h / 2);
+  TravHarness<V, kL> rtl(image, {depth});
+  const int side = p == 16 ? 4 : p == 4 ? 2 : 1;  // square tiles of P pixels
+  const int tiles = (w / side) * (h / side);
   for (int k = 0; k < packets; ++k) {
     const int tile = static_cast<int>(static_cast<long>(k) * tiles / packets);
-    const auto x = static_cast<std::uint32_t>((tile % (w / 2)) * 2);
-    const auto y = static_cast<std::uint32_t>((tile / (w / 2)) * 2);
+    const auto x = static_cast<std::uint32_t>((tile % (w / side)) * side);
+    const auto y = static_cast<std::uint32_t>((tile / (w / side)) * side);
     const auto uw = static_cast<std::uint32_t>(w);
-    const std::vector<std::uint32_t> px = {y * uw + x, y * uw + x + 1, (y + 1) * uw + x,
-                                           (y + 1) * uw + x + 1};
-    auto s = std::make_unique<State>(image, fp, pu, sink);
+    std::vector<std::uint32_t> px;
+    for (int j = 0; j < side; ++j)
+      for (int i = 0; i < side; ++i)
+        px.push_back((y + static_cast<std::uint32_t>(j)) * uw + x + static_cast<std::uint32_t>(i));
+    auto s = std::make_unique<typename TravHarness<V, kL>::S>(image, fp, pu, sink);
     s->rgs.start_primary(*s, px);
     s->transformation.generate(*s);
     if (!rtl.packet(*s, static_cast<std::uint32_t>(k % 64))) break;
@@ -91,6 +97,21 @@ TEST(RtlTraversal, DynamicSceneTwoLevels) {
   EXPECT_EQ(r.packets, 200u) << describe(r);
   EXPECT_GT(r.clips, 200u) << describe(r);  // bottom-level clips beside the 200 top-level ones
   std::printf("RtlTraversal dynamic: %s\n", describe(r).c_str());
+}
+
+// Other packet widths: the Verilated builds with P = 16 and P = 1.
+TEST(RtlTraversal, RoomWithSixteenRayPackets) {
+  const TravRun r = run_scene<Vtraversal_ctrl_p16, 16>("builtin:room", 80, depth(), false, 16);
+  EXPECT_FALSE(r.first.found) << describe(r);
+  EXPECT_EQ(r.packets, 80u) << describe(r);
+  std::printf("RtlTraversal room P=16: %s\n", describe(r).c_str());
+}
+
+TEST(RtlTraversal, DynamicSceneWithSingleRayPackets) {
+  const TravRun r = run_scene<Vtraversal_ctrl_p1, 2>("builtin:dynamic", 200, depth(), false, 1);
+  EXPECT_FALSE(r.first.found) << describe(r);
+  EXPECT_EQ(r.packets, 200u) << describe(r);
+  std::printf("RtlTraversal dynamic P=1: %s\n", describe(r).c_str());
 }
 
 class RtlTraversalOnModels : public ::testing::TestWithParam<const char*> {};

@@ -23,7 +23,7 @@
 namespace saarcor::rtl::testing {
 
 using F = ff::fp24;
-inline constexpr int kLanes = 4;  // the Verilated builds' P
+inline constexpr int kLanes = 4;  // P of the default build
 using State = units::PacketState<F, kLanes>;
 
 // The first difference between the RTL and the model.
@@ -52,9 +52,12 @@ struct TravLatency {
   int depth = 12;
 };
 
-template <class V>
+// V: the Verilated traversal_ctrl; kL: the model's lane capacity (>= P, at least 2).
+template <class V, int kL = kLanes>
 class TravHarness {
  public:
+  using S = units::PacketState<F, kL>;
+
   TravHarness(const memif::MemoryImage& image, TravLatency lat)
       : image_(image), lat_(lat), top_(std::make_unique<V>()) {
     const auto& r = image.registers();
@@ -73,7 +76,7 @@ class TravHarness {
 
   // Runs one packet from its generation to the RGS (primary rays; the model's neighbours).
   // Returns false at the first divergence.
-  bool packet(State& s, std::uint32_t thread) {
+  bool packet(S& s, std::uint32_t thread) {
     ++run_.packets;
     thread_ = thread;
     // Path b: the generated world rays and t_best, then the top level's start.
@@ -138,7 +141,7 @@ class TravHarness {
     return o.str();
   }
 
-  void load_world(const State& s) {
+  void load_world(const S& s) {
     for (int i = 0; i < s.p; ++i) {
       const auto& l = s.lane(i);
       top_->ld_valid = 1;
@@ -153,7 +156,7 @@ class TravHarness {
       tick();
     }
   }
-  void load_object(const State& s) {
+  void load_object(const S& s) {
     for (int i = 0; i < s.p; ++i) {
       const auto& l = s.lane(i);
       top_->ld_valid = 1;
@@ -165,7 +168,7 @@ class TravHarness {
       tick();
     }
   }
-  void start(const State& s, bool bottom) {
+  void start(const S& s, bool bottom) {
     top_->st_valid = 1;
     top_->st_thread = thread_;
     top_->st_bottom = bottom;
@@ -182,7 +185,7 @@ class TravHarness {
   }
 
   // The request the RTL names for the thread against the model's.
-  bool check_request(const State& s) {
+  bool check_request(const S& s) {
     top_->rq_thread = thread_;
     settle();
     const bool clip = s.phase == Phase::kClipTop || s.phase == Phase::kClipBottom;
@@ -208,7 +211,7 @@ class TravHarness {
   }
 
   // The segments of the lanes in the mask (node requests).
-  bool check_segments(const State& s) {
+  bool check_segments(const S& s) {
     for (int i = 0; i < s.p; ++i) {
       if (!units::lane_in(s.traversal.mask(), i)) continue;
       top_->dbg_thread = thread_;
@@ -261,7 +264,7 @@ class TravHarness {
     return o;
   }
 
-  bool clip(State& s) {
+  bool clip(S& s) {
     if (!check_request(s)) return false;
     top_->dbg_thread = thread_;
     settle();
@@ -283,7 +286,7 @@ class TravHarness {
     return outcome(s, o, issue + static_cast<std::uint64_t>(faces - 1 + lat_.depth));
   }
 
-  bool step(State& s) {
+  bool step(S& s) {
     if (!check_request(s) || !check_segments(s)) return false;
     const memif::KdNode n = image_.node(s.traversal.node());
     const auto w = memif::encode_node(n);
@@ -306,7 +309,7 @@ class TravHarness {
   }
 
   // A pop the model ran in the list or intersection unit: the thread passes through the RTL.
-  bool pop(State& s) {
+  bool pop(S& s) {
     top_->dbg_thread = thread_;
     settle();
     size_before_ = top_->dbg_size;
@@ -323,7 +326,7 @@ class TravHarness {
   // issue + depth, one cycle later per stack entry dropped. A bottom level that ended inside the
   // request goes back to the top level's list (dest 2); when the model popped the top level as
   // well (that list was over), the RTL pops on, and the request's drops are split over the two.
-  bool outcome(State& s, const Out& o, std::uint64_t due) {
+  bool outcome(S& s, const Out& o, std::uint64_t due) {
     ++run_.requests;
     top_->dbg_thread = thread_;
     settle();
@@ -382,7 +385,7 @@ class TravHarness {
   }
 
   // The model's list, transformation and intersection steps; their hand-overs to the RTL.
-  bool neighbour(State& s) {
+  bool neighbour(S& s) {
     const Phase ph = s.phase;
     const units::Level level = s.traversal.level();
     const std::uint64_t drops0 = s.u.stack_drops;
