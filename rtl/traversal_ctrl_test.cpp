@@ -27,11 +27,12 @@ namespace {
 // another on threads 0, 1, 2, ... (mod 64), through the RTL and the model.
 template <class V, int kL = kLanes>
 TravRun run_scene(const std::string& spec, int packets, int depth, bool reference = false,
-                  int p = kLanes) {
+                  int p = kLanes, bool shadows = false) {
   const host::BuiltImage built = host::build_image(host::load_scene(spec));
   const memif::MemoryImage& image = built.image;
   units::FunctionalParams fp;
   fp.packet = p;
+  fp.shadows = shadows;
   fp.reference_datapath = reference;
   units::PipelineUnits<F> pu(fp.mode);
   units::FrameSink sink;
@@ -53,7 +54,7 @@ TravRun run_scene(const std::string& spec, int packets, int depth, bool referenc
     auto s = std::make_unique<typename TravHarness<V, kL>::S>(image, fp, pu, sink);
     s->rgs.start_primary(*s, px);
     s->transformation.generate(*s);
-    if (!rtl.packet(*s, static_cast<std::uint32_t>(k % 64))) break;
+    if (!rtl.packet(*s, static_cast<std::uint32_t>(k % 64), shadows)) break;
   }
   return rtl.run();
 }
@@ -112,6 +113,15 @@ TEST(RtlTraversal, DynamicSceneWithSingleRayPackets) {
   EXPECT_FALSE(r.first.found) << describe(r);
   EXPECT_EQ(r.packets, 200u) << describe(r);
   std::printf("RtlTraversal dynamic P=1: %s\n", describe(r).c_str());
+}
+
+// Shadow packets (docs/shading.md 6.4): the RGS hands them to the traversal unit directly, their
+// rays finish at any hit (done), and entries whose rays are all done are dropped at a pop.
+TEST(RtlTraversal, DynamicSceneWithShadowRays) {
+  const TravRun r = run_scene<Vtraversal_ctrl>("builtin:dynamic", 60, depth(), false, kLanes, true);
+  EXPECT_FALSE(r.first.found) << describe(r);
+  EXPECT_GT(r.packets, 60u) << describe(r);  // the shadow packets count too
+  std::printf("RtlTraversal dynamic with shadows: %s\n", describe(r).c_str());
 }
 
 class RtlTraversalOnModels : public ::testing::TestWithParam<const char*> {};

@@ -74,9 +74,10 @@ class TravHarness {
 
   const TravRun& run() const { return run_; }
 
-  // Runs one packet from its generation to the RGS (primary rays; the model's neighbours).
-  // Returns false at the first divergence.
-  bool packet(S& s, std::uint32_t thread) {
+  // Runs one packet from its generation to the RGS (the model's neighbours). With `shade`, the
+  // thread goes on through the RGS (shading, shadow packets from path a and RGS -> traversal)
+  // until it is done. Returns false at the first divergence.
+  bool packet(S& s, std::uint32_t thread, bool shade = false) {
     ++run_.packets;
     thread_ = thread;
     // Path b: the generated world rays and t_best, then the top level's start.
@@ -91,8 +92,10 @@ class TravHarness {
       } else if (ph == units::Phase::kList || ph == units::Phase::kIntersect ||
                  ph == units::Phase::kTransformObject || ph == units::Phase::kTransformTriangle) {
         if (!neighbour(s)) return false;
-      } else {
+      } else if (!shade || ph == units::Phase::kDone) {
         return true;  // the RGS: the packet left the traversal
+      } else {
+        rgs(s);
       }
     }
   }
@@ -304,7 +307,7 @@ class TravHarness {
     ++run_.node_steps;
     drops_left_ = s.u.stack_drops - drops0;
     run_.drops += drops_left_;
-    const Out o = wait_out(lat_.depth + static_cast<int>(drops_left_) + 16);
+    const Out o = wait_out(lat_.depth + static_cast<int>(drops_left_) + 80);
     return outcome(s, o, issue + static_cast<std::uint64_t>(lat_.depth));
   }
 
@@ -318,7 +321,7 @@ class TravHarness {
     top_->is_thread = thread_;
     top_->is_kind = 2;
     ++run_.pops;
-    const Out o = wait_out(lat_.depth + static_cast<int>(drops_left_) + 16);
+    const Out o = wait_out(lat_.depth + static_cast<int>(drops_left_) + 80);
     return outcome(s, o, issue + static_cast<std::uint64_t>(lat_.depth));
   }
 
@@ -337,12 +340,16 @@ class TravHarness {
     const Phase ph = s.phase;
     const bool more = o.dest == 2 && !(ph == Phase::kList || ph == Phase::kTransformObject);
     const std::uint64_t extra = o.cycle >= due ? o.cycle - due : ~std::uint64_t{0};
-    if (more ? extra > drops_left_ : extra != drops_left_)
+    // Shadow packets also drop entries whose rays are all done, which the model does not count:
+    // there the RTL may leave later than the counted drops say, never earlier.
+    const bool shadow = s.kind == units::RayKind::kShadow;
+    if (shadow ? (extra == ~std::uint64_t{0} || (!more && extra < drops_left_))
+               : (more ? extra > drops_left_ : extra != drops_left_))
       return fail("timing", "thread left in cycle " + std::to_string(o.cycle) + ", model " +
                                 std::to_string(due + drops_left_) + " (depth " +
                                 std::to_string(lat_.depth) + " + " + std::to_string(drops_left_) +
                                 " drops after the issue)");
-    drops_left_ -= extra;
+    drops_left_ = drops_left_ > extra ? drops_left_ - extra : 0;
     if (o.dest == 2) {
       // Back at the top level's list: the model continued there or popped the top level too.
       if (s.traversal.level() != units::Level::kTop)
@@ -381,6 +388,35 @@ class TravHarness {
       default:
         return fail("payload", std::string("model phase ") + units::phase_name(ph) +
                                    " after a traversal request");
+    }
+  }
+
+  // The RGS and ray generation (as ThreadProgram::execute): a packet that starts a top level
+  // (a secondary packet from path b, a shadow packet from the RGS) loads its world rays.
+  void rgs(S& s) {
+    switch (s.phase) {
+      case Phase::kGenerate:
+        s.transformation.generate(s);
+        break;
+      case Phase::kShadeSurface:
+        s.rgs.begin_request();
+        s.rgs.shade_surface(s);
+        break;
+      case Phase::kShadeLight:
+        s.rgs.begin_request();
+        s.rgs.shade_light(s);
+        break;
+      case Phase::kShadeShadow:
+        s.rgs.begin_request();
+        s.rgs.shade_shadow(s);
+        break;
+      default:
+        return;
+    }
+    if (s.phase == Phase::kClipTop) {
+      ++run_.packets;
+      load_world(s);
+      start(s, false);
     }
   }
 
