@@ -4,8 +4,13 @@
 //
 //   saarcor-rtl check FILE [--out OUT] [--max N]
 //
-// Exit status: 0 every vector matches, 2 some differ (or the RTL's latency is not the cycle
-// model's unit depth), 1 usage error or malformed file.
+//   saarcor-rtl lockstep SCENE [--units list] [--res WxH] [--set KEY=VALUE ...] [--shadows]
+//                        [--depth N] [--until CYCLE] [--wave FILE] [--bench]
+//
+// check: exit status 0 every vector matches, 2 some differ (or the RTL's latency is not the cycle
+// model's unit depth), 1 usage error or malformed file. lockstep (rtl/lockstep.h): 0 no
+// divergence, 2 a divergence (its screen printed, the RTL waveform around it written), 1 bad
+// usage or a configuration no Verilated build has.
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -13,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "rtl/lockstep.h"
 #include "rtl/rtl_units.h"
 #include "rtl/vector_file.h"
 #include "units/cycle_params.h"
@@ -21,6 +27,12 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: saarcor-rtl check FILE [--out OUT] [--max N]\n"
+    "       saarcor-rtl lockstep SCENE [--units list] [--res WxH] [--set KEY=VALUE ...]\n"
+    "                            [--shadows] [--depth N] [--until CYCLE] [--wave FILE] [--bench]\n"
+    "  lockstep: runs the cycle model and the Verilated list unit side by side and compares\n"
+    "  every port event in the same cycle; exit 2 at the first divergence (its screen, a VCD\n"
+    "  window of the RTL around it and the replay command printed). --bench also times the cycle\n"
+    "  model alone on the same frame.\n"
     "  Runs the unit vectors in FILE (saarcor vectors --out FILE) through the Verilated unit and\n"
     "  lists the vectors whose outputs differ from the file's (at most N, default 20).\n"
     "  --out OUT  also writes FILE with the RTL's outputs (saarcor vectors --check OUT checks it)\n"
@@ -93,6 +105,124 @@ int check(const std::string& path, const std::string& out, std::size_t max_list)
   return (differing == 0 && latency_ok) ? 0 : 2;
 }
 
+// Parses a decimal count; false for anything else.
+bool parse_count(const std::string& s, std::uint64_t& out) {
+  if (s.empty() || s.size() > 18 || s.find_first_not_of("0123456789") != std::string::npos)
+    return false;
+  out = std::stoull(s);
+  return true;
+}
+
+int lockstep(const std::vector<std::string>& args) {
+  using saarcor::rtl::LockstepOptions;
+  LockstepOptions o;
+  o.scene = args[1];
+  auto fail = [](const std::string& m) {
+    std::fprintf(stderr, "saarcor-rtl: error: %s\n", m.c_str());
+    return 1;
+  };
+  for (std::size_t i = 2; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool has = i + 1 < args.size();
+    std::uint64_t n = 0;
+    if (a == "--shadows") {
+      o.shadows = true;
+    } else if (a == "--bench") {
+      o.bench = true;
+    } else if (!has) {
+      return fail("unknown or incomplete argument '" + a + "'");
+    } else if (a == "--units") {
+      o.units.clear();
+      std::string u = args[++i];
+      for (std::size_t p = 0; p != std::string::npos;) {
+        const std::size_t q = u.find(',', p);
+        o.units.push_back(u.substr(p, q == std::string::npos ? q : q - p));
+        p = q == std::string::npos ? q : q + 1;
+      }
+    } else if (a == "--res") {
+      const std::string r = args[++i];
+      const std::size_t x = r.find('x');
+      std::uint64_t w = 0, h = 0;
+      if (x == std::string::npos || !parse_count(r.substr(0, x), w) ||
+          !parse_count(r.substr(x + 1), h) || w == 0 || h == 0 || w > 8192 || h > 8192)
+        return fail("--res '" + r + "' is not WxH");
+      o.width = static_cast<int>(w);
+      o.height = static_cast<int>(h);
+    } else if (a == "--set") {
+      o.set.push_back(args[++i]);
+    } else if (a == "--depth") {
+      if (!parse_count(args[++i], n) || n > 16)
+        return fail("--depth '" + args[i] + "' is not 0..16");
+      o.depth = static_cast<int>(n);
+    } else if (a == "--until") {
+      if (!parse_count(args[++i], n) || n == 0)
+        return fail("--until '" + args[i] + "' is not a cycle");
+      o.until = n;
+    } else if (a == "--wave") {
+      o.wave = args[++i];
+    } else if (a == "--fault") {
+      o.fault = args[++i];
+    } else {
+      return fail("unknown argument '" + a + "'");
+    }
+  }
+  try {
+    if (o.until != 0) {  // a replay: the waveform of the window before the cycle asked for
+      o.write_wave = true;
+      o.wave_from = o.until > 64 ? o.until - 64 : 0;
+      o.wave_to = o.until;
+    }
+    const saarcor::rtl::LockstepResult r = saarcor::rtl::run_lockstep(o);
+    if (r.diverged) {
+      LockstepOptions w = o;
+      w.write_wave = true;
+      w.wave_from = r.divergence.cycle > 64 ? r.divergence.cycle - 64 : 0;
+      w.wave_to = r.divergence.cycle + 16;
+      w.until = w.wave_to;
+      (void)saarcor::rtl::run_lockstep(w);  // the same run again, traced around the cycle
+      std::fputs(r.screen.c_str(), stdout);
+      std::printf("  waveform: %s (RTL cycles %llu..%llu, 2 time units per cycle)\n",
+                  w.wave.c_str(), static_cast<unsigned long long>(w.wave_from),
+                  static_cast<unsigned long long>(w.wave_to));
+      std::printf("  replay:   %s --until %llu --wave %s\n",
+                  saarcor::rtl::lockstep_command(o).c_str(),
+                  static_cast<unsigned long long>(r.divergence.cycle), w.wave.c_str());
+      return 2;
+    }
+    if (o.until != 0 && r.cycles <= o.until + 1)
+      std::printf(
+          "saarcor-rtl lockstep: stopped after cycle %llu (--until), no divergence up to "
+          "it; waveform %s (RTL cycles %llu..%llu)\n",
+          static_cast<unsigned long long>(o.until), o.wave.c_str(),
+          static_cast<unsigned long long>(o.wave_from), static_cast<unsigned long long>(o.wave_to));
+    static constexpr const char* kPorts[] = {"input",          "side_band",     "cache_request",
+                                             "cache_response", "cache_blocked", "output"};
+    std::printf(
+        "saarcor-rtl lockstep: %s %dx%d, list unit (build %s): 0 divergences in %llu cycles\n",
+        o.scene.c_str(), o.width, o.height, r.build.c_str(),
+        static_cast<unsigned long long>(r.model_cycles));
+    std::printf("  driven:  ");
+    for (int p : {0, 1, 3, 4})
+      std::printf(" %s %llu", kPorts[p],
+                  static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
+    std::printf("\n  compared:");
+    for (int p : {2, 5})
+      std::printf(" %s %llu", kPorts[p],
+                  static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
+    const double c = static_cast<double>(r.model_cycles);
+    std::printf("\n  speed: RTL %.0f k cycles/s, co-simulation %.0f k cycles/s",
+                r.rtl_seconds > 0 ? static_cast<double>(r.cycles) / r.rtl_seconds / 1e3 : 0.0,
+                r.seconds > 0 ? c / r.seconds / 1e3 : 0.0);
+    if (o.bench)
+      std::printf(", cycle model alone %.0f k cycles/s",
+                  r.model_seconds > 0 ? c / r.model_seconds / 1e3 : 0.0);
+    std::printf("\n");
+    return 0;
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -101,6 +231,7 @@ int main(int argc, char** argv) {
     std::fputs(kUsage, stdout);
     return 0;
   }
+  if (args.size() >= 2 && args[0] == "lockstep") return lockstep(args);
   if (args.size() < 2 || args[0] != "check") {
     std::fputs(kUsage, stderr);
     return 1;

@@ -22,6 +22,7 @@ module unit_threads #(
     parameter int IW      = 32,  // cache item address bits
     parameter int CW      = 4,   // fetch count bits (items per request)
     parameter int SW      = 8,   // step count bits (issue cycles per request)
+    parameter bit FAULT_PRIORITY_SWAP = 1'b0,  // tests only (rtl/lockstep_test.cpp)
     parameter int TW      = THREADS > 1 ? $clog2(THREADS) : 1
 ) (
     input  logic                     clk,
@@ -68,8 +69,12 @@ module unit_threads #(
   logic [$clog2(INPUTS+1)-1:0] sel;
   always_comb begin
     sel = '0;
-    for (int i = INPUTS - 1; i >= 0; --i) begin
-      path_any[i] = path_head[i] != path_tail[i];
+    for (int i = 0; i < INPUTS; ++i) path_any[i] = path_head[i] != path_tail[i];
+    for (int k = INPUTS - 1; k >= 0; --k) begin
+      // The injected fault (tests only): the first two paths' priorities swapped.
+      /* verilator lint_off UNUSEDSIGNAL */
+      automatic int i = FAULT_PRIORITY_SWAP && INPUTS > 1 && k < 2 ? 1 - k : k;
+      /* verilator lint_on UNUSEDSIGNAL */
       if (path_any[i]) sel = i[$clog2(INPUTS+1)-1:0];
     end
   end

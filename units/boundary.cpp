@@ -8,9 +8,6 @@ namespace saarcor::units {
 namespace {
 
 constexpr const char* kRequestFields[] = {"phase", "item", "mask"};
-constexpr const char* kCacheRequestFields[] = {"address", "requester", "tag"};
-constexpr const char* kCacheResponseFields[] = {"address", "word0", "word1", "word2",
-                                                "word3",   "word4", "word5", "word6"};
 
 }  // namespace
 

@@ -32,6 +32,11 @@ enum class BoundaryPort : std::uint8_t {
 const char* boundary_port_name(BoundaryPort p);
 
 inline constexpr int kBoundaryFields = 8;
+// The cache port's payloads (the same for every unit): a request's item address and label, a
+// response's item address and words.
+inline constexpr const char* kCacheRequestFields[] = {"address", "requester", "tag"};
+inline constexpr const char* kCacheResponseFields[] = {"address", "word0", "word1", "word2",
+                                                       "word3",   "word4", "word5", "word6"};
 
 struct BoundaryEvent {
   std::uint64_t cycle = 0;

@@ -1,0 +1,76 @@
+// The lockstep co-simulation (issue 34; docs/rtl.md "Lockstep"): the cycle model runs a frame and
+// the Verilated list unit (rtl/list_unit.sv) runs beside it, cycle by cycle. In every cycle the
+// RTL gets what the model's list unit gets (threads arriving on its paths with their payload,
+// packet starts, the cache's back-pressure, the cache responses with the SRAM words: the boundary
+// record's input events, units/boundary.h), and each of its outputs (cache requests, threads
+// leaving with their payload) is compared with the model's. Events are matched `window` cycles
+// behind the RTL's clock, so a divergence is classified with both sides' neighbourhood known:
+//   payload  the same port, cycle and thread, other bits;
+//   order    the same port and cycle, another thread;
+//   timing   the same event (port, thread, bits) in another cycle;
+//   missing  the model has an event the RTL does not have within the window;
+//   extra    the RTL has an event the model does not have within the window.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rtl/unit_rtl.h"
+#include "units/boundary.h"
+
+namespace saarcor::rtl {
+
+struct LockstepOptions {
+  std::string scene;  // host::load_scene spec (builtin:room, a glTF path)
+  std::vector<std::string> units{"list"};
+  int width = 32, height = 24;
+  std::vector<std::string> set;  // cycle-model KEY=VALUE (and kd.* tree keys)
+  bool shadows = false;
+  int depth = 0;      // secondary-ray depth (0: none)
+  std::string fault;  // "" or "mailbox-never-hits": the fault build (tests)
+  std::string wave = "lockstep_divergence.vcd";  // the RTL waveform around a divergence
+  std::uint64_t until = 0;                       // != 0: stop both sides after this cycle (replay)
+  int window = 64;                               // cycles between the RTL's clock and the matching
+  // The RTL waveform of cycles [wave_from, wave_to] into `wave` (set by the replay).
+  std::uint64_t wave_from = 0, wave_to = 0;
+  bool write_wave = false;
+  bool bench = false;  // also run the cycle model alone and time it (the speed beside the RTL's)
+  // Tests: every event of the model's list unit, as it is recorded.
+  std::function<void(const units::BoundaryEvent&)> model_events;
+  // Tests: wraps the Verilated unit (a fault between its ports and the comparison).
+  std::function<std::unique_ptr<UnitRtl>(std::unique_ptr<UnitRtl>)> wrap_rtl;
+};
+
+struct Divergence {
+  std::uint64_t cycle = 0;
+  std::string unit, port, field, kind;  // kind: payload, order, timing, missing, extra
+  std::uint64_t model_value = 0, rtl_value = 0;
+  std::uint64_t other_cycle = 0;  // timing: the RTL's cycle of the model's event (or vice versa)
+};
+
+struct LockstepResult {
+  bool diverged = false;
+  Divergence divergence;
+  std::string screen;  // the divergence screen (diverged) or the summary
+  std::string build;   // the Verilated build that ran
+  // Per port of the list unit (units::BoundaryPort): events driven into the RTL (inputs) or
+  // compared (outputs).
+  std::array<std::uint64_t, 6> events{};
+  std::uint64_t cycles = 0;        // RTL cycles (the model's and the window after them)
+  std::uint64_t model_cycles = 0;  // the frame's cycles in the model
+  double rtl_seconds = 0, seconds = 0;
+  double model_seconds = 0;  // with LockstepOptions::bench: the model alone, the same frame
+};
+
+// Runs the co-simulation. Throws std::runtime_error (one line) for bad input: an unknown unit, a
+// configuration no Verilated build has, an unreadable scene.
+LockstepResult run_lockstep(const LockstepOptions& options);
+
+// The command line that runs `o` (for the replay line of a divergence screen).
+std::string lockstep_command(const LockstepOptions& o);
+
+}  // namespace saarcor::rtl
