@@ -1,4 +1,4 @@
-// Throughput of the fp24 ops (DESIGN.md section 3) against the host's binary32 in the same run.
+// Throughput of the fp24 ops (docs/fixedfloat.md) against the host's binary32 in the same run.
 // Every result goes through benchmark::DoNotOptimize, so neither side is vectorised or folded
 // away; both loops walk the same 4096 operand pairs (normal values over several binades, the
 // common case in the datapaths). The summary at the end prints fp24 time / binary32 time per op

@@ -1,5 +1,5 @@
 // Parameterised binary floating-point formats: the runtime description (Format, Mode) and the one
-// round-and-pack routine every operation ends in (DESIGN.md section 3).
+// round-and-pack routine every operation ends in (docs/fixedfloat.md).
 //
 // An encoding holds sign | exponent (E bits, bias 2^(E-1)-1) | mantissa (M stored bits) in the low
 // 1+E+M bits of a uint32_t. Exponent all-ones is +-inf (mantissa 0) or NaN (mantissa != 0), as in

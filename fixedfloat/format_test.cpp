@@ -1,7 +1,7 @@
-// Conversions, the binary32 self-check, packing and op counters (DESIGN.md sections 3 and 4):
-// Float<8,23> in kIeeeMode against the machine's binary32, fp24 -> binary32 -> fp24 and
-// fp24 -> binary64 over all 2^24 encodings, binary64 and integer -> format against MPFR,
-// pack_row/unpack_row, OpCounts, and the small helpers (parse_format, bit_groups).
+// Conversions, the binary32 self-check, packing and op counters (docs/fixedfloat.md and
+// docs/memory-image.md): Float<8,23> in kIeeeMode against the machine's binary32, fp24 -> binary32
+// -> fp24 and fp24 -> binary64 over all 2^24 encodings, binary64 and integer -> format against
+// MPFR, pack_row/unpack_row, OpCounts, and the small helpers (parse_format, bit_groups).
 #include <gtest/gtest.h>
 
 #include <bit>

@@ -1,4 +1,4 @@
-// fp24 (Float<7,16>, the paper's 24-bit format) against GNU MPFR (DESIGN.md section 3):
+// fp24 (Float<7,16>, the paper's 24-bit format) against GNU MPFR (docs/fixedfloat.md):
 // seeded random operand pairs (10 million per op in the default mode, 1 million per op in each
 // other mode), a hand-written edge list in every mode, and sqrt over all 2^24 encodings in every
 // mode. Each op/mode is its own test case so ctest spreads them over the cores.

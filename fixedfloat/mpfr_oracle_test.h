@@ -1,4 +1,4 @@
-// Test-only: GNU MPFR as the oracle for the float ops (DESIGN.md section 3), the operand
+// Test-only: GNU MPFR as the oracle for the float ops (docs/fixedfloat.md), the operand
 // generators shared by the fixedfloat tests, and the mismatch reporter.
 //
 // The oracle follows TOOLCHAIN.md gotcha 5: precision M+1, the format's exponent range (emax =

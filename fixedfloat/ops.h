@@ -1,4 +1,4 @@
-// The inline fast paths of the float ops for a format known at compile time (DESIGN.md section 3).
+// The inline fast paths of the float ops for a format known at compile time (docs/fixedfloat.md).
 // Float<E,M> and FpUnit call these; the runtime-format functions in format.h remain the general
 // path every special case falls back to.
 //
@@ -14,7 +14,7 @@
 //      the lowest kept bit for ties to even). A carry out of the mantissa increments the exponent
 //      field, and a carry out of the largest finite value gives exactly the infinity encoding.
 //      Double rounding is innocuous because 53 >= 2(M+1)+2 for every supported format (Figueroa
-//      1995; DESIGN.md section 3). One unsigned compare of the rounded field against a span from
+//      1995; docs/fixedfloat.md). One unsigned compare of the rounded field against a span from
 //      the Rounder accepts the result: the span is empty for truncation, so the nearest-even
 //      path needs no test of the mode.
 // Nearest-even add/sub test no operand at all (see add_nearest for why zeros, subnormals, inf and

@@ -1,4 +1,4 @@
-// Packing of float encodings into 32-bit memory words (DESIGN.md section 4): a matrix row of four
+// Packing of float encodings into 32-bit memory words (docs/memory-image.md): a matrix row of four
 // values is one memory item. Four fp24 values fill exactly three words; formats wider than 24
 // bits take four words per row. Value 0 sits in the low bits of word 0, bits run upwards through
 // the words (little-endian bit stream).

@@ -1,7 +1,7 @@
 // Exhaustive agreement of Float<4,5> with GNU MPFR: every operand pair for add, sub, mul, div and
-// the compares (lt, le, eq, min, max), every operand for sqrt, in all four modes (DESIGN.md
-// section 3). A 10-bit format is small enough to try everything, and it has every kind of case
-// fp24 has: ties, carries into the exponent, overflow, gradual underflow, flushing.
+// the compares (lt, le, eq, min, max), every operand for sqrt, in all four modes (
+// docs/fixedfloat.md). A 10-bit format is small enough to try everything, and it has every kind of
+// case fp24 has: ties, carries into the exponent, overflow, gradual underflow, flushing.
 #include <gtest/gtest.h>
 
 #include "fixedfloat/mpfr_oracle_test.h"

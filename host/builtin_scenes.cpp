@@ -1,5 +1,5 @@
 // Built-in procedural scenes, stand-ins for the paper's benchmarks (paper section 5, Table 3;
-// DIGEST.md D42): the same triangle and object counts, generated deterministically (own
+// decision D42): the same triangle and object counts, generated deterministically (own
 // generator, fixed seeds, no hash-map iteration) so a scene name always gives the same bytes.
 #include "host/builtin_scenes.h"
 

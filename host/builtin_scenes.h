@@ -1,5 +1,5 @@
 // Built-in procedural scenes, deterministic stand-ins for the paper's benchmark scenes (paper
-// section 5, Table 3; DIGEST.md D42: matched in triangle and object counts). docs/scenes.md lists
+// section 5, Table 3; decision D42: matched in triangle and object counts). docs/scenes.md lists
 // what each contains.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Built-in scenes (issue 3; DIGEST.md D42): the triangle and object counts of the paper's Table 3
+// Built-in scenes (decision D42): the triangle and object counts of the paper's Table 3
 // stand-ins, determinism, animation of the dynamic scene, and glTF export -> re-load.
 #include "host/builtin_scenes.h"
 

@@ -1,4 +1,4 @@
-// An independent ray tracer for checking the float reference (DESIGN.md section 9: model 1 is
+// An independent ray tracer for checking the float reference (docs/compare.md: model 1 is
 // checked against Intel Embree on the same triangles). Header-only on purpose: host/ library code
 // must not depend on Embree, so only tests and benchmarks (which link the `embree` target)
 // include this file.

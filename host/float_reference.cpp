@@ -1,6 +1,6 @@
-// The float reference renderer (DESIGN.md section 9, model 1; paper sections 2.1, 2.2.2, 3.1 and
-// DESIGN.md sections 5 and 7): two-level kd-tree traversal, world -> object transform, unit-
-// triangle intersection, all in binary32 in the datapath op order. docs/float-reference.md.
+// The float reference renderer (docs/compare.md, model 1; paper sections 2.1, 2.2.2, 3.1 and
+// docs/cycle-model.md and docs/shading.md): two-level kd-tree traversal, world -> object transform,
+// unit- triangle intersection, all in binary32 in the datapath op order. docs/float-reference.md.
 #include "host/float_reference.h"
 
 #include <algorithm>
@@ -38,7 +38,7 @@ struct StackEntry {
   float t_far;
 };
 
-// out_r = (m_r0*x + m_r1*y) + (m_r2*z + t_r): the transformation unit's adder tree (DIGEST D5).
+// out_r = (m_r0*x + m_r1*y) + (m_r2*z + t_r): the transformation unit's adder tree (decision D5).
 inline glm::vec3 transform_point(const Affine32& m, const glm::vec3& p) {
   glm::vec3 r;
   for (int i = 0; i < 3; ++i) {
@@ -190,7 +190,7 @@ void FloatScene::set_top(const KdTree& tree) {
 
 // ---- traversal ----------------------------------------------------------------------------------
 
-// Front-to-back kd traversal (Wald's formulation, DESIGN.md section 5): d = (split - O) / D per
+// Front-to-back kd traversal (Wald's formulation, docs/cycle-model.md): d = (split - O) / D per
 // inner node; the near child is the one the direction's sign points away from; the far child is
 // pushed with [d, t_far]. After a leaf, the ray ends when its closest hit lies within the leaf.
 // Visit(leaf_node, t_near, t_far) processes one leaf and returns true to stop.
@@ -253,7 +253,7 @@ void FloatScene::trace_object(std::uint32_t instance, const FloatRay& world, flo
                      glm::vec3(inst.world_to_object.apply_vector(glm::dvec3(world.direction)))}
           : FloatRay{transform_point(inst.world_to_object32, world.origin),
                      transform_vector(inst.world_to_object32, world.direction)};
-  // DIGEST D29: the object's tree is traversed over the ray's whole [t_min, t_best], clipped to
+  // decision D29: the object's tree is traversed over the ray's whole [t_min, t_best], clipped to
   // the object's box, not to the top-level leaf.
   float t_near = t_min;
   float t_far = hit.t;

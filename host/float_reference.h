@@ -1,10 +1,10 @@
-// The float reference renderer: the golden model of DESIGN.md section 9 (model 1). It traverses
+// The float reference renderer: the golden model of docs/compare.md (model 1). It traverses
 // the same kd-trees the hardware reads (paper section 2: a top-level tree over object instances,
-// then the object's own tree after the world -> object transform; DESIGN.md section 5) and
-// intersects with the unit-triangle method of paper section 2.1 (DESIGN.md section 5), in IEEE
+// then the object's own tree after the world -> object transform; docs/cycle-model.md) and
+// intersects with the unit-triangle method of paper section 2.1 (docs/cycle-model.md), in IEEE
 // binary32 with the datapath op orders, so the functional fp24 model differs from it only by the
 // number format. Primary rays come from the camera basis exactly as the hardware's T_init
-// (paper section 2.2.2, DIGEST D8). Shading follows docs/shading.md. docs/float-reference.md
+// (paper section 2.2.2, decision D8). Shading follows docs/shading.md. docs/float-reference.md
 // gives the rules (interval, tie, mailbox, defaults).
 #pragma once
 
@@ -33,7 +33,7 @@ struct FloatRay {
   glm::vec3 direction{0.0f, 0.0f, 1.0f};
 };
 
-// The closest hit of one ray (DESIGN.md section 5: t, u, v, object and triangle id, D'z).
+// The closest hit of one ray (docs/cycle-model.md: t, u, v, object and triangle id, D'z).
 struct FloatHit {
   float t = std::numeric_limits<float>::infinity();  // miss: +inf
   float u = 0.0f;
@@ -147,12 +147,12 @@ FloatHit trace_float(const FloatScene& scene, const FloatRay& ray, float t_min =
 // The unit-triangle test of paper section 2.1.2 on one triangle, in binary32 with the datapath's
 // op order: O' = T.O and D' = T.D as (m0*x + m1*y) + (m2*z + t), t = -O'z / D'z,
 // u = O'x + t*D'x, v = O'y + t*D'y; accepted when u >= 0, v >= 0, u + v <= 1 and
-// t_min < t < t_best and D'z != 0 (DIGEST D13). Returns true and fills t, u, v, cos when
+// t_min < t < t_best and D'z != 0 (decision D13). Returns true and fills t, u, v, cos when
 // accepted. (FloatScene::trace adds the tie rule for t == t_best.)
 bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float t_min,
                              float t_best, float& t, float& u, float& v, float& cos);
 
-// The refracted direction (docs/shading.md section 7; DESIGN.md section 7 with the sign of D12) of
+// The refracted direction (docs/shading.md section 7; docs/shading.md with the sign of D12) of
 // a ray with direction D at a surface whose normal n faces the ray, eta = n1 / n2, in binary32 in
 // the RGS's op order: c = -dot(n, D), mu = (eta*c - sqrt((1 - eta*eta)*(dot(D, D)*dot(n, n)) +
 // (eta*c)*(eta*c))) / dot(n, n), direction_r = (D_r*eta + n_r*mu) + (D_r*0 + 0), which has the
@@ -160,7 +160,7 @@ bool intersect_unit_triangle(const Affine32& t_delta, const FloatRay& ray, float
 // internal reflection: a negative radicand.
 bool refract_float(const glm::vec3& d, const glm::vec3& n, float eta, glm::vec3& direction);
 
-// The primary ray of pixel (x, y) from T_init = [Cr, Cu, Cd; Cp] (host/primary_rays.h, DIGEST D8:
+// The primary ray of pixel (x, y) from T_init = [Cr, Cu, Cd; Cp] (host/primary_rays.h, decision D8:
 // the host has folded scale and pixel-centre offset into the basis): origin Cp, direction
 // (Cr*x + Cu*y) + (Cd*1 + 0), in binary32.
 FloatRay primary_ray(const PrimaryBasis32& camera, int x, int y);

@@ -1,7 +1,7 @@
-// Float reference against Embree on the built-in scenes too large for the default run (DESIGN.md
-// section 9): SunCOR (187M triangles through 5,622 instances) and the terrain (10.5M triangles
-// through 264 objects). Flattening them into world space would take gigabytes, so Embree gets the
-// same objects and instances as instance geometries (it then transforms the ray itself).
+// Float reference against Embree on the built-in scenes too large for the default run (
+// docs/compare.md): SunCOR (187M triangles through 5,622 instances) and the terrain (10.5M
+// triangles through 264 objects). Flattening them into world space would take gigabytes, so Embree
+// gets the same objects and instances as instance geometries (it then transforms the ray itself).
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -1,4 +1,4 @@
-// Float reference renderer (DESIGN.md section 9, model 1): the unit-triangle test and the
+// Float reference renderer (docs/compare.md, model 1): the unit-triangle test and the
 // two-level traversal on hand-made trees, where every answer is known in advance.
 #include "host/float_reference.h"
 
@@ -92,7 +92,7 @@ TEST(FloatIntersection, UnitTriangleIdentity) {
   EXPECT_EQ(u, 0.25f);
   EXPECT_EQ(v, 0.5f);
   EXPECT_EQ(c, -1.0f);
-  // Edges and vertices are inside (DIGEST D13): u = 0, v = 0, u + v = 1.
+  // Edges and vertices are inside (decision D13): u = 0, v = 0, u + v = 1.
   EXPECT_TRUE(intersect_unit_triangle(id, {{0, 0.5f, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
   EXPECT_TRUE(intersect_unit_triangle(id, {{0.5f, 0, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
   EXPECT_TRUE(intersect_unit_triangle(id, {{0.5f, 0.5f, 1}, {0, 0, -1}}, 0, kInf, t, u, v, c));
@@ -643,7 +643,7 @@ TEST(FloatShading, RefusesASceneWithOtherLights) {
   EXPECT_NO_THROW(render_float(image, other, hits_only));
 }
 
-// ---- against Embree (DESIGN.md section 9) ----------------------------------------------------
+// ---- against Embree (docs/compare.md) ----------------------------------------------------
 
 std::vector<std::string> manifest_gltf_models() {
   const std::string dir = SAARCOR_SHARED_SCENES;
@@ -673,7 +673,7 @@ std::vector<std::string> manifest_gltf_models() {
   return out;
 }
 
-// Largest relative t error allowed where the triangle agrees (issue 4). VC's vehicles (instances
+// Largest relative t error allowed where the triangle agrees. VC's vehicles (instances
 // scaled ~40, translated ~600) needed 2.5e-5 while the world -> object step ran in binary32; it
 // runs in binary64 now (docs/float-reference.md).
 constexpr double kTErrorBound = 1e-5;

@@ -1,4 +1,4 @@
-// Scene -> glTF 2.0 (DESIGN.md section 2: host/ owns scene files). Instances become nodes that
+// Scene -> glTF 2.0 (README.md "Layout": host/ owns scene files). Instances become nodes that
 // share one mesh per object, so an instanced scene (paper section 5, SunCOR) stays small on disk.
 #include "host/gltf_export.h"
 
@@ -165,7 +165,7 @@ void export_gltf(const Scene& scene, const std::string& path) {
     gm.pbrMetallicRoughness.roughnessFactor = m.roughness;
     gm.pbrMetallicRoughness.baseColorTexture.index = m.texture;
     if (m.transparency > 0.0f) gm.alphaMode = "BLEND";
-    gm.doubleSided = true;  // the hardware has no backface culling (DIGEST D13)
+    gm.doubleSided = true;  // the hardware has no backface culling (decision D13)
     // Glass (docs/scenes.md "Materials"): the inputs the loader derives the refraction weight from.
     if (m.transmission > 0.0f) {
       tinygltf::Value::Object t;

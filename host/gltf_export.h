@@ -1,5 +1,5 @@
 // Scene -> glTF 2.0 through tinygltf's writer, so other tools can open the built-in scenes
-// (issue 3: `saarcor scene builtin:NAME --export out.glb`). Mapping rules in docs/scenes.md.
+// (`saarcor scene builtin:NAME --export out.glb`). Mapping rules in docs/scenes.md.
 #pragma once
 
 #include <string>

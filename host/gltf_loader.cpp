@@ -1,8 +1,8 @@
-// glTF 2.0 -> Scene (DESIGN.md sections 2 and 4; paper section 2: each mesh is an object with its
-// own bottom-level tree, each node that carries it an instance in the top level). tinygltf parses
-// the file; texture images reach us through its image-loader callback and are decoded with
-// OpenImageIO. What the hardware cannot represent is reduced with a warning or refused with one
-// line (docs/scenes.md, "What is refused or reduced").
+// glTF 2.0 -> Scene (README.md "Layout" and docs/memory-image.md; paper section 2: each mesh is an
+// object with its own bottom-level tree, each node that carries it an instance in the top level).
+// tinygltf parses the file; texture images reach us through its image-loader callback and are
+// decoded with OpenImageIO. What the hardware cannot represent is reduced with a warning or refused
+// with one line (docs/scenes.md, "What is refused or reduced").
 #include "host/gltf_loader.h"
 
 #include <tiny_gltf.h>

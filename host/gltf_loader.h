@@ -1,4 +1,4 @@
-// glTF 2.0 import through tinygltf, textures through OpenImageIO (DESIGN.md section 2: host/ is
+// glTF 2.0 import through tinygltf, textures through OpenImageIO (README.md "Layout": host/ is
 // the one hardware-free library that reads files). Mapping rules are in docs/scenes.md.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The memory image the host uploads (DESIGN.md section 4; paper sections 2 and 3). Layout and
+// The memory image the host uploads (docs/memory-image.md; paper sections 2 and 3). Layout and
 // arithmetic: docs/memory-image.md.
 #include "host/image_builder.h"
 
@@ -744,7 +744,7 @@ BuiltImage build_image(const Scene& scene, const ImageParams& params) {
   b.params.kd.split_format = params.format;
   const ff::Format& f = params.format;
 
-  // The frame buffer and the RGS's exact int -> float pixel indices (DIGEST D8).
+  // The frame buffer and the RGS's exact int -> float pixel indices (decision D8).
   const std::uint64_t pixels = static_cast<std::uint64_t>(std::max(params.width, 0)) *
                                static_cast<std::uint64_t>(std::max(params.height, 0));
   const std::uint64_t max_index = 1ull << (f.man_bits + 1);

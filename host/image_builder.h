@@ -1,9 +1,9 @@
-// The memory image the host uploads (DESIGN.md section 4; paper section 3: "camera settings and
+// The memory image the host uploads (docs/memory-image.md; paper section 3: "camera settings and
 // scene data are uploaded by the host"; section 2: a top-level kd-tree over object instances,
 // one bottom-level tree per object, rebuilt only at the top when instances move). Writes the
 // words memif/image_format.h defines; docs/memory-image.md gives the layout and its arithmetic.
 //
-// Scene banks 3-5 (item-interleaved, DIGEST D22):
+// Scene banks 3-5 (item-interleaved, decision D22):
 //   nodes  [top-level tree, reserved capacity][object 0's tree][object 1's tree]...
 //   lists  [top-level lists, reserved capacity][object 0's lists]...
 //   rows   [instance records, 6 rows each][object 0's T_delta, 3 rows per triangle slot]...

@@ -1,4 +1,4 @@
-// The memory image (DESIGN.md section 4; memif/image_format.h): encode then decode, layout and
+// The memory image (docs/memory-image.md; memif/image_format.h): encode then decode, layout and
 // capacity accounting, overflow errors, texture and texcoord encoding, per-frame upload.
 #include "host/image_builder.h"
 #include "host/tree_settings.h"
@@ -218,7 +218,7 @@ TEST(ImageBuilder, FrameRegisters) {
   }
   EXPECT_EQ(dec(r.scene_max[0]), 3.0);
   EXPECT_EQ(dec(r.scene_max[2]), 2.0);  // the degenerate triangle's z = 4..6 is not in the bounds
-  // Epsilon: 1e-4 x diagonal (DIGEST D14).
+  // Epsilon: 1e-4 x diagonal (decision D14).
   const glm::dvec3 diag = glm::dvec3(b.top.bounds.hi - b.top.bounds.lo);
   EXPECT_EQ(r.epsilon, ff::from_double(1e-4 * glm::length(diag), ff::kFp24, {}));
   p.epsilon = 0.5;

@@ -1,8 +1,8 @@
 // SAH kd-tree builder: Wald & Havran, "On building fast kd-trees for ray tracing, and on doing
 // that in O(N log N)" (2006), with perfect splits, below a binned-SAH stage (Wald 2007, Shevtsov
 // et al. 2007) at the top. Builds the paper's (section 2) bottom-level trees over an object's
-// triangles and the top-level tree over instance bounds; the node layout follows DESIGN.md
-// section 4 (root at 0, children adjacent, split positions in fp24).
+// triangles and the top-level tree over instance bounds; the node layout follows
+// docs/memory-image.md (root at 0, children adjacent, split positions in fp24).
 //
 // How it works (docs/kdtree.md has the long form):
 // - Item bounds are rounded outward onto the split grid (the values representable in

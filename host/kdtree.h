@@ -86,7 +86,7 @@ struct KdBuildParams {
   int bins = 128;  // 2..256
   // Item bounds are rounded outward onto this format's values before any plane is chosen, so
   // every split is exactly representable and the tree is exact for the plane the hardware stores
-  // (DESIGN.md section 4: split position in fp24).
+  // (docs/memory-image.md: split position in fp24).
   ff::Format split_format = ff::kFp24;
 };
 

@@ -1,4 +1,4 @@
-// Build rate of the SAH kd-tree builder (host/kdtree.h; paper section 2, DESIGN.md section 4) on
+// Build rate of the SAH kd-tree builder (host/kdtree.h; paper section 2, docs/memory-image.md) on
 // deterministic meshes of about 10K, 100K and 1M triangles: a noisy terrain heightfield (like the
 // builtin terrain scene) and a finely tessellated sphere. Prints triangles per second, the ratio
 // against the target of 1M triangles/s on one core, and, as a reference measured in the same

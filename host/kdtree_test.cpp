@@ -1,6 +1,6 @@
-// Tests of the SAH kd-tree builder (host/kdtree.h, docs/kdtree.md; paper section 2, DESIGN.md
-// section 4): the tree's lists against exact triangle-box overlap, node structure and split
-// rounding, point and ray queries against brute force, the top level over boxes, degenerate
+// Tests of the SAH kd-tree builder (host/kdtree.h, docs/kdtree.md; paper section 2,
+// docs/memory-image.md): the tree's lists against exact triangle-box overlap, node structure and
+// split rounding, point and ray queries against brute force, the top level over boxes, degenerate
 // inputs and bad input.
 #include "host/kdtree.h"
 

@@ -1,4 +1,4 @@
-// The primary-ray transformation (paper section 2.2.2; DESIGN.md section 7; DIGEST D8).
+// The primary-ray transformation (paper section 2.2.2; docs/shading.md; decision D8).
 #include "host/primary_rays.h"
 
 #include <cmath>

@@ -1,5 +1,5 @@
-// The primary-ray transformation T_init = [Cr, Cu, Cd; Cp] (paper section 2.2.2; DESIGN.md
-// section 7; DIGEST D8), pre-scaled by the host so that the RGS issues the initial ray
+// The primary-ray transformation T_init = [Cr, Cu, Cd; Cp] (paper section 2.2.2;
+// docs/shading.md; decision D8), pre-scaled by the host so that the RGS issues the initial ray
 // R' = ((0,0,0), (px, py, 1)) with integer pixel indices and stays free of floating point:
 //   origin = Cp, direction = px*Cr + py*Cu + Cd,
 // px = 0..width-1 left to right, py = 0..height-1 with row 0 at the top of the image. The pixel

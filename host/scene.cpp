@@ -1,5 +1,5 @@
 // Scene-wide operations: counts, animation sampling (set_time), the default camera and light, and
-// the degenerate-triangle test shared by every loader (DESIGN.md section 4: degenerate triangles
+// the degenerate-triangle test shared by every loader (docs/memory-image.md: degenerate triangles
 // are dropped by the host and counted; paper section 2: dynamic objects move under one affine
 // transformation each, so only instance matrices change over time).
 #include "host/scene.h"
@@ -229,7 +229,7 @@ void mark_degenerate_triangles(Object& object) {
         std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
     bool bad = !(twice_area > kDegenerateRelativeArea * longest) || !(longest > 0.0);
     if (!bad) {
-      // T_delta^-1 = [A-C, B-C, N] (DESIGN.md section 4 erratum): its determinant is
+      // T_delta^-1 = [A-C, B-C, N] (docs/memory-image.md erratum): its determinant is
       // (A-C) x (B-C) . N; the inverse must come out finite in binary64.
       const glm::dvec3 n = cr / twice_area;
       const glm::dmat3 m(a - c, b - c, n);

@@ -1,8 +1,8 @@
 // The host's scene: objects (one per glTF mesh, in the mesh's own space), instances of them with
-// world transforms, materials, textures, lights and cameras (DESIGN.md sections 4 and 7; paper
-// section 2: objects that move under one affine transformation, instanced into a top level).
-// This is host data; the hardware never sees it, only the memory image built from it.
-// Loading, defaults and the built-in scenes are described in docs/scenes.md.
+// world transforms, materials, textures, lights and cameras (docs/memory-image.md and
+// docs/shading.md; paper section 2: objects that move under one affine transformation, instanced
+// into a top level). This is host data; the hardware never sees it, only the memory image built
+// from it. Loading, defaults and the built-in scenes are described in docs/scenes.md.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// glTF import (issue 3, "Scenes"): every glTF model of the shared MANIFEST.md loads with the
+// glTF import (docs/scenes.md): every glTF model of the shared MANIFEST.md loads with the
 // triangle counts the manifest lists, instancing, cameras, textures, node animations sampled at
 // chosen times, and one test per class of bad input.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Triangle and instance matrices (paper section 2.1.1; DESIGN.md section 4; DIGEST D11, D19).
+// Triangle and instance matrices (paper section 2.1.1; docs/memory-image.md; decisions D11, D19).
 #include "host/triangle_matrix.h"
 
 #include <algorithm>

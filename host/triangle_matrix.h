@@ -1,11 +1,12 @@
 // Triangle and instance matrices the host uploads (paper section 2.1.1, the affine triangle
-// transformation; DESIGN.md section 4, matrix rows and the T_delta erratum; DIGEST D11, D18, D19).
+// transformation; docs/memory-image.md, matrix rows and the T_delta erratum; decisions D11, D18,
+// D19).
 //
 // Every matrix is an affine 3x4 map written as three rows (m_r0, m_r1, m_r2, t_r), the order in
 // which the image stores it and the transformation unit evaluates it:
 //   out_r = (m_r0*x + m_r1*y) + (m_r2*z + t_r).
 // The host computes each matrix in binary64 and rounds every coefficient once into the image's
-// float format (DIGEST D11).
+// float format (decision D11).
 #pragma once
 
 #include <array>
@@ -56,9 +57,9 @@ inline constexpr double kDegenerateRelArea = 1e-12;
 
 // T_delta of triangle (A, B, C): maps A -> (1,0,0), B -> (0,1,0), C -> (0,0,0) and C + N ->
 // (0,0,1), N the unit normal of (A-C) x (B-C). Built as the inverse of
-// T_delta^-1(X) = [A-C, B-C, N] X + C (DESIGN.md erratum: the third column is N, not N - C), in
-// binary64. Row 2 is N itself. std::nullopt for a degenerate triangle (see kDegenerateRelArea) or
-// non-finite vertices.
+// T_delta^-1(X) = [A-C, B-C, N] X + C (decision D11, the paper's erratum: the third column is N,
+// not N - C), in binary64. Row 2 is N itself. std::nullopt for a degenerate triangle (see
+// kDegenerateRelArea) or non-finite vertices.
 std::optional<Affine64> triangle_matrix(const glm::dvec3& a, const glm::dvec3& b,
                                         const glm::dvec3& c);
 std::optional<Affine64> triangle_matrix(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);

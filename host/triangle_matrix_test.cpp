@@ -1,5 +1,5 @@
-// T_delta (paper section 2.1.1 with the DESIGN.md section 4 erratum), instance matrices and the
-// primary-ray basis (paper section 2.2.2, DIGEST D8).
+// T_delta (paper section 2.1.1 with the docs/memory-image.md erratum), instance matrices and the
+// primary-ray basis (paper section 2.2.2, decision D8).
 #include "host/triangle_matrix.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Registered channels of the simulation kernel (DESIGN.md section 8; STYLE.md: SystemC's
+// Registered channels of the simulation kernel (docs/hw.md; STYLE.md: SystemC's
 // sc_fifo, ChampSim's channel): bounded FIFOs with a latency, valid/ready handshake and
 // back-pressure, whose semantics make a design independent of module evaluation order.
 //

@@ -1,4 +1,4 @@
-// Channel and pipeline semantics (DESIGN.md section 8): exact cycle counts with mock neighbours,
+// Channel and pipeline semantics (docs/hw.md): exact cycle counts with mock neighbours,
 // capacity, back-pressure, port width, no loss and no duplication, misuse detection.
 #include "hw/channel.h"
 

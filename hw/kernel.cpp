@@ -1,4 +1,4 @@
-// The simulation kernel (DESIGN.md section 8): clock, two-phase cycle, idle skip, watchdog.
+// The simulation kernel (docs/hw.md): clock, two-phase cycle, idle skip, watchdog.
 // Also the out-of-line parts of Module and ChannelBase, which register with the kernel.
 #include "hw/kernel.h"
 

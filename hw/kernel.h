@@ -1,4 +1,4 @@
-// The simulation kernel (DESIGN.md section 8): owns the clock, knows every module and channel,
+// The simulation kernel (docs/hw.md): owns the clock, knows every module and channel,
 // runs cycles as evaluate-all then commit-all, skips idle cycles, stops stuck runs with a
 // watchdog report, keeps the statistics registry and drives the VCD tracer.
 //

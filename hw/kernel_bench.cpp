@@ -1,4 +1,4 @@
-// Kernel speed (DESIGN.md section 8): simulated cycles per second and module evaluations per
+// Kernel speed (docs/hw.md): simulated cycles per second and module evaluations per
 // second for a design of 20 modules and 40 channels with traffic, with and without idle
 // skipping. Target: >= 20 million module evaluations per second on one core; each run prints its
 // ratio to that target, and the skipping runs their speed-up over stepping every cycle.

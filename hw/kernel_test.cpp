@@ -1,4 +1,4 @@
-// Kernel semantics (DESIGN.md section 8): evaluation-order independence, idle skipping that
+// Kernel semantics (docs/hw.md): evaluation-order independence, idle skipping that
 // changes no figure, the watchdog and its report, cycle limits, time series.
 #include "hw/kernel.h"
 

@@ -1,4 +1,4 @@
-// Clocked modules of the simulation kernel (DESIGN.md section 8; STYLE.md habits 1-2, ChampSim's
+// Clocked modules of the simulation kernel (docs/hw.md; STYLE.md habits 1-2, ChampSim's
 // operable): one unit shape for every piece of hardware.
 //
 // A cycle is two phases. evaluate(): read only state committed at the end of the previous cycle

@@ -1,4 +1,4 @@
-// Statistics registry (DESIGN.md section 8): storage, JSON dump and time series.
+// Statistics registry (docs/hw.md): storage, JSON dump and time series.
 #include "hw/stats.h"
 
 #include <charconv>

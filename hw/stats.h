@@ -1,4 +1,4 @@
-// Statistics registry of the simulation kernel (DESIGN.md section 8; STYLE.md: gem5 stats with
+// Statistics registry of the simulation kernel (docs/hw.md; STYLE.md: gem5 stats with
 // dotted names, unit and description; DRAMsim3's epoch dumps as a time series).
 //
 // Every statistic is declared once, by the module that updates it, with a hierarchical dotted

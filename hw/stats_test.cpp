@@ -1,4 +1,4 @@
-// Statistics registry (DESIGN.md section 8): declaration rules, values, JSON dump, time series.
+// Statistics registry (docs/hw.md): declaration rules, values, JSON dump, time series.
 #include "hw/stats.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Small designs shared by the hw/ tests (DESIGN.md section 8): a pipeline of stages that share
+// Small designs shared by the hw/ tests (docs/hw.md): a pipeline of stages that share
 // state only through registers and channels, and a bursty design with long idle gaps, internal
 // timers and back-pressure stalls (what idle skipping must handle). With `sleep`, every module
 // that may (all but the doubler, which reads another module's register) opts into event

@@ -1,4 +1,4 @@
-// VCD tracer (DESIGN.md section 8; IEEE 1364-2005 section 18.2 grammar).
+// VCD tracer (docs/hw.md; IEEE 1364-2005 section 18.2 grammar).
 #include "hw/vcd.h"
 
 #include <map>

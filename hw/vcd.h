@@ -1,4 +1,4 @@
-// VCD tracer (DESIGN.md section 8; IEEE 1364-2005 section 18, the four-state VCD format that
+// VCD tracer (docs/hw.md; IEEE 1364-2005 section 18, the four-state VCD format that
 // GTKWave reads). Traces per module `busy` and `stall` and per channel `valid`, `ready` and
 // `occupancy` over a window of cycles; one VCD time unit is one clock cycle. Dotted names become
 // nested $scope modules, so `dynrtp0.traversal` appears as dynrtp0 > traversal in GTKWave.

@@ -1,4 +1,4 @@
-// VCD tracer (DESIGN.md section 8): the output is checked against the VCD grammar of
+// VCD tracer (docs/hw.md): the output is checked against the VCD grammar of
 // IEEE 1364-2005 section 18.2 by a small independent parser, and the values it carries are
 // checked against what the design did.
 #include "hw/vcd.h"

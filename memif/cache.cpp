@@ -1,4 +1,4 @@
-// Per-type item cache (paper section 3, Table 2; DESIGN.md section 6; DIGEST D20).
+// Per-type item cache (paper section 3, Table 2; docs/memif.md; decision D20).
 #include "memif/cache.h"
 
 #include <algorithm>

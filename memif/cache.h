@@ -1,5 +1,5 @@
 // Per-type item cache of a DynRTP (paper section 3: "individual caches for each type of data";
-// Table 2: 512 items each; DESIGN.md section 6; DIGEST D20).
+// Table 2: 512 items each; docs/memif.md; decision D20).
 //
 // One cache serves one item type (kd-nodes, list entries or matrix rows of MemoryImage); a line
 // holds one item; the cache is read-only. Sets = items / ways, set = index mod sets, LRU within a
@@ -42,7 +42,7 @@
 namespace saarcor::memif {
 
 struct CacheConfig {
-  int items = 512;       // lines (DESIGN.md section 6)
+  int items = 512;       // lines (docs/memif.md)
   int ways = 1;          // associativity; items must be a multiple
   int hit_latency = 2;   // cycles from the unit's push to the response being poppable (>= 2)
   int max_misses = 8;    // outstanding misses (D20)

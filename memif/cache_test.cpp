@@ -1,5 +1,5 @@
-// Per-type caches behind the simple routing and the memory controller (DESIGN.md section 6;
-// DIGEST D20): exact hit and miss latencies with a mock unit, merging of secondary misses,
+// Per-type caches behind the simple routing and the memory controller (docs/memif.md;
+// decision D20): exact hit and miss latencies with a mock unit, merging of secondary misses,
 // MSHR back-pressure, fair arbitration, invalidation, bad configurations.
 #include "memif/cache.h"
 

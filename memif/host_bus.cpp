@@ -1,4 +1,4 @@
-// The host bus: rate-limited uploads into the SRAM banks (paper section 4; DIGEST D40).
+// The host bus: rate-limited uploads into the SRAM banks (paper section 4; decision D40).
 #include "memif/host_bus.h"
 
 #include <cmath>

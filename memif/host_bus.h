@@ -1,5 +1,5 @@
-// The host bus (paper section 4: the prototype sits on a PCI board; DESIGN.md section 6;
-// DIGEST D40: upload at a configurable bandwidth, default 132 MB/s = 32-bit PCI at 33 MHz).
+// The host bus (paper section 4: the prototype sits on a PCI board; docs/memif.md;
+// decision D40: upload at a configurable bandwidth, default 132 MB/s = 32-bit PCI at 33 MHz).
 //
 // The host queues words to upload (between frames: upload() is called between kernel runs, not
 // from a module's evaluate); the bus sends them to the memory controller as write bursts of up

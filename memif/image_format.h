@@ -1,4 +1,4 @@
-// The memory image: what every 32-bit word in the SaarCOR SRAM banks means (DESIGN.md section 4).
+// The memory image: what every 32-bit word in the SaarCOR SRAM banks means (docs/memory-image.md).
 // This header is the one contract between host/ (which writes images) and units/ (which reads
 // them through the caches). It depends on fixedfloat/ and the standard library only.
 //
@@ -13,7 +13,7 @@
 //   row   3 words   one row of an affine 3x4 matrix: four floats packed (fixedfloat/pack.h);
 //                   4 words for formats wider than 24 bits
 // Item i of a type lives in scene bank (i mod 3) at word region_base[type] + (i div 3)*item_words,
-// so consecutive items spread over the three banks (DIGEST D22) and no item straddles banks.
+// so consecutive items spread over the three banks (decision D22) and no item straddles banks.
 //
 // Instance record (6 rows, at row index instance_row_base + 6*instance):
 //   rows 0-2  world -> object affine matrix, row r = (m_r0, m_r1, m_r2, t_r)
@@ -22,7 +22,7 @@
 //             the object's triangle 0
 //   rows 4-5  object-space bounds: (min x, y, z, 0) and (max x, y, z, 0)
 // Triangle matrix (3 rows per triangle, at triangle_row_base + 3*triangle_id): T_delta, the
-// object -> unit-triangle transform (paper section 2.1.1 with the erratum of DESIGN.md: the
+// object -> unit-triangle transform (paper section 2.1.1 with the erratum of decision D11: the
 // third column of T_delta^-1 is the unit normal), so row 2 of T_delta is the unit normal. Every
 // triangle of a mesh has a slot, degenerate ones included (all-zero rows, never listed), so a
 // triangle id is the triangle's index within its mesh.
@@ -207,7 +207,7 @@ inline ShadingRecord decode_shading(const std::uint32_t* w) {
 }
 
 // Light record (4 words at light_base + 4*light): w0..w2 position x, y, z (float encodings, one
-// per word), w3 intensity RGB8. Point lights, no attenuation (DIGEST D34).
+// per word), w3 intensity RGB8. Point lights, no attenuation (decision D34).
 inline constexpr int kLightWords = 4;
 
 // ---- per-frame registers (written by the host over the bus, not stored in SRAM) --------------
@@ -216,8 +216,8 @@ struct FrameRegisters {
   std::uint32_t width = 512;
   std::uint32_t height = 384;
   // Primary-ray transformation T_init = [Cr, Cu, Cd; Cp] (paper section 2.2.2), pre-scaled by the
-  // host (DIGEST D8) so that the RGS issues R' = ((0,0,0), (px, py, 1)) with integer pixel indices
-  // px, py: direction = px*Cr + py*Cu + Cd, with the pixel-centre offset folded into Cd.
+  // host (decision D8) so that the RGS issues R' = ((0,0,0), (px, py, 1)) with integer pixel
+  // indices px, py: direction = px*Cr + py*Cu + Cd, with the pixel-centre offset folded into Cd.
   std::array<std::uint32_t, 3> cam_r{}, cam_u{}, cam_d{}, cam_p{};
   std::uint32_t top_root = 0;                // top-level root node index
   std::array<std::uint32_t, 3> scene_min{};  // world bounds of the top-level tree

@@ -1,4 +1,4 @@
-// The memory controller and SRAM banks (paper section 3, DESIGN.md section 6, DIGEST D21/D23).
+// The memory controller and SRAM banks (paper section 3, docs/memif.md, decisions D21/D23).
 #include "memif/memory_controller.h"
 
 #include <algorithm>

@@ -1,6 +1,6 @@
 // The memory controller and the SRAM banks (paper section 3: "Mem-Ctrl ... uses a simple
-// reordering algorithm that ... avoid[s] unnecessary switching of memory-banks"; DESIGN.md
-// section 6; DIGEST D21, D23, D39).
+// reordering algorithm that ... avoid[s] unnecessary switching of memory-banks";
+// docs/memif.md; decisions D21, D23, D39).
 //
 // Model:
 //   * Ports: each client group (the simple routing of the caches, a shading unit, a frame-buffer

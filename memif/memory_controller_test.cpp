@@ -1,4 +1,4 @@
-// Memory controller and SRAM banks (DESIGN.md section 6; DIGEST D21, D23): exact timing with a
+// Memory controller and SRAM banks (docs/memif.md; decisions D21, D23): exact timing with a
 // mock client, bank parallelism, the switch penalty and the reordering, writes, bandwidth
 // counting, bad requests and bad configurations.
 #include "memif/memory_controller.h"

@@ -1,4 +1,4 @@
-// The memory interface assembled (paper Fig. 2, section 3; DESIGN.md section 6).
+// The memory interface assembled (paper Fig. 2, section 3; docs/memif.md).
 #include "memif/memory_system.h"
 
 #include <cstdio>

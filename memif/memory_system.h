@@ -1,5 +1,5 @@
-// The memory interface (MI) assembled (paper Fig. 2 and section 3; DESIGN.md section 6;
-// DIGEST D23, D44): per DynRTP three caches (kd-nodes, lists, matrix rows) behind one simple
+// The memory interface (MI) assembled (paper Fig. 2 and section 3; docs/memif.md;
+// decisions D23, D44): per DynRTP three caches (kd-nodes, lists, matrix rows) behind one simple
 // routing shared by all DynRTPs; per DynRTP an uncached shading port and a frame-buffer port;
 // one host bus; one memory controller over the six SRAM banks of a MemoryImage.
 //

@@ -1,4 +1,4 @@
-// Simulation speed of the memory interface (DESIGN.md section 6): one and four DynRTPs' caches
+// Simulation speed of the memory interface (docs/memif.md): one and four DynRTPs' caches
 // under random item traffic (one request per cache per cycle when accepted), with idle skipping.
 // Prints simulated cycles per second and module evaluations per second, and the ratio of the
 // latter to the kernel target of 20 million per second measured by hw_bench.

@@ -1,4 +1,4 @@
-// The memory interface under constrained-random traffic (DESIGN.md section 6): several
+// The memory interface under constrained-random traffic (docs/memif.md): several
 // requesters on the caches of two DynRTPs plus uncached shading reads, frame-buffer writes and a
 // host upload, all through one controller. A scoreboard checks that every request is answered
 // exactly once with the words of a reference image, and the caches' hit/miss counts equal those

@@ -1,4 +1,4 @@
-// A plain cache simulation for the tests (DIGEST D20): lines of one item, set = index mod sets,
+// A plain cache simulation for the tests (decision D20): lines of one item, set = index mod sets,
 // LRU, fills are instant. Used as the reference the cycle-level Cache's counters must match on
 // the same request sequence. Test-only header.
 #pragma once

@@ -1,5 +1,5 @@
 // What travels on the memory interface's channels (paper section 3 "memory interface",
-// DESIGN.md section 6): item requests from units to their cache, labelled item responses back,
+// docs/memif.md): item requests from units to their cache, labelled item responses back,
 // word requests from caches and other clients to the memory controller, and labelled word
 // responses (the "labeled broadcast" of the simple routing).
 #pragma once
@@ -40,7 +40,7 @@ struct MemRequest {
   std::uint8_t bank = 0;
   std::uint8_t words = 1;  // 1..kMaxRequestWords
   bool write = false;
-  std::uint8_t counted_bytes = 0;  // bytes to count for bandwidth; 0 = 4 * words (DIGEST D36)
+  std::uint8_t counted_bytes = 0;  // bytes to count for bandwidth; 0 = 4 * words (decision D36)
   std::uint32_t offset = 0;        // word offset within the bank
   std::array<std::uint32_t, kMaxRequestWords> data{};  // write data
 };

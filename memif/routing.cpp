@@ -1,5 +1,5 @@
 // Simple routing: request multiplexer and labelled response broadcast (paper section 3,
-// DESIGN.md section 6, DIGEST D23).
+// docs/memif.md, decision D23).
 #include "memif/routing.h"
 
 #include <stdexcept>

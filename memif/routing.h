@@ -1,5 +1,5 @@
 // Simple routing (paper section 3: "acts like a multiplexer for memory requests and uses a
-// labeled broadcast for memory responses" [SWS02]; DESIGN.md section 6; DIGEST D23).
+// labeled broadcast for memory responses" [SWS02]; docs/memif.md; decision D23).
 //
 // Requests: one per cycle from the clients (every cache of every DynRTP) to the controller port,
 // chosen round-robin among the clients that have one (fair: a client waits at most one turn of

@@ -1,4 +1,4 @@
-// Traffic generators and a scoreboard for the memif tests (DESIGN.md section 6): a requester
+// Traffic generators and a scoreboard for the memif tests (docs/memif.md): a requester
 // that drives one cache with constrained-random item requests and checks every response against
 // a reference MemoryImage, and a scene image filled with random words. Test-only header.
 #pragma once

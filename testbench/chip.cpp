@@ -1,4 +1,4 @@
-// The chip of Figure 2 instantiated and clocked (DESIGN.md section 2: testbench/ "instantiates the
+// The chip of Figure 2 instantiated and clocked (README.md "Layout": testbench/ "instantiates the
 // chip and clocks it"; docs/cycle-model.md): the RGC, the DynRTPs of units/dynrtp.h and the
 // memory system they share, the frame loop, the figures it samples (units/figures.h), and the
 // frame with the host's upload beside it.

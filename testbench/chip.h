@@ -1,4 +1,4 @@
-// The chip of the cycle model instantiated and clocked (DESIGN.md section 2: testbench/
+// The chip of the cycle model instantiated and clocked (README.md "Layout": testbench/
 // "instantiates the chip and clocks it"; section 9 model 3): the RGC, one DynRTP as in the
 // prototype or several sharing the memory controller (D44; units/dynrtp.h), the memory system,
 // and the frame loop with its figures (units/figures.h). Bit-identical to the functional fp24

@@ -1,4 +1,4 @@
-// `saarcor compare`: hit-record and image metrics between two models (DESIGN.md section 9; the
+// `saarcor compare`: hit-record and image metrics between two models (docs/compare.md; the
 // precision study of functional fp24 against the float reference). Classes: docs/compare.md.
 #include "testbench/compare.h"
 

@@ -1,4 +1,4 @@
-// Golden-model comparison (DESIGN.md section 9): hit records of two models, or two images, and
+// Golden-model comparison (docs/compare.md): hit records of two models, or two images, and
 // the metrics `saarcor compare` prints and writes as JSON (classes and thresholds in
 // docs/compare.md). B is the reference: relative errors are taken against B.
 #pragma once

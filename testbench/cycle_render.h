@@ -1,4 +1,4 @@
-// `saarcor render --model cycle` (issue 6; DESIGN.md section 9 model 3): the cycle model's options
+// `saarcor render --model cycle` (docs/compare.md model 3): the cycle model's options
 // (--preset, --set KEY=VALUE, --interval, --vcd), its per-frame JSON report and the printout in
 // the layout of the paper's Table 4 (docs/cycle-model.md).
 #pragma once

@@ -10,7 +10,7 @@
 // moves with the model, not with the machine.
 //
 // Two frames (second argument): 0 = the issue's frame, primary rays into a hit sink (what the
-// DynRTC computes; also the frame issue 4's functional-model target is measured on), and 1 = the
+// DynRTC computes; also the frame the functional model's speed target is measured on), and 1 = the
 // paper's Table 3 setting with the RGS's local shading: its shading-bank reads, shading pipeline
 // and frame-buffer writes are timed (docs/shading.md section 9), so the shaded frame takes more
 // cycles, and its host time per simulated cycle is the figure to compare with the hit sink's

@@ -1,4 +1,4 @@
-// saarcor float-info / float-calc / float-gen (issue 2; DESIGN.md section 3). The ops come from
+// saarcor float-info / float-calc / float-gen (docs/fixedfloat.md). The ops come from
 // the runtime-format functions of fixedfloat/format.h, the same code the MPFR tests check.
 #include "testbench/float_tools.h"
 

@@ -1,4 +1,4 @@
-// The float tools a verification engineer uses against an RTL FPU (issue 2; DESIGN.md section 3):
+// The float tools a verification engineer uses against an RTL FPU (docs/fixedfloat.md):
 //   saarcor float-info  the parameters of a format, and the encoding of a value rounded into it;
 //   saarcor float-calc  "OP A [B]" lines in, one result per line out (TestFloat's testfloat_ver
 //                       shape), for diffing against an RTL simulation;

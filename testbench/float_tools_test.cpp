@@ -1,4 +1,4 @@
-// Tests of saarcor float-info / float-calc / float-gen (issue 2): known encodings, the
+// Tests of saarcor float-info / float-calc / float-gen: known encodings, the
 // float-gen -> float-calc round trip in every mode, and one clear error per class of bad input,
 // in process and through the `saarcor` executable.
 #include "testbench/float_tools.h"

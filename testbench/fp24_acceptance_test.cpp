@@ -1,4 +1,4 @@
-// Issue 4 acceptance: the functional fp24 model against the float reference (DESIGN.md section 9)
+// Acceptance of the functional fp24 model against the float reference (docs/compare.md)
 // on every glTF model in the shared scenes and every built-in scene, at the issue's 512x384: the
 // same closest triangle for at least 99 % of the primary rays and a shaded image within 35 dB
 // PSNR. Every scene prints its figures, so the test output is the precision report. The

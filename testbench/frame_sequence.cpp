@@ -64,7 +64,7 @@ std::uint64_t rays_of(const units::FunctionalFrame& f) {
   return n;
 }
 
-// The cycle model's frame k against the functional model's (DESIGN.md section 9: bit for bit).
+// The cycle model's frame k against the functional model's (docs/compare.md: bit for bit).
 void check_frame(const units::FunctionalFrame& c, const units::FunctionalFrame& ref, int index,
                  double time) {
   std::size_t differ = 0;

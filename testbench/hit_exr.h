@@ -1,6 +1,6 @@
 // The hit EXR: one frame's per-pixel closest-hit records (testbench/hit_buffer.h) as ONE
 // multi-channel OpenEXR file, so any other tool can read the hits and trace the same rays
-// (DESIGN.md section 9; channel layout in docs/compare.md):
+// (docs/compare.md; channel layout in docs/compare.md):
 //   float hit.t, hit.u, hit.v, hit.cos; uint hit.instance, hit.triangle;
 //   float ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz.
 // A miss has hit.t = +inf and both ids 0xFFFFFFFF. Values are stored bit for bit (lossless zip).

@@ -1,5 +1,5 @@
 // The hit EXR round trip: what OpenImageIO decodes from the file is exactly the records in
-// memory, bit for bit, every pixel and every channel (issue 4, "What it must show").
+// memory, bit for bit, every pixel and every channel.
 #include "testbench/hit_exr.h"
 
 #include <gtest/gtest.h>

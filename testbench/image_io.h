@@ -1,4 +1,4 @@
-// Image files of the testbench (DESIGN.md section 2: image I/O stays in testbench/ and host/):
+// Image files of the testbench (README.md "Layout": image I/O stays in testbench/ and host/):
 // every image the tools write or read goes through OpenImageIO here. Writers never leave a
 // partial file behind: they write a temporary file beside the target and rename it into place.
 // Every failure throws std::runtime_error with one line naming the file.

@@ -194,7 +194,7 @@ std::vector<PaperFigure> table4_figures(const nlohmann::json& cycle, const std::
       {"hit_list", h["list"].get<double>(), p.hit[1]},
       {"hit_transformation", h["transformation"].get<double>(), p.hit[2]},
       {"mb_s_dynrtc", b["dynrtc"].get<double>(), p.bw[0]},
-      // The paper's shading bandwidth includes the frame buffer (DESIGN.md section 10).
+      // The paper's shading bandwidth includes the frame buffer (docs/fidelity.md).
       {"mb_s_shading", b["shading"].get<double>() + b.value("frame_buffer", 0.0), p.bw[1]},
       {"mb_s_total", b["total"].get<double>(), p.bw[2]},
   };

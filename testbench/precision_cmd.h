@@ -1,7 +1,7 @@
 // `saarcor precision`: the paper's "parameterised precision" study (section 4: the FP units were
 // modelled "with a parameterized precision in order to evaluate its effect on performance and
 // rendering quality"; 16 mantissa bits were chosen). The functional model runs in Float<7, m> for
-// each m and is compared with the float reference (DESIGN.md section 9): same-triangle share and
+// each m and is compared with the float reference (docs/compare.md): same-triangle share and
 // PSNR per m, printed as a table, written as JSON and drawn as a PNG plot.
 #pragma once
 

@@ -1,6 +1,6 @@
-// Refraction rays in the three models (DESIGN.md sections 7 and 9; docs/shading.md section 7;
-// decisions D12, D37): the functional fp24 model against the float reference on every scene with a
-// refractive material (builtin:glass; BART's kitchen, whose glasses, bowl and dragon are glass),
+// Refraction rays in the three models (docs/shading.md and docs/compare.md; docs/shading.md section
+// 7; decisions D12, D37): the functional fp24 model against the float reference on every scene with
+// a refractive material (builtin:glass; BART's kitchen, whose glasses, bowl and dragon are glass),
 // Float<7,23> against the binary32 reference bit for bit with refraction, shadow and reflection
 // rays (both models run the RGS's op order), and total internal reflection in both models on a
 // glass quad seen from inside at 60 degrees. The cycle model's bit-exactness with refraction is in

@@ -1,4 +1,4 @@
-// Speed of the two golden models (DESIGN.md section 9) against Intel Embree 3 on the same rays in
+// Speed of the two golden models (docs/compare.md) against Intel Embree 3 on the same rays in
 // the same run: 512x384 primary rays (the paper's Table 3 resolution) of builtin:room and of the
 // largest instanced glTF model that builds quickly (2CylinderEngine, 121K triangles after
 // instancing). Rays per second of thread CPU time (the machine is shared; wall time would measure
@@ -8,7 +8,7 @@
 //   - functional fp24 model: run_functional<fp24> with P = 4, hit only and shaded;
 //   - Embree: rtcIntersect1 (single ray) on the float reference's world rays, world-space
 //     triangles, high-quality BVH.
-// Targets (issue 4): float reference >= 0.25x Embree's single-ray rate; fp24 >= 0.1x.
+// Targets: float reference >= 0.25x Embree's single-ray rate; fp24 >= 0.1x.
 //
 // BM_PaperTable3: the paper's Table 3 compares the prototype (one DynRTP at 90 MHz) with OpenRT
 // on a 2.66 GHz Pentium 4. Its software column becomes Embree's single-ray rate on this host, on

@@ -1,4 +1,4 @@
-// `saarcor render` (issue 4; DESIGN.md section 9): load, set the time, build the memory image,
+// `saarcor render` (docs/compare.md): load, set the time, build the memory image,
 // run one model, write PNG / EXR / hit EXR / JSON report. docs/compare.md lists the outputs.
 #include "testbench/render_cmd.h"
 

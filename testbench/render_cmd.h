@@ -1,4 +1,4 @@
-// `saarcor render`: one frame of a scene through one of the models of DESIGN.md section 9 (float
+// `saarcor render`: one frame of a scene through one of the models of docs/compare.md (float
 // reference, functional model in Float<7,m>; the cycle model comes later), written as image, hit
 // EXR and JSON report (docs/compare.md). The pieces are public so `saarcor precision` and the
 // tests reuse them.

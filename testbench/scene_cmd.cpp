@@ -1,6 +1,6 @@
 // `saarcor scene`: loads a scene (glTF or built-in), evaluates it at a time, optionally exports it,
-// builds the memory image (both kd-tree levels, DESIGN.md section 4) and reports counts, tree
-// statistics, build times and bytes per bank (issue 3, "Command line").
+// builds the memory image (both kd-tree levels, docs/memory-image.md) and reports counts, tree
+// statistics, build times and bytes per bank (README "Command line").
 #include "testbench/scene_cmd.h"
 
 #include <algorithm>

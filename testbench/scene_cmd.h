@@ -1,6 +1,6 @@
 // `saarcor scene SCENE [--time T] [--json] [--export FILE] [--bank-mb MB]`: what a scene holds
-// and what the host makes of it (issue 3: counts, both kd-tree levels' statistics and build
-// times, bytes per SRAM bank; DESIGN.md section 4).
+// and what the host makes of it (counts, both kd-tree levels' statistics and build
+// times, bytes per SRAM bank; docs/memory-image.md).
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// `saarcor scene` as a user runs it (issue 3, "Command line"): the JSON keys and values, --time,
+// `saarcor scene` as a user runs it (README "Command line"): the JSON keys and values, --time,
 // --export then re-load, and one line on stderr with a non-zero exit for each class of bad input.
 #include <gtest/gtest.h>
 

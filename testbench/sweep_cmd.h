@@ -2,7 +2,7 @@
 // memory image built once; the cycle model then runs a frame for every point of the cartesian
 // product of the --vary lists (on top of --preset and --set), and every point's hit records and
 // image are checked bit for bit against the functional fp24 model on the same image: timing may
-// change, results never do (issue 6). Prints one row per point (cycles, fps, speed-up over the
+// change, results never do. Prints one row per point (cycles, fps, speed-up over the
 // first point, the paper's Table 4 columns), and writes the same as JSON and CSV
 // (docs/cycle-model.md, "Sweeps").
 #pragma once

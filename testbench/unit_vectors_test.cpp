@@ -72,7 +72,7 @@ TEST_P(UnitVectorsOnScenes, EveryVectorIsTheDatapathsAnswer) {
 INSTANTIATE_TEST_SUITE_P(Scenes, UnitVectorsOnScenes, ::testing::Range(0, 28));
 
 // With shadow and secondary rays the transformation unit also generates shadow, reflection and
-// transparency rays (the RGS's T, DESIGN.md section 7): those steps are vectors too.
+// transparency rays (the RGS's T, docs/shading.md): those steps are vectors too.
 TEST(UnitVectors, ShadowAndSecondaryRaysToo) {
   const host::BuiltImage b = build("builtin:dynamic", 32, 24);
   FunctionalParams shaded;

@@ -1,7 +1,8 @@
-// The cycle model's parameters (DESIGN.md sections 5, 6 and 10; DIGEST D7, D20-D33): one table
-// declares every parameter once (name, default, unit, help, range); presets are data (named sets of
-// overrides); `--set KEY=VALUE` goes through the same table. The defaults are the paper's
-// prototype: one DynRTP, 64 threads of 4-ray packets, 512-item direct-mapped caches, 90 MHz.
+// The cycle model's parameters (docs/cycle-model.md, docs/memif.md and docs/fidelity.md; decisions
+// D7, D20-D33): one table declares every parameter once (name, default, unit, help, range); presets
+// are data (named sets of overrides); `--set KEY=VALUE` goes through the same table. The defaults
+// are the paper's prototype: one DynRTP, 64 threads of 4-ray packets, 512-item direct-mapped
+// caches, 90 MHz.
 #pragma once
 
 #include <cstdint>

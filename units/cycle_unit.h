@@ -1,10 +1,10 @@
-// The shape every DynRTP unit of the cycle model shares (paper section 3.1, Figure 2; DESIGN.md
-// section 5; DIGEST D20, D25, D32): thread ids arrive on input paths (FIFO queues, one per path,
-// served by a fixed priority), the unit fetches the item the thread's request names through its
-// cache (one request per packet; a matrix is several row items), the thread waits for the data
-// without blocking the unit, ready threads are issued in the order their data arrived, a request
-// occupies the unit's issue slot for its steps, and after the pipeline depth the thread leaves on
-// the path to the unit its next request names.
+// The shape every DynRTP unit of the cycle model shares (paper section 3.1, Figure 2;
+// docs/cycle-model.md; decisions D20, D25, D32): thread ids arrive on input paths (FIFO queues, one
+// per path, served by a fixed priority), the unit fetches the item the thread's request names
+// through its cache (one request per packet; a matrix is several row items), the thread waits for
+// the data without blocking the unit, ready threads are issued in the order their data arrived, a
+// request occupies the unit's issue slot for its steps, and after the pipeline depth the thread
+// leaves on the path to the unit its next request names.
 //
 // What a thread computes is decided only by the thread program (units/thread_program.h): the unit
 // calls ThreadTable::execute(t) once per request, at issue. Timing decides when, never what.

@@ -1,6 +1,6 @@
-// The DynRTC datapaths as pure functions (paper sections 2.1-2.3 and 3.1; DESIGN.md sections 5
+// The DynRTC datapaths as pure functions (paper sections 2.1-2.3 and 3.1; docs/cycle-model.md
 // and 7): the transformation step, the traversal step of one kd-node for a packet, the
-// unit-triangle intersection and its acceptance rules (DIGEST D13 plus the tie rule of
+// unit-triangle intersection and its acceptance rules (decision D13 plus the tie rule of
 // docs/shading.md section 3), the slab clip of D29, and the RGS FP helper's refraction factor. Each
 // takes the float unit (UnitFp) of the hardware unit that owns the operators, so ops are counted
 // per unit. The functional model and the cycle model call these same functions; nothing here keeps
@@ -72,9 +72,10 @@ inline std::uint32_t magnitude_key(F x) {
   return magnitude_bits(x);
 }
 
-// ---- transformation unit (paper 2.3, DESIGN.md 5: 9 mul, 9 add per step) -----------------------
-// One step: per output component r, (m_r0*x + m_r1*y) + (m_r2*z + t_r). A direction step feeds
-// zero as the translation (the adder still runs: -0 + +0 = +0, a real datapath effect).
+// ---- transformation unit (paper 2.3, docs/cycle-model.md: 9 mul, 9 add per step)
+// ----------------------- One step: per output component r, (m_r0*x + m_r1*y) + (m_r2*z + t_r). A
+// direction step feeds zero as the translation (the adder still runs: -0 + +0 = +0, a real datapath
+// effect).
 template <class F, class Fp>
 [[gnu::flatten]] inline Vec3<F> transform_step(const Fp& fp, const Mat34<F>& m, const Vec3<F>& v,
                                                bool translate) {
@@ -94,12 +95,12 @@ template <class F, class Fp>
                 fp.add(fp.mul(a[2], b[2]), F::zero()));
 }
 
-// ---- RGS FP helper: the refraction factor (paper 2.2.2, DESIGN.md 7, D10, D12) ----------------
-// The paper generates a refracted ray from T_R = [D, N, D; O] and R' = ((t, 0, e), (-eta, mu, 0))
-// with mu = eta*c - sqrt(1 - eta^2 + (eta*c)^2), c = N.D: the textbook formula for a D that points
-// back to the viewer. With D the ray's direction, as in every other row of the table, and N the
-// normal facing the ray (as for reflection), c = -N.D (the cosine of incidence, >= 0) and the
-// refracted direction is eta*D + mu*N: R' = ((t, 0, e), (eta, mu, 0)), with eta = n1 / n2 (the
+// ---- RGS FP helper: the refraction factor (paper 2.2.2, docs/shading.md, D10, D12)
+// ---------------- The paper generates a refracted ray from T_R = [D, N, D; O] and R' = ((t, 0, e),
+// (-eta, mu, 0)) with mu = eta*c - sqrt(1 - eta^2 + (eta*c)^2), c = N.D: the textbook formula for a
+// D that points back to the viewer. With D the ray's direction, as in every other row of the table,
+// and N the normal facing the ray (as for reflection), c = -N.D (the cosine of incidence, >= 0) and
+// the refracted direction is eta*D + mu*N: R' = ((t, 0, e), (eta, mu, 0)), with eta = n1 / n2 (the
 // side the ray comes from over the side it enters). Neither D nor N is a unit vector (D9), so the
 // helper scales mu by |D| / |N|, which gives the refracted direction the length of D:
 //   mu = (eta*c - sqrt((1 - eta*eta)*(D.D * N.N) + (eta*c)^2)) / N.N,   c = -N.D
@@ -122,13 +123,13 @@ inline RefractionFactor<F> refraction_factor(const Fp& fp, F eta, F nd, F dd, F 
   return r;
 }
 
-// ---- traversal unit (paper 3.1, DESIGN.md 5, DIGEST D27/D33) ---------------------------------
-// One ray's lane of a kd-node step. The packet shares one near/far order (all active rays have
-// the same direction sign on the split axis, D27): near = lower child when the sign bit is clear.
-// d = (split - O[axis]) / D[axis]; the ray segment [tn, tf] needs the near child unless d < tn
-// and the far child unless d > tf. When it needs both, near gets [tn, d] and far [d, tf]; a NaN d
-// (origin on the plane, direction parallel) keeps [tn, tf] on both sides (a bit test, no
-// comparator). 1 add, 1 div, 2 cmp.
+// ---- traversal unit (paper 3.1, docs/cycle-model.md, decisions D27/D33)
+// --------------------------------- One ray's lane of a kd-node step. The packet shares one
+// near/far order (all active rays have the same direction sign on the split axis, D27): near =
+// lower child when the sign bit is clear. d = (split - O[axis]) / D[axis]; the ray segment [tn, tf]
+// needs the near child unless d < tn and the far child unless d > tf. When it needs both, near gets
+// [tn, d] and far [d, tf]; a NaN d (origin on the plane, direction parallel) keeps [tn, tf] on both
+// sides (a bit test, no comparator). 1 add, 1 div, 2 cmp.
 template <class F>
 struct TraversalLane {
   bool go_near = false;
@@ -175,7 +176,8 @@ template <class F, class Fp, class Den>
     tf = fp.min(tf, t);
 }
 
-// ---- intersection unit (paper 2.1.2, DESIGN.md 5: 3 add, 2 mul, 1 div per ray) --------------
+// ---- intersection unit (paper 2.1.2, docs/cycle-model.md: 3 add, 2 mul, 1 div per ray)
+// --------------
 template <class F>
 struct Candidate {
   F t{}, u{}, v{}, c{};  // c = D'z, the cosine with the geometric normal

@@ -48,7 +48,7 @@ TEST(TransformStep, OpOrderIsM0XPlusM1YThenM2ZPlusT) {
   EXPECT_EQ(dot_step(fp, Vec3<F>{f(1), f(2), f(3)}, Vec3<F>{f(4), f(5), f(6)}).bits, f(32).bits);
 }
 
-// Ray generation through transformations (paper 2.2.2, DESIGN.md 7): T = [A, B, C; D] has rows
+// Ray generation through transformations (paper 2.2.2, docs/shading.md): T = [A, B, C; D] has rows
 // (A_r, B_r, C_r, D_r); the origin step translates, the direction step does not.
 Mat34<F> columns(const Vec3<F>& a, const Vec3<F>& b, const Vec3<F>& c, const Vec3<F>& d) {
   Mat34<F> t{};
@@ -85,7 +85,7 @@ TEST(RayGeneration, ShadowReflectionTransparency) {
   expect_vec(transform_step(fp, tr, v3(1, 0, 0), false), 0, -1, 0, "transparency direction");
 }
 
-// Refraction (DESIGN.md 7 with the sign decided in D12): T_R = [D, N, D; O] on
+// Refraction (docs/shading.md with the sign decided in D12): T_R = [D, N, D; O] on
 // R' = ((t, 0, e), (eta, mu, 0)) gives (O + t*D + e*D, eta*D + mu*N), N facing the ray.
 TEST(RayGeneration, Refraction) {
   ff::OpCounts ops;

@@ -1,4 +1,4 @@
-// The units of one DynRTP in the cycle model (paper section 3.1, Figure 2; DESIGN.md section 5):
+// The units of one DynRTP in the cycle model (paper section 3.1, Figure 2; docs/cycle-model.md):
 // traversal, mailboxed list, transformation, intersection, and the ray source (the RGC/RGS in
 // front of path a with the hit sink after path g). Each is a CycleUnit (units/cycle_unit.h) with
 // its own cache, pipeline depth and rules; units/dynrtp.cpp wires them with the paths a-g.

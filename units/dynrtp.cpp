@@ -1,7 +1,7 @@
-// The DynRTP assembled for the cycle model (paper section 3.1, Figure 2 paths a-g; DESIGN.md
-// sections 5 and 6; docs/cycle-model.md): Figure 2's units with their input priorities, the paths
-// between every two units, and the memory system's parameters. testbench/chip.cpp instantiates
-// the chip from it and clocks it.
+// The DynRTP assembled for the cycle model (paper section 3.1, Figure 2 paths a-g;
+// docs/cycle-model.md and docs/memif.md; docs/cycle-model.md): Figure 2's units with their input
+// priorities, the paths between every two units, and the memory system's parameters.
+// testbench/chip.cpp instantiates the chip from it and clocks it.
 #include "units/dynrtp.h"
 
 #include <stdexcept>

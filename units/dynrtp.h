@@ -1,8 +1,9 @@
-// The DynRTP of the cycle model (paper section 3.1, Figure 2; DESIGN.md sections 5, 6 and 9 model
-// 3): the traversal, mailboxed list, transformation and intersection units and the ray source,
-// built from a list of unit specs, with a path between every two units, over its pipeline's
-// caches and memory ports. testbench/chip.h instantiates the chip (one DynRTP as in the
-// prototype, or several sharing the memory controller and fed by one RGC, D44) and clocks it.
+// The DynRTP of the cycle model (paper section 3.1, Figure 2; docs/cycle-model.md, docs/memif.md
+// and docs/compare.md model 3): the traversal, mailboxed list, transformation and intersection
+// units and the ray source, built from a list of unit specs, with a path between every two units,
+// over its pipeline's caches and memory ports. testbench/chip.h instantiates the chip (one DynRTP
+// as in the prototype, or several sharing the memory controller and fed by one RGC, D44) and clocks
+// it.
 #pragma once
 
 #include <array>

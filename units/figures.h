@@ -120,7 +120,7 @@ inline constexpr FigureInfo kFigures[] = {
      figure::frame_buffer, true, nullptr},
     {"bandwidth_mb_s.total", "MB/s", "total memory bandwidth (MB/s, MB = 2^20 B)", figure::total,
      true, nullptr},
-    // The paper's shading column counts the frame buffer too (DESIGN.md section 10): the frame
+    // The paper's shading column counts the frame buffer too (docs/fidelity.md): the frame
     // sequence's rows report it as their shading bandwidth.
     {"bandwidth_mb_s.rgs", "MB/s",
      "rgs memory bandwidth: shading reads and frame-buffer writes (MB/s, MB = 2^20 B)", figure::rgs,

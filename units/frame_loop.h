@@ -1,4 +1,4 @@
-// The functional model's frame loop (DESIGN.md section 9, model 2; paper section 3.1: the RGC
+// The functional model's frame loop (docs/compare.md, model 2; paper section 3.1: the RGC
 // schedules screen-space packets): one thread program, one packet after another, to completion,
 // for a datapath policy D chosen at compile time. It names no policy: units/functional_model.cpp
 // instantiates it with FastDatapath (run_functional), units/reference_model.cpp with

@@ -1,4 +1,4 @@
-// The functional fp24 model (DESIGN.md section 9, model 2) on the fast datapath: the frame loop
+// The functional fp24 model (docs/compare.md, model 2) on the fast datapath: the frame loop
 // (units/frame_loop.h) instantiated with FastDatapath for every built-in format, the RGC's packet
 // tiling (paper section 3.1: screen-space packets), and the replay of one pixel's packet.
 #include "units/functional_model.h"

@@ -1,5 +1,5 @@
-// The functional fp24 model (DESIGN.md section 9, model 2): the DynRTP's algorithms, untimed, in
-// the hardware's float format with the datapath op orders of DESIGN.md sections 5 and 7. The RGC
+// The functional fp24 model (docs/compare.md, model 2): the DynRTP's algorithms, untimed, in
+// the hardware's float format with the datapath op orders of docs/cycle-model.md and 7. The RGC
 // (paper section 3.1) hands screen-space packets of P pixels to one thread program
 // (units/thread_program.h) that runs each to completion, packet after packet. The cycle model
 // drives the same thread program with timing and must match this model bit for bit.

@@ -1,5 +1,5 @@
-// Intersection unit of the DynRTP (paper section 3.1, Figure 2 paths e, f; DESIGN.md section 5;
-// DIGEST D30). Depth: t = -O'z / D'z (div), u = O'x + t D'x (mul, add), u + v (add), the hit
+// Intersection unit of the DynRTP (paper section 3.1, Figure 2 paths e, f; docs/cycle-model.md;
+// decision D30). Depth: t = -O'z / D'z (div), u = O'x + t D'x (mul, add), u + v (add), the hit
 // compares (cmp) = 8 + 3 + 3 + 3 + 1 = 18 cycles by default; one ray per cycle.
 #include "units/dynrtc_units.h"
 

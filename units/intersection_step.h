@@ -1,8 +1,8 @@
-// The intersection unit's semantics (paper section 2.1.2; Figure 2 paths e and f; DESIGN.md
-// section 5; decision D30): the unit-triangle test of every entering ray of the packet, one ray per
-// cycle (P cycles), and the closest-hit update; a shadow ray is done at its first hit (any-hit).
-// Then back to the list (path f). Timing: units/intersection.cpp (depth: div, mul, add, add, the
-// hit tests); exact-cycle test: units/unit_timing_test.cpp (UnitTimingIntersection.*).
+// The intersection unit's semantics (paper section 2.1.2; Figure 2 paths e and f;
+// docs/cycle-model.md; decision D30): the unit-triangle test of every entering ray of the packet,
+// one ray per cycle (P cycles), and the closest-hit update; a shadow ray is done at its first hit
+// (any-hit). Then back to the list (path f). Timing: units/intersection.cpp (depth: div, mul, add,
+// add, the hit tests); exact-cycle test: units/unit_timing_test.cpp (UnitTimingIntersection.*).
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// The list unit's semantics (paper section 3.1; Figure 2 paths c and d; DESIGN.md section 5;
+// The list unit's semantics (paper section 3.1; Figure 2 paths c and d; docs/cycle-model.md;
 // decision D28): a leaf's list, one entry per request; at the top level an entry is an object
 // instance, at the bottom level a triangle; the mailbox "omits objects already visited by the same
 // ray" (and, with triangle_mailbox > 0, triangles). An entry some ray still needs goes to the

@@ -1,5 +1,5 @@
-// Mailboxed list unit of the DynRTP (paper section 3.1, Figure 2 paths c, d; DESIGN.md section 5;
-// DIGEST D28). Depth: the mailbox compare, fp-cmp latency (1 cycle by default).
+// Mailboxed list unit of the DynRTP (paper section 3.1, Figure 2 paths c, d; docs/cycle-model.md;
+// decision D28). Depth: the mailbox compare, fp-cmp latency (1 cycle by default).
 #include "units/dynrtc_units.h"
 
 namespace saarcor::units {

@@ -1,5 +1,5 @@
 // The mailbox of the mailboxed list unit (paper section 3.1: "omitting objects that have already
-// been visited by the same ray"; DESIGN.md section 5; DIGEST D28): per thread the last `capacity`
+// been visited by the same ray"; docs/cycle-model.md; decision D28): per thread the last `capacity`
 // ids, each with the mask of the packet's rays that have visited it, FIFO replacement, cleared when
 // a new packet starts. Since a bottom-level tree is traversed over the ray's whole interval
 // (D29), skipping a visited object never changes a result; evicting an entry only costs a revisit.

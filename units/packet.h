@@ -1,4 +1,4 @@
-// The packet a DynRTP thread carries through the units (DESIGN.md section 5): per lane the ray in
+// The packet a DynRTP thread carries through the units (docs/cycle-model.md): per lane the ray in
 // world, current and unit-triangle space, the closest hit and the ray's counters; the binary64
 // values the traversal unit works on; what the RGS hands the transformation unit to generate a
 // packet (path a). The state each unit keeps besides is that unit's slice (units/*_step.h), all

@@ -1,4 +1,4 @@
-// One DynRTP thread's state (DESIGN.md section 5): the packet every unit works on (lanes, binary64
+// One DynRTP thread's state (docs/cycle-model.md): the packet every unit works on (lanes, binary64
 // lane values, kind, depth, the phase that names the unit it waits for) and one slice per unit,
 // each the unit's own state with its semantics (units/*_step.h). Besides, what the units share:
 // matrix rows read through the scene view, and the datapath policy D's transformation kernels

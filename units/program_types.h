@@ -1,4 +1,4 @@
-// What a thread program and the models around it share (DESIGN.md section 5; paper section 3.1,
+// What a thread program and the models around it share (docs/cycle-model.md; paper section 3.1,
 // Figure 2): the model's functional parameters, the per-ray work counters, the ray kinds, the
 // DynRTP units a thread asks for and the phases that name them, the request a thread hands a unit,
 // the capture tap for unit transactions, the float units with their counters, and the frame sink
@@ -45,7 +45,7 @@ struct FunctionalParams {
   ff::Mode mode{};         // rounding of every FP unit
 };
 
-// Work counted per ray (DESIGN.md section 5; issue 4).
+// Work counted per ray (docs/cycle-model.md).
 struct RayCounters {
   std::uint64_t traversal_steps = 0;  // kd-node visits in which the ray was active
   std::uint64_t list_entries = 0;     // list entries fetched for the ray
@@ -173,12 +173,13 @@ struct Request {
   std::uint64_t mask = 0;  // the rays concerned
 };
 
-// One memory access of the RGS (DESIGN.md sections 4, 6 and 7; docs/shading.md "Shading
-// traffic"): a read of `words` consecutive shading-bank words, or a one-word write of a finished
-// pixel into a frame-buffer bank. Reads come in dependent waves: the shading record and the light
-// records (0) name the material (1), which names the texels (2); a wave is read once the one
-// before it has arrived. The thread program lists a request's accesses as it executes it
-// (RgsStep::memory()); the cycle model's RGS issues them through the memory controller.
+// One memory access of the RGS (docs/memory-image.md, docs/memif.md and docs/shading.md;
+// docs/shading.md "Shading traffic"): a read of `words` consecutive shading-bank words, or a
+// one-word write of a finished pixel into a frame-buffer bank. Reads come in dependent waves: the
+// shading record and the light records (0) name the material (1), which names the texels (2); a
+// wave is read once the one before it has arrived. The thread program lists a request's accesses as
+// it executes it (RgsStep::memory()); the cycle model's RGS issues them through the memory
+// controller.
 struct RgsAccess {
   std::uint32_t offset = 0;  // word offset within `bank`
   std::uint32_t data = 0;    // the word written (writes only)
@@ -222,7 +223,7 @@ class UnitTap {
 };
 
 // The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is
-// DIGEST D10's optional shading helper (cosines: mul, sqrt, div; the refraction factor mu).
+// decision D10's optional shading helper (cosines: mul, sqrt, div; the refraction factor mu).
 template <class F>
 class PipelineUnits {
  public:

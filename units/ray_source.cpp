@@ -1,7 +1,8 @@
 // The ray generation and shading unit with the RGC's admission (paper section 3.1: the RGC
 // schedules packets to free threads, path a; path g returns the final hits to the RGS, which
 // shades them, spawns secondary rays and writes the finished pixels into the frame buffer;
-// DESIGN.md sections 5, 6 and 7; docs/shading.md "Shading traffic"; DIGEST D24, D25).
+// docs/cycle-model.md, docs/memif.md and docs/shading.md; docs/shading.md "Shading traffic";
+// decisions D24, D25).
 #include <algorithm>
 #include <bit>
 #include <stdexcept>

@@ -1,5 +1,5 @@
 // The ray generation and shading unit's semantics (paper section 3; Figure 2 paths a and g;
-// DESIGN.md section 7; docs/shading.md; decisions D10, D15, D19, D37): the RGC hands a thread a
+// docs/shading.md; docs/shading.md; decisions D10, D15, D19, D37): the RGC hands a thread a
 // primary packet of pixels, the RGS builds R' and T for the transformation unit (path a); when a
 // packet returns (path g) it records primary hits, shades: the world normal through M^T, the
 // material and texture, ambient, per light a packet of shadow-ray directions through the
@@ -465,7 +465,7 @@ class RgsStep {
     }
   }
 
-  // The refraction factor of one hit (DESIGN.md section 7, the sign of D12): N.D and D.D on the
+  // The refraction factor of one hit (docs/shading.md, the sign of D12): N.D and D.D on the
   // transformation unit (one step: rows N and D on D), mu on the RGS FP helper. eta is the
   // material's ratio for the side the ray comes from: the back of a triangle (D'z > 0, the
   // normal was turned to face the ray) is inside the material.

@@ -1,4 +1,4 @@
-// The scene banks as a thread program reads them on the host (DESIGN.md section 4).
+// The scene banks as a thread program reads them on the host (docs/memory-image.md).
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// The fixed-function shader of the RGS (paper sections 3.2 and 4.2; DESIGN.md section 7;
+// The fixed-function shader of the RGS (paper sections 3.2 and 4.2; docs/shading.md;
 // docs/shading.md): integer colour arithmetic, texture addressing and filtering, and the reads of
 // the shading bank. The float steps of shading (normal transform, dot products, cosines) run in
 // units/thread_program.h on the transformation unit and the RGS FP helper; this file is integer

@@ -1,11 +1,11 @@
-// One DynRTP thread as the units see it (paper section 3.1, Figure 2, paths a-g; DESIGN.md section
-// 5; docs/functional-model.md): a packet of P rays whose control flow is an explicit state
-// machine, the "thread program". `request()` says which unit the thread needs next and what for
-// (the request table); `execute()` hands the thread to that unit's semantics (units/*_step.h),
-// which does the unit's work on the packet and moves it to the next phase. The functional model
-// runs a thread to completion; the cycle model queues the thread at the requested unit and calls
-// execute() when the unit serves it. Both run the same code in the same per-thread order, so
-// their results are bit-identical by construction.
+// One DynRTP thread as the units see it (paper section 3.1, Figure 2, paths a-g;
+// docs/cycle-model.md and docs/functional-model.md): a packet of P rays whose control flow is an
+// explicit state machine, the "thread program". `request()` says which unit the thread needs next
+// and what for (the request table); `execute()` hands the thread to that unit's semantics
+// (units/*_step.h), which does the unit's work on the packet and moves it to the next phase. The
+// functional model runs a thread to completion; the cycle model queues the thread at the requested
+// unit and calls execute() when the unit serves it. Both run the same code in the same per-thread
+// order, so their results are bit-identical by construction.
 //
 //   phase                unit            semantics                     path
 //   generate             transformation  TransformationStep::generate  a

@@ -1,6 +1,6 @@
-// Transformation unit of the DynRTP (paper section 3.1, Figure 2 paths a, b, d, e; DESIGN.md
-// section 5; DIGEST D30, D31, D32). Depth: fp mul, then the two adds of (m0 x + m1 y) + (m2 z + t)
-// = 3 + 3 + 3 = 9 cycles by default; n+1 (shared origin) or 2n steps per packet.
+// Transformation unit of the DynRTP (paper section 3.1, Figure 2 paths a, b, d, e;
+// docs/cycle-model.md; decisions D30, D31, D32). Depth: fp mul, then the two adds of (m0 x + m1 y)
+// + (m2 z + t) = 3 + 3 + 3 = 9 cycles by default; n+1 (shared origin) or 2n steps per packet.
 #include "units/dynrtc_units.h"
 
 #include "memif/image_format.h"

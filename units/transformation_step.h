@@ -1,7 +1,7 @@
-// The transformation unit's semantics (paper sections 2.2-2.3; Figure 2 paths a and d; DESIGN.md
-// section 5; decisions D30, D31): ray generation (the RGS's R' through its matrix T into world
-// rays), world to object space with an instance's matrix, object to unit-triangle space with a
-// triangle's T_delta. A ray transformation takes n+1 steps for a packet with one origin, 2n
+// The transformation unit's semantics (paper sections 2.2-2.3; Figure 2 paths a and d;
+// docs/cycle-model.md; decisions D30, D31): ray generation (the RGS's R' through its matrix T into
+// world rays), world to object space with an instance's matrix, object to unit-triangle space with
+// a triangle's T_delta. A ray transformation takes n+1 steps for a packet with one origin, 2n
 // otherwise, whatever the mask (D30: a masked lane fires and its result is discarded). Timing:
 // units/transformation.cpp (depth: fp mul + two adds); exact-cycle test:
 // units/unit_timing_test.cpp (UnitTimingTransformation.*).

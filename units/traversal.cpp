@@ -1,5 +1,5 @@
-// Traversal unit of the DynRTP (paper section 3.1, Figure 2 paths b, c, f, g; DESIGN.md section 5;
-// DIGEST D26, D27, D29, D33). Depth: fp add (split - O) + fp div (/ D) + fp cmp (near/far/
+// Traversal unit of the DynRTP (paper section 3.1, Figure 2 paths b, c, f, g; docs/cycle-model.md;
+// decisions D26, D27, D29, D33). Depth: fp add (split - O) + fp div (/ D) + fp cmp (near/far/
 // termination) = 3 + 8 + 1 = 12 cycles by default.
 #include "units/dynrtc_units.h"
 

@@ -1,4 +1,4 @@
-// The traversal unit's semantics (paper section 3.1; Figure 2 paths b and f; DESIGN.md section 5;
+// The traversal unit's semantics (paper section 3.1; Figure 2 paths b and f; docs/cycle-model.md;
 // decisions D26, D27, D29, D33): the clip of a packet against the scene box or an object's box,
 // the sign groups, one kd-node step per request (early termination at node entry, near and far
 // child, the push of the far child), the stack shared by both levels with its drops at the pop,

@@ -1,4 +1,4 @@
-// The float operators of one DynRTC unit (DESIGN.md section 5; paper Table 2 counts them per unit):
+// The float operators of one DynRTC unit (docs/cycle-model.md; paper Table 2 counts them per unit):
 // the ff::fast paths of ff::FpUnit with inline answers for operands that are exact zeros. The
 // datapaths feed many zeros (the direction step's zero translation, R' = (0,0,0), zero matrix
 // entries) and x + (-x); the fixedfloat fast path sends those to the general routine. The answers

@@ -1,4 +1,4 @@
-// Exact-cycle tests of the DynRTP units in isolation (project issue 16; units/cycle_unit.h,
+// Exact-cycle tests of the DynRTP units in isolation (units/cycle_unit.h,
 // units/dynrtc_units.h; the style of memif/cache_test.cpp): each unit is built alone on a
 // hw::Kernel with mock neighbours (a scripted thread table, a source pushing thread ids on an
 // input path, a sink popping its output paths) and, where it reads scene data, the real per-type

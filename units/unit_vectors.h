@@ -1,4 +1,4 @@
-// Unit transaction vectors (DESIGN.md section 1: an RTL design is checked against the model "unit
+// Unit transaction vectors (README.md: an RTL design is checked against the model "unit
 // by unit (transaction vectors) and frame by frame"): the operands and results of the traversal,
 // transformation and intersection datapaths as a real frame exercises them, captured from the
 // functional fp24 model, and the datapath's answer to any vector's operands, so a vector file an
