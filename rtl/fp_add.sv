@@ -4,6 +4,7 @@
 //   stage 1: classify, order the operands by magnitude, align the smaller (guard, round, sticky)
 //   stage 2: add or subtract the significands, normalise
 //   stage 3: round, pack, special values
+// (normalise, round, pack and the special values are the tail every operator shares: fp_finish)
 // With LAT < 3 the first boundaries become wires; with LAT > 3 the extra registers follow stage 3.
 module fp_add #(
     parameter int E     = 7,
@@ -25,8 +26,6 @@ module fp_add #(
   localparam int R1 = LAT >= 2 ? 1 : 0;
   localparam int R2 = LAT >= 3 ? 1 : 0;
   localparam int ROut = LAT - R1 - R2;
-  localparam logic [E+M-1:0] NanMag = {{E{1'b1}}, 1'b1, {(M - 1) {1'b0}}};
-  localparam logic [E+M-1:0] InfMag = {{E{1'b1}}, {M{1'b0}}};
 
   typedef struct packed {
     logic nan;
@@ -39,19 +38,6 @@ module fp_add #(
     logic [M:0] big;
     logic [M+3:0] little;  // the smaller, aligned: M+1 bits, guard, round, sticky
   } s1_t;
-
-  typedef struct packed {
-    logic nan;
-    logic inf;
-    logic inf_sign;
-    logic zero;
-    logic zero_sign;
-    logic sign;
-    logic [XW-1:0] e;
-    logic [M:0] kept;
-    logic guard;
-    logic sticky;
-  } s2_t;
 
   // ---- stage 1 ----------------------------------------------------------------------------
   logic sa, sb_raw, sb, na, nb, ia, ib;
@@ -97,62 +83,29 @@ module fp_add #(
 
   fp_stage #(.W($bits(s1)), .N(R1)) u_r1 (.clk(clk), .d(s1), .q(s1_q));
 
-  // ---- stage 2 ----------------------------------------------------------------------------
-  s2_t s2, s2_q;
+  // ---- stage 2: add or subtract the significands; then normalise | round, pack, special
+  // values (fp_finish) ---------------------------------------------------------------------
   logic [M+4:0] sum;
-  logic [XW-1:0] n_e;
-  logic [M:0] n_kept;
-  logic n_guard, n_sticky;
-
   always_comb begin
     if (s1_q.eff_sub) sum = {1'b0, s1_q.big, 3'b000} - {1'b0, s1_q.little};
     else sum = {1'b0, s1_q.big, 3'b000} + {1'b0, s1_q.little};
   end
 
   // The sum's top bit (the carry) stands for exponent exp + 1.
-  fp_normalize #(.E(E), .M(M), .SW(M + 5), .XW(XW)) u_norm (
+  fp_finish #(
+      .E(E), .M(M), .SW(M + 5), .XW(XW), .RNE(RNE), .FLUSH(FLUSH), .RMID(R2), .ROUT(ROut)
+  ) u_finish (
+      .clk(clk),
+      .nan(s1_q.nan),
+      .inf(s1_q.inf),
+      .inf_sign(s1_q.inf_sign),
+      .zero(~(|sum)),
+      .zero_sign(s1_q.zero_sign),
+      .sign(s1_q.sign),
       .exp(XW'(s1_q.exp) + XW'(1)),
       .sig(sum),
       .sticky_in(1'b0),
-      .e(n_e),
-      .kept(n_kept),
-      .guard(n_guard),
-      .sticky(n_sticky)
+      .y(y)
   );
-
-  always_comb begin
-    s2.nan = s1_q.nan;
-    s2.inf = s1_q.inf;
-    s2.inf_sign = s1_q.inf_sign;
-    s2.zero = ~(|sum);
-    s2.zero_sign = s1_q.zero_sign;
-    s2.sign = s1_q.sign;
-    s2.e = n_e;
-    s2.kept = n_kept;
-    s2.guard = n_guard;
-    s2.sticky = n_sticky;
-  end
-
-  fp_stage #(.W($bits(s2)), .N(R2)) u_r2 (.clk(clk), .d(s2), .q(s2_q));
-
-  // ---- stage 3 ----------------------------------------------------------------------------
-  logic [E+M:0] rounded, result;
-  fp_round #(.E(E), .M(M), .RNE(RNE), .FLUSH(FLUSH), .XW(XW)) u_round (
-      .sign(s2_q.sign),
-      .e(s2_q.e),
-      .kept(s2_q.kept),
-      .guard(s2_q.guard),
-      .sticky(s2_q.sticky),
-      .y(rounded)
-  );
-
-  always_comb begin
-    if (s2_q.nan) result = {1'b0, NanMag};
-    else if (s2_q.inf) result = {s2_q.inf_sign, InfMag};
-    else if (s2_q.zero) result = {s2_q.zero_sign, {(E + M) {1'b0}}};
-    else result = rounded;
-  end
-
-  fp_stage #(.W(E + M + 1), .N(ROut)) u_rout (.clk(clk), .d(result), .q(y));
   fp_valid #(.N(LAT)) u_valid (.clk(clk), .rst(rst), .d(in_valid), .q(out_valid));
 endmodule

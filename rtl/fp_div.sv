@@ -6,7 +6,7 @@
 //            so the quotient is in (1/2, 2): M+1 bits, the guard bit, one bit for the
 //            normalising shift), spread over LAT-2 register stages; the remainder is the sticky bit
 //   last:    normalise (at most one left shift, or right into the subnormal range), round, pack,
-//            special values
+//            special values (the tail every operator shares: fp_finish)
 // With LAT = 8 (fp24) the 19 steps run 3 or 4 per stage. LAT < 3 merges stages; LAT-2 beyond the
 // step count adds registers after the last stage.
 module fp_div #(
@@ -30,8 +30,6 @@ module fp_div #(
   localparam int R1 = LAT >= 2 ? 1 : 0;
   localparam int NSteps = LAT - 2 < 0 ? 0 : (LAT - 2 > N ? N : LAT - 2);
   localparam int ROut = LAT - R1 - NSteps;
-  localparam logic [E+M-1:0] NanMag = {{E{1'b1}}, 1'b1, {(M - 1) {1'b0}}};
-  localparam logic [E+M-1:0] InfMag = {{E{1'b1}}, {M{1'b0}}};
   localparam int CW = $clog2(M + 2);
 
   typedef struct packed {
@@ -120,41 +118,25 @@ module fp_div #(
     fp_stage #(.W(SW), .N(Regs)) u_reg (.clk(clk), .d(nxt), .q(chain[(i+1)*SW+:SW]));
   end
 
-  // ---- last stage -------------------------------------------------------------------------
+  // ---- last stage: normalise, round, pack, special values (fp_finish) -------------------
   /* verilator lint_off UNUSEDSIGNAL */
   st_t l;  // the divisor is not needed any more
   /* verilator lint_on UNUSEDSIGNAL */
   assign l = chain[N*SW+:SW];
-  logic [XW-1:0] n_e;
-  logic [M:0] n_kept;
-  logic n_guard, n_sticky;
-  fp_normalize #(.E(E), .M(M), .SW(N), .XW(XW)) u_norm (
+  fp_finish #(
+      .E(E), .M(M), .SW(N), .XW(XW), .RNE(RNE), .FLUSH(FLUSH), .RMID(0), .ROUT(ROut)
+  ) u_finish (
+      .clk(clk),
+      .nan(l.nan),
+      .inf(l.inf),
+      .inf_sign(l.sign),
+      .zero(l.zero),
+      .zero_sign(l.sign),
+      .sign(l.sign),
       .exp(l.exp),
       .sig(l.q),
       .sticky_in(|l.rem),
-      .e(n_e),
-      .kept(n_kept),
-      .guard(n_guard),
-      .sticky(n_sticky)
+      .y(y)
   );
-
-  logic [E+M:0] rounded, result;
-  fp_round #(.E(E), .M(M), .RNE(RNE), .FLUSH(FLUSH), .XW(XW)) u_round (
-      .sign(l.sign),
-      .e(n_e),
-      .kept(n_kept),
-      .guard(n_guard),
-      .sticky(n_sticky),
-      .y(rounded)
-  );
-
-  always_comb begin
-    if (l.nan) result = {1'b0, NanMag};
-    else if (l.inf) result = {l.sign, InfMag};
-    else if (l.zero) result = {l.sign, {(E + M) {1'b0}}};
-    else result = rounded;
-  end
-
-  fp_stage #(.W(E + M + 1), .N(ROut)) u_rout (.clk(clk), .d(result), .q(y));
   fp_valid #(.N(LAT)) u_valid (.clk(clk), .rst(rst), .d(in_valid), .q(out_valid));
 endmodule

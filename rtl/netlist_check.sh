@@ -12,8 +12,8 @@ build="$(cd "${1:-$root/build-rtl}" && pwd)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 files=()
-for f in fp_pkg fp_stage fp_valid fp_lzc fp_class fp_normalize fp_round fp_add fp_mul fp_div \
-         fp_cmp_core fp_cmp fp_minmax fp_ops_top; do
+for f in fp_pkg fp_stage fp_valid fp_lzc fp_class fp_normalize fp_round fp_finish fp_add fp_mul \
+         fp_div fp_cmp_core fp_cmp fp_minmax fp_ops_top; do
   files+=("$here/$f.sv")
 done
 synth() {  # name, chparam settings

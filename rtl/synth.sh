@@ -10,7 +10,7 @@
 # Default tops: every operator and unit (generic: about 4 minutes; xc2v: longer).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-fp=(fp_pkg fp_stage fp_valid fp_lzc fp_class fp_normalize fp_round fp_add fp_mul fp_div
+fp=(fp_pkg fp_stage fp_valid fp_lzc fp_class fp_normalize fp_round fp_finish fp_add fp_mul fp_div
     fp_cmp_core fp_cmp fp_minmax)
 tops=("$@")
 if [ ${#tops[@]} -eq 0 ]; then

@@ -1,11 +1,13 @@
-// The independent bit-exact check of the functional model's fast paths: every datapath step of a
-// frame on encodings in the paper's op order (FunctionalParams::reference_datapath, units/
-// datapath.h) against the default frame, whose traversal, clip and transformation steps run on
-// the binary64 fast paths where those decide. The two are computed independently (encodings
-// through fixedfloat's round-and-pack; binary64 values rounded once), so a fast path that rounds
-// differently on any step of any of these scenes fails here: step by step (every traversal lane,
-// transformation and intersection a tap sees, in order) and frame by frame (hit records, image,
-// counters, op counts). Scenes with shadow, reflection and transparency rays included.
+// The independent bit-exact check of the functional model's fast paths: the reference
+// instantiation of the thread program (units/reference_model.h: ReferenceDatapath, every datapath
+// step on encodings in the paper's op order, built in a target that cannot see units/fast_paths.h)
+// against the fast one (run_functional: FastDatapath, whose traversal, clip, transformation and
+// RGS dot and cosine steps run on binary64 values where those decide). The two are computed
+// independently (encodings through fixedfloat's round-and-pack; binary64 values rounded once),
+// so a fast path that rounds differently on any step of any of these scenes fails here: step by
+// step (every traversal lane, transformation and intersection a tap sees, in order) and frame by
+// frame (hit records, image, counters, op counts). Scenes with shadow, reflection and
+// transparency rays included.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -14,6 +16,7 @@
 
 #include "testbench/render_cmd.h"
 #include "units/functional_model.h"
+#include "units/reference_model.h"
 
 namespace saarcor {
 namespace {
@@ -80,12 +83,11 @@ TEST_P(ReferenceDatapath, FastPathsEqualTheReferenceStepByStep) {
 #endif
   const RenderSettings s = frame_settings(res, 0.0, c.shadows, c.depth, 32.0);
   const PreparedScene prep = prepare_scene(spec, s);
-  units::FunctionalParams fast = functional_params(s);
-  units::FunctionalParams ref = fast;
-  ref.reference_datapath = true;
+  const units::FunctionalParams params = functional_params(s);
   RecordingTap fast_tap, ref_tap;
-  const units::FunctionalFrame a = units::run_functional<F>(prep.built.image, fast, {}, &fast_tap);
-  const units::FunctionalFrame b = units::run_functional<F>(prep.built.image, ref, {}, &ref_tap);
+  const units::FunctionalFrame a =
+      units::run_functional<F>(prep.built.image, params, {}, &fast_tap);
+  const units::FunctionalFrame b = units::run_reference(prep.built.image, params, &ref_tap);
   // Step by step: the first differing transaction names itself.
   ASSERT_EQ(fast_tap.steps.size(), ref_tap.steps.size()) << spec;
   EXPECT_GT(fast_tap.steps.size(), 1000u) << spec;

@@ -2,7 +2,8 @@
 // or two lanes at a time (SSE2 vectors): the host-speed paths of the thread program. Each accepts a
 // result only where it equals the encoding path's bit for bit and otherwise tells the caller to
 // redo the lane on encodings (units/datapath.h, the paper's op order), so the model's results
-// never depend on them; FunctionalParams::reference_datapath turns them off for a whole frame and
+// never depend on them. Only the fast datapath policy (units/fast_datapath.h) calls them; the
+// reference instantiation (units/reference_model.cpp) is built without them, and
 // testbench/reference_datapath_test.cpp compares both frames step by step.
 #pragma once
 
@@ -10,6 +11,7 @@
 #include <cstring>
 
 #include "units/datapath.h"
+#include "units/lane_values.h"
 
 namespace saarcor::units {
 
@@ -51,17 +53,6 @@ inline double traversal_reciprocal(const Fp& fp, F d) {
   if (e == 0 || e == kExpMax || fp.mode().rounding != ff::Rounding::kNearestEven)
     return std::numeric_limits<double>::quiet_NaN();
   return 1.0 / fp.to_double(d);
-}
-
-// The value of an encoding: exact, a subnormal read as +-0 in flush mode (as every op reads it).
-template <class F>
-[[gnu::always_inline]] inline double value_of(F x, ff::Subnormals s) {
-  constexpr std::uint32_t kExpMax = F::kFormat.exp_field_max();
-  const std::uint32_t e = (x.bits >> F::kManBits) & kExpMax;
-  if (e - 1u < kExpMax - 1u) [[likely]]
-    return ff::fast::decode_normal<F::kExpBits, F::kManBits>(x.bits);
-  if ((x.bits & (F::kFormat.sign_mask() - 1u)) == 0) return x.sign() ? -0.0 : 0.0;
-  return ff::decode(x.bits, F::kFormat, s);
 }
 
 // x is +-0 or normal (what decode_pair takes).
@@ -182,10 +173,6 @@ template <class F>
 // on x86-64). Every lane's op sequence is unchanged, so each lane's results are those of the
 // scalar functions above; the rounding to F's precision is the same integer arithmetic on the
 // binary64 bit patterns, lane by lane.
-using V2d = double __attribute__((vector_size(16)));
-using V2u = std::uint64_t __attribute__((vector_size(16)));
-using V2i = std::int64_t __attribute__((vector_size(16)));
-
 // round_in_range on both lanes.
 template <class F>
 [[gnu::always_inline]] inline V2d round_in_range2(V2d v) {
@@ -358,21 +345,6 @@ template <class F>
   const auto mag = std::bit_cast<V2d>(std::bit_cast<V2u>(r) & ~(std::uint64_t{1} << 63));
   ok &= ((mag >= kMin) & (mag < kLimit)) | (r == 0.0);
   return r;
-}
-
-// Lane-wise select: c ? a : b for a compare result c (all ones or zero per lane).
-[[gnu::always_inline]] inline V2d select2(V2i c, V2d a, V2d b) {
-  const auto m = std::bit_cast<V2u>(c);
-  return std::bit_cast<V2d>((m & std::bit_cast<V2u>(a)) | (~m & std::bit_cast<V2u>(b)));
-}
-
-// The lanes of a compare result as bits 0 and 1.
-[[gnu::always_inline]] inline std::uint64_t mask2(V2i c) {
-#if defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
-  return static_cast<std::uint64_t>(__builtin_ia32_movmskpd(std::bit_cast<V2d>(c)));
-#else
-  return static_cast<std::uint64_t>((c[0] & 1) | (c[1] & 2));
-#endif
 }
 
 // traversal_lane64 on two lanes. go_near, go_far and fail as bits 0 and 1; a failed lane (not

@@ -1,5 +1,6 @@
-// The functional fp24 model's frame loop (docs/compare.md, model 2; paper section 3.1: the RGC
-// schedules screen-space packets): one thread program, one packet after another, to completion.
+// The functional fp24 model (docs/compare.md, model 2) on the fast datapath: the frame loop
+// (units/frame_loop.h) instantiated with FastDatapath for every built-in format, the RGC's packet
+// tiling (paper section 3.1: screen-space packets), and the replay of one pixel's packet.
 #include "units/functional_model.h"
 
 #include <algorithm>
@@ -9,7 +10,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "units/request_trace.h"
+#include "units/fast_datapath.h"
+#include "units/frame_loop.h"
 
 namespace saarcor::units {
 
@@ -31,24 +33,6 @@ PacketTiling packet_tiling(int width, int height, int packet) {
   return t;
 }
 
-namespace {
-
-void fill_packet_pixels(const PacketTiling& t, int width, int height, int index,
-                        std::vector<std::uint32_t>& px) {
-  px.assign(static_cast<std::size_t>(t.tile_width * t.tile_height), memif::kNone);
-  const int x0 = (index % t.tiles_x) * t.tile_width;
-  const int y0 = (index / t.tiles_x) * t.tile_height;
-  for (int j = 0; j < t.tile_height; ++j)
-    for (int i = 0; i < t.tile_width; ++i) {
-      const int x = x0 + i, y = y0 + j;
-      if (x < width && y < height)
-        px[static_cast<std::size_t>(j * t.tile_width + i)] =
-            static_cast<std::uint32_t>(y * width + x);
-    }
-}
-
-}  // namespace
-
 std::vector<std::uint32_t> packet_pixels(const PacketTiling& t, int width, int height, int index) {
   std::vector<std::uint32_t> px;
   fill_packet_pixels(t, width, height, index, px);
@@ -56,14 +40,6 @@ std::vector<std::uint32_t> packet_pixels(const PacketTiling& t, int width, int h
 }
 
 namespace {
-
-void check_image(const memif::MemoryImage& image) {
-  const auto& r = image.registers();
-  if (r.width < 1 || r.height < 1 || r.width > 16384 || r.height > 16384)
-    throw std::runtime_error("functional model: frame registers give a resolution of " +
-                             std::to_string(r.width) + "x" + std::to_string(r.height) +
-                             " (1..16384 per side)");
-}
 
 // Calls fn(Float<E,M>{}) for the image's format.
 template <class Fn>
@@ -107,73 +83,12 @@ decltype(auto) with_format(const ff::Format& f, Fn&& fn) {
                            " is not built in (e7m10..e7m23, e8m23)");
 }
 
-// ThreadProgram::run() with a request-trace line per request (the same requests in the same
-// order). Returns the number of requests served.
-template <class F>
-std::uint64_t run_traced(ThreadProgram<F>& thread, PipelineUnits<F>& units, TraceTap<F>& tap,
-                         int packet, std::ostream& out) {
-  TraceLine line;
-  line.packet = packet;
-  units.tap = &tap;
-  std::uint32_t n = 0;
-  while (!thread.done()) {
-    const Request r = thread.request();
-    line.seq = n++;
-    line.unit = r.unit;
-    line.phase = r.phase;
-    line.item = r.item;
-    line.steps = r.steps;
-    line.mask = r.mask;
-    line.kind = thread.kind();
-    tap.begin();
-    thread.execute();
-    line.txn = tap.take();
-    out << format_trace_line(line) << '\n';
-  }
-  units.tap = nullptr;
-  return n;
-}
-
 }  // namespace
 
 template <class F>
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
                                const ProgressFn& progress, UnitTap<F>* tap, std::ostream* trace) {
-  if (tap != nullptr && trace != nullptr)
-    throw std::logic_error("functional model: a tap and a trace at once");
-  const auto t0 = std::chrono::steady_clock::now();
-  check_image(image);
-  const int w = static_cast<int>(image.registers().width);
-  const int h = static_cast<int>(image.registers().height);
-  const PacketTiling tiling = packet_tiling(w, h, params.packet);
-  PipelineUnits<F> units(params.mode);
-  units.tap = tap;
-  FrameSink sink;
-  sink.reset(w, h);
-  ThreadProgram<F> thread(image, params, units, sink);
-  FunctionalFrame frame;
-  frame.format = F::kFormat;
-  frame.width = w;
-  frame.height = h;
-  frame.params = params;
-  const int total = tiling.count();
-  std::vector<std::uint32_t> pixels;  // reused: no allocation per packet
-  TraceTap<F> trace_tap;
-  if (trace != nullptr) *trace << kTraceHeader << '\n';
-  for (int p = 0; p < total; ++p) {
-    fill_packet_pixels(tiling, w, h, p, pixels);
-    thread.start_primary(pixels);
-    frame.units.requests +=
-        trace != nullptr ? run_traced(thread, units, trace_tap, p, *trace) : thread.run();
-    if (progress && ((p + 1) % 1024 == 0 || p + 1 == total)) progress(p + 1, total);
-  }
-  frame.units.packets = static_cast<std::uint64_t>(total);
-  const std::uint64_t requests = frame.units.requests;
-  collect_frame(frame, units, sink);
-  frame.units.requests = requests;
-  frame.units.packets = static_cast<std::uint64_t>(total);
-  frame.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return frame;
+  return run_frame<F, FastDatapath>(image, params, progress, tap, trace);
 }
 
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
@@ -198,7 +113,7 @@ PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& 
     PipelineUnits<F> units(params.mode);
     FrameSink sink;
     sink.reset(w, h);
-    ThreadProgram<F> thread(image, params, units, sink);
+    ThreadProgram<F, kMaxPacket, FastDatapath> thread(image, params, units, sink);
     thread.start_primary(packet_pixels(tiling, w, h, index));
     PixelTrace trace;
     while (!thread.done()) {

@@ -11,10 +11,10 @@
 
 namespace saarcor::units {
 
-template <class F, int kLanes>
+template <class F, int kLanes, class D>
 class IntersectionStep {
  public:
-  using State = PacketState<F, kLanes>;
+  using State = PacketState<F, kLanes, D>;
 
   void step(State& t) {
     ++t.u.intersection_packets;

@@ -14,10 +14,10 @@
 
 namespace saarcor::units {
 
-template <class F, int kLanes>
+template <class F, int kLanes, class D>
 class ListStep {
  public:
-  using State = PacketState<F, kLanes>;
+  using State = PacketState<F, kLanes, D>;
 
   explicit ListStep(const FunctionalParams& params)
       : mailbox_(params.mailbox), tri_mailbox_(params.triangle_mailbox) {}

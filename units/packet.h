@@ -12,7 +12,7 @@
 
 #include "memif/image_format.h"
 #include "units/datapath.h"
-#include "units/fast_paths.h"
+#include "units/lane_values.h"
 #include "units/program_types.h"
 
 namespace saarcor::units {
@@ -52,11 +52,13 @@ struct Lane {
   RayCounters counters;
 };
 
-// The traversal unit works on binary64 values (fast_paths.h, traversal_lane64): O and 1/D per axis
-// of the world and of the current (object) ray, and the segments. Every one is the exact value of
-// an encoding of F, so the encodings are recovered exactly where the encoding path is needed. Kept
-// per packet as arrays over the lanes, so two lanes go through one vector op (traversal_pair64);
-// slots from P up to the next even count are padding, computed along and never used. A lane's tn,
+// The traversal unit keeps the segments as binary64 values: every one is the exact value of an
+// encoding of F (lane_values.h), so the encodings are recovered exactly where a step reads them,
+// and a compare of two values is the compare of their encodings. The fast datapath also keeps
+// O and 1/D per axis of the world and of the current (object) ray (FastDatapath::axis_values, for
+// traversal_pair64); the reference datapath reads the rays' encodings instead. Kept per packet as
+// arrays over the lanes, so two lanes go through one vector op; slots from P up to the next even
+// count are padding, computed along and never used. A lane's tn,
 // tf are meaningful only while it is in the packet's mask: it enters the mask only where they are
 // set (start of a sign group, pop, the near child), so whole-array copies may overwrite the others.
 template <int kLanes>
@@ -81,7 +83,16 @@ inline void store2(double* p, V2d v) {
   std::memcpy(p, &v, sizeof v);
 }
 
-template <class F, int kLanes>
+// The lanes' decisions at an inner kd-node (a datapath's decide): which go near, which go far, and
+// their new segments.
+template <int kLanes>
+struct TraversalDecision {
+  std::uint64_t near_mask = 0, far_mask = 0;
+  alignas(16) Slots<kLanes> near_tf, far_tn;  // slots 0..P-1 (rounded up to even) set
+};
+
+// D: the datapath policy (units/fast_datapath.h or units/reference_datapath.h).
+template <class F, int kLanes, class D>
 struct PacketState;
 
 }  // namespace saarcor::units

@@ -1,12 +1,13 @@
 // One DynRTP thread's state (docs/cycle-model.md): the packet every unit works on (lanes, binary64
 // lane values, kind, depth, the phase that names the unit it waits for) and one slice per unit,
-// each the unit's own state with its semantics (units/*_step.h). Besides, the fast-path helpers
-// the units share: matrix rows read through the scene view, transformation steps on binary64 values
-// two lanes at a time where units/fast_paths.h decides, on encodings (units/datapath.h) otherwise.
+// each the unit's own state with its semantics (units/*_step.h). Besides, what the units share:
+// matrix rows read through the scene view, and the datapath policy D's transformation kernels
+// (units/fast_datapath.h: on binary64 values where they decide; units/reference_datapath.h: on
+// encodings only). This header names no policy: each model's translation unit includes the one it
+// instantiates.
 #pragma once
 
 #include <cstdint>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -22,10 +23,13 @@
 
 namespace saarcor::units {
 
-template <class F, int kLanes>
+template <class F, int kLanes, class D>
 struct PacketState {
   static_assert(kLanes >= 2 && kLanes <= kMaxPacket && (kLanes & (kLanes - 1)) == 0);
-  using Mat64 = MatrixValues<F>;
+  using Float = F;
+  using Datapath = D;
+  static constexpr int kLaneCapacity = kLanes;
+  using Mat64 = typename D::template Matrix<F>;  // what a transformation step reads of a matrix
 
   PacketState(const memif::MemoryImage& image_, const FunctionalParams& params_,
               PipelineUnits<F>& units, FrameSink& sink_)
@@ -35,8 +39,8 @@ struct PacketState {
         sink(sink_),
         p(params_.packet),
         slots(p + (p & 1)),
-        // The binary64 paths decide only for nearest-even; reference_datapath turns them all off.
-        nearest(!params_.reference_datapath && params_.mode.rounding == ff::Rounding::kNearestEven),
+        // The fast datapath's binary64 paths decide only for nearest-even.
+        nearest(params_.mode.rounding == ff::Rounding::kNearestEven),
         lanes(static_cast<std::size_t>(p)),
         transformation(image_, *this),
         traversal(image_, params_, slots),
@@ -67,11 +71,11 @@ struct PacketState {
   std::array<std::uint64_t, kLanes> traversal_steps{};
 
   // ---- the units' slices ----------------------------------------------------------------------
-  TransformationStep<F, kLanes> transformation;
-  TraversalStep<F, kLanes> traversal;
-  ListStep<F, kLanes> list;
-  IntersectionStep<F, kLanes> intersection;
-  RgsStep<F, kLanes> rgs;
+  TransformationStep<F, kLanes, D> transformation;
+  TraversalStep<F, kLanes, D> traversal;
+  ListStep<F, kLanes, D> list;
+  IntersectionStep<F, kLanes, D> intersection;
+  RgsStep<F, kLanes, D> rgs;
 
   // ---- lanes ----------------------------------------------------------------------------------
   Lane<F>& lane(int i) { return lanes[static_cast<std::size_t>(i)]; }
@@ -98,28 +102,10 @@ struct PacketState {
   double value(F x) const { return value_of(x, u.raw.mode().subnormals); }
   F encoding(double x) const { return u.raw.from_double(x); }  // exact: x is a value of F
 
-  // O and 1/D (traversal_reciprocal) of every lane's ray `ray`, the reciprocals two lanes per
-  // division (the same binary64 quotients). Lanes outside the level's mask get values nothing
-  // reads.
+  // What the datapath keeps of every lane's ray `ray` for the traversal unit (D::axis_values).
   void set_axis_values(std::array<Slots<kLanes>, 3>& o, std::array<Slots<kLanes>, 3>& inv,
                        Ray<F> Lane<F>::*ray) {
-    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-    for (int i = 0; i < p; i += 2) {
-      const Ray<F>& a = lane(i).*ray;
-      const Ray<F>& b = lane(i + 1 < p ? i + 1 : i).*ray;
-      const auto s = static_cast<std::size_t>(i);
-      for (std::size_t k = 0; k < 3; ++k) {
-        const int c = static_cast<int>(k);
-        o[k][s] = value(a.o[c]);
-        o[k][s + 1] = value(b.o[c]);
-        // Decoded as if normal; lanes whose D is not normal (or truncation) get NaN.
-        const V2d r = 1.0 / decode_pair<F>(a.d[c].bits, b.d[c].bits);
-        inv[k][s] =
-            nearest && ff::fast::is_normal<F::kExpBits, F::kManBits>(a.d[c].bits) ? r[0] : kNaN;
-        inv[k][s + 1] =
-            nearest && ff::fast::is_normal<F::kExpBits, F::kManBits>(b.d[c].bits) ? r[1] : kNaN;
-      }
-    }
+    D::axis_values(*this, o, inv, ray);
   }
 
   // ---- matrices -------------------------------------------------------------------------------
@@ -139,67 +125,16 @@ struct PacketState {
   Mat34<F> matrix(std::uint32_t first_row) const {
     return {row(first_row), row(first_row + 1), row(first_row + 2)};
   }
-  // A transformation step (transform_step) through the binary64 path where it decides.
-  Mat64 matrix_values(const Mat34<F>& m) const {
-    bool normal = true;  // every entry zero or normal: decoded two at a time (the same values)
-    for (const auto& r : m)
-      for (const F x : r)
-        normal &= normal_or_zero(x);
-    if (!normal) {
-      Mat64 mv = units::matrix_values(m, u.raw.mode().subnormals);
-      mv.nearest = nearest;
-      return mv;
-    }
-    Mat64 mv;
-    for (std::size_t r = 0; r < 3; ++r) {
-      const auto& rw = m[static_cast<int>(r)];
-      for (int c = 0; c < 4; c += 2) {
-        const V2d x = decode_pair<F>(rw[c].bits, rw[c + 1].bits);
-        mv.m[r][static_cast<std::size_t>(c)] = x[0];
-        mv.m[r][static_cast<std::size_t>(c + 1)] = x[1];
-      }
-      mv.linear.include(rw[0]);
-      mv.linear.include(rw[1]);
-      mv.linear.include(rw[2]);
-      mv.translation.include(rw[3]);
-    }
-    mv.nearest = nearest;
-    return mv;
-  }
-  // One vector: the two-lane path with both lanes the same (fewer moves than the scalar path).
+  // Transformation steps (transform_step) through the datapath's kernels: a matrix as the
+  // datapath reads it, one vector, and out(i) = m * in(i) for the lanes in `mask`.
+  Mat64 matrix_values(const Mat34<F>& m) const { return D::matrix(*this, m); }
   Vec3<F> transform(const Mat34<F>& m, const Mat64& mv, const Vec3<F>& x, bool translate) const {
-    if (!transform_decides<F>(mv, x, translate)) return transform_step(u.raw, m, x, translate);
-    const V2d d[3] = {decode_pair<F>(x[0].bits, x[0].bits), decode_pair<F>(x[1].bits, x[1].bits),
-                      decode_pair<F>(x[2].bits, x[2].bits)};
-    V2u r[3];
-    transform_pair64<F>(mv, d, translate, r);
-    return lane_of<F>(r, 0);
+    return D::transform(*this, m, mv, x, translate);
   }
-  // out(i) = m * in(i) (a transformation step) for the lanes in `mask`: two lanes at a time on
-  // values where transform_decides holds for both or one of them, the others on encodings.
   template <class In, class Out>
   void transform_masked(const Mat34<F>& m, const Mat64& mv, std::uint64_t mask, bool translate,
                         In in, Out out) {
-    for (int i = 0; i < p; i += 2) {
-      const int j = i + 1 < p ? i + 1 : i;
-      const bool a = lane_in(mask, i), b = j != i && lane_in(mask, j);
-      if (!(a | b)) continue;
-      const Vec3<F>& va = in(i);
-      const Vec3<F>& vb = in(j);
-      const bool da = a && transform_decides<F>(mv, va, translate);
-      const bool db = b && transform_decides<F>(mv, vb, translate);
-      if (da | db) {
-        const V2d x[3] = {decode_pair<F>(va[0].bits, vb[0].bits),
-                          decode_pair<F>(va[1].bits, vb[1].bits),
-                          decode_pair<F>(va[2].bits, vb[2].bits)};
-        V2u r[3];
-        transform_pair64<F>(mv, x, translate, r);
-        if (da) out(i) = lane_of<F>(r, 0);
-        if (db) out(j) = lane_of<F>(r, 1);
-      }
-      if (a && !da) out(i) = transform_step(u.raw, m, in(i), translate);
-      if (b && !db) out(j) = transform_step(u.raw, m, in(j), translate);
-    }
+    D::transform_masked(*this, m, mv, mask, translate, in, out);
   }
 
  private:

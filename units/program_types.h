@@ -38,10 +38,6 @@ struct FunctionalParams {
   // Box faces a clip step divides for: 1 = one divider per ray (Table 2's 4 dividers for a 4-ray
   // packet); k > 1 models a traversal unit with k dividers per ray (1..6).
   int clip_faces_per_step = 1;
-  // Every datapath step on encodings in the paper's op order (units/datapath.h), none on the
-  // binary64 fast paths: slower, the same results. The fast paths' independent check
-  // (testbench/reference_datapath_test.cpp compares both frames step by step).
-  bool reference_datapath = false;
   bool shade = true;       // run the RGS; false leaves the image black (hit records only)
   bool shadows = false;    // shadow rays (docs/shading.md 6.4); Table 3 setting: off
   bool secondary = false;  // reflection, transparency and refraction rays; Table 3 setting: off

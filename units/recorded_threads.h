@@ -19,6 +19,7 @@
 
 #include "units/cycle_unit.h"
 #include "units/dynrtp.h"
+#include "units/fast_datapath.h"
 #include "units/functional_model.h"
 #include "units/request_trace.h"
 #include "units/run_trace.h"
@@ -62,8 +63,8 @@ class RecordedThreads final : public ThreadTable {
     }
     if (!recorded_) {
       for (int i = 0; i < threads; ++i) {
-        programs_.push_back(
-            std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
+        programs_.push_back(std::make_unique<ThreadProgram<F, kLanes, FastDatapath>>(
+            image, params_, units_, sink_));
         requests_[static_cast<std::size_t>(i)] = programs_.back()->request();
       }
       return;
@@ -74,7 +75,8 @@ class RecordedThreads final : public ThreadTable {
       free_.push_back(i);
     cursor_.resize(static_cast<std::size_t>(threads));
     rgs_mem_.resize(static_cast<std::size_t>(threads));
-    programs_.push_back(std::make_unique<ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
+    programs_.push_back(
+        std::make_unique<ThreadProgram<F, kLanes, FastDatapath>>(image, params_, units_, sink_));
     for (int i = 0; i < threads; ++i)
       requests_[static_cast<std::size_t>(i)] = programs_.back()->request();
     if (mode_ == ProgramMode::kAhead) worker_ = std::thread([this] { run_ahead(); });
@@ -100,7 +102,7 @@ class RecordedThreads final : public ThreadTable {
     }
     if (tracing_) [[unlikely]]
       return execute_traced(t);
-    ThreadProgram<F, kLanes>& p = *programs_[t];
+    ThreadProgram<F, kLanes, FastDatapath>& p = *programs_[t];
     p.execute();
     // Returned straight into the table (guaranteed elision): a copy of the returned temporary
     // would reload a struct the callee has just written field by field (a store-forward stall).
@@ -183,14 +185,15 @@ class RecordedThreads final : public ThreadTable {
     std::vector<std::uint32_t> mem_end;
   };
   // After program `p` executed request `r`: an RGS request's accesses into the slot.
-  static void note_memory(Slot& s, const ThreadProgram<F, kLanes>& p, const Request& r) {
+  static void note_memory(Slot& s, const ThreadProgram<F, kLanes, FastDatapath>& p,
+                          const Request& r) {
     if (r.unit != UnitId::kRgs) return;
     const std::vector<RgsAccess>& m = p.rgs_memory();
     s.mem.insert(s.mem.end(), m.begin(), m.end());
     s.mem_end.push_back(static_cast<std::uint32_t>(s.mem.size()));
   }
   // Runs packet `packet` on program `p` and records its request sequence into `s`.
-  void record(Slot& s, ThreadProgram<F, kLanes>& p, int packet) {
+  void record(Slot& s, ThreadProgram<F, kLanes, FastDatapath>& p, int packet) {
     s.packet = packet;
     s.trace.clear();
     s.masks.clear();
@@ -219,7 +222,7 @@ class RecordedThreads final : public ThreadTable {
   // ---- a traced run (units/run_trace.h) ----------------------------------------------------
   // record() with each request's kind and, for the request trace, its transactions (the tap is
   // set only around this packet's steps, so an untraced run never sees it).
-  void record_traced(Slot& s, ThreadProgram<F, kLanes>& p) {
+  void record_traced(Slot& s, ThreadProgram<F, kLanes, FastDatapath>& p) {
     s.kinds.clear();
     s.txns.clear();
     const bool capture = capture_ && (trace_packet_ < 0 || trace_packet_ == s.packet);
@@ -251,7 +254,7 @@ class RecordedThreads final : public ThreadTable {
   }
   // execute() of a program per thread, with the trace's view of the request.
   void execute_traced(std::uint32_t t) {
-    ThreadProgram<F, kLanes>& p = *programs_[t];
+    ThreadProgram<F, kLanes, FastDatapath>& p = *programs_[t];
     TracedStep& n = traced_[t];
     PerStep& ps = per_step_[t];
     n.packet = ps.packet;
@@ -289,7 +292,7 @@ class RecordedThreads final : public ThreadTable {
   // while max_ahead_ packets are finished and the simulation only while none is: never both.
   void run_ahead() {
     try {
-      ThreadProgram<F, kLanes>& p = *programs_[0];
+      ThreadProgram<F, kLanes, FastDatapath>& p = *programs_[0];
       const int total = tiling_.count();
       for (int k = 0; k < total; ++k) {
         std::size_t id;
@@ -374,7 +377,7 @@ class RecordedThreads final : public ThreadTable {
   ProgramMode mode_;
   bool recorded_;  // kPacketFirst or kAhead: the simulated threads replay recorded packets
   std::size_t max_ahead_ = 0;
-  std::vector<std::unique_ptr<ThreadProgram<F, kLanes>>> programs_;
+  std::vector<std::unique_ptr<ThreadProgram<F, kLanes, FastDatapath>>> programs_;
   std::vector<Slot> slots_;
   std::vector<Cursor> cursor_;
   std::vector<std::vector<RgsAccess>> rgs_mem_;  // recorded: each thread's last RGS accesses

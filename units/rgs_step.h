@@ -21,11 +21,12 @@
 
 namespace saarcor::units {
 
-template <class F, int kLanes>
+template <class F, int kLanes, class D>
 class RgsStep {
  public:
-  using State = PacketState<F, kLanes>;
-  using Mat64 = MatrixValues<F>;
+  using State = PacketState<F, kLanes, D>;
+  using Mat64 = typename State::Mat64;
+  using Operand = typename D::Operand;  // a vector as the dot products read it
 
   RgsStep(const memif::MemoryImage& image, const FunctionalParams& params, int packet) {
     const auto& regs = image.registers();
@@ -101,8 +102,8 @@ class RgsStep {
       s.lit = false;
       s.highlight = false;
       if (!s.hit) continue;
-      const Vec3<F>& sd = t.lane(i).world.d;     // hit point - L
-      const DotOperand ds = dot_operand<F>(sd);  // decoded once for the light's two or three dots
+      const Vec3<F>& sd = t.lane(i).world.d;  // hit point - L
+      const Operand ds = D::operand(sd);      // decoded once for the light's two or three dots
       const F ns = shade_dot(t, s.n, s.n_op, sd, ds);
       const F ss = shade_dot(t, sd, ds, sd, ds);
       s.lit = is_neg_nonzero(ns);
@@ -153,7 +154,7 @@ class RgsStep {
     F nn{}, kk{}, rr{};
     Vec3<F> r{};  // reflected view direction (specular)
     // n and r as the dot products read them, decoded once per hit for every light's dots.
-    DotOperand n_op{}, r_op{};
+    Operand n_op{}, r_op{};
     bool spec = false;
     memif::MaterialRecord mat;
     Rgb8 base{}, spec_rgb{};
@@ -162,107 +163,34 @@ class RgsStep {
     bool lit = false, highlight = false;
   };
 
-  // ---- arithmetic: the value paths of fast_paths.h where they decide, else the ops on encodings;
-  // the ops counted here per use (the same counts as UnitFp's per op).
+  // ---- arithmetic: the datapath policy D's kernels (units/fast_datapath.h,
+  // units/reference_datapath.h); the ops counted here per use (the same counts as UnitFp's per op).
   static void count_transform(State& t, std::uint64_t steps) {
     PipelineUnits<F>::count(t.u.transformation_ops, 9 * steps, 9 * steps, 0, 0);
   }
   // A direction step (ops counted by the caller) as three dot products: each of its rows is
-  // dot_step's expression with the row as the first vector. With a matrix per lane (T_shadow, T_R)
-  // the exponent ranges are cheaper than matrix_values for one step.
+  // dot_step's expression with the row as the first vector.
   static Vec3<F> direction_step(const State& t, const Mat34<F>& m, const Vec3<F>& v) {
     Vec3<F> out;
-    direction_steps(t, m, v, m, v, out, out);
-    return out;
-  }
-  // dot_step64's condition for every row at once: the linear part's exponent range contains each
-  // row's, so where it holds, each row's holds too.
-  static bool direction_decides(const State& t, const Mat34<F>& m, const Vec3<F>& v) {
-    ExponentRange rm, rv;
-    for (int r = 0; r < 3; ++r) {
-      rm.include(m[r][0]);
-      rm.include(m[r][1]);
-      rm.include(m[r][2]);
-    }
-    rv.include(v[0]);
-    rv.include(v[1]);
-    rv.include(v[2]);
-    return dot_step64_decides<F>(rm, rv, t.nearest);
-  }
-  // Two lanes' direction steps (a matrix each): where direction_decides holds, both lanes' rows go
-  // through dot_step64's ops together (one lane per half of a vector register: each lane's ops
-  // and values are its own, so its results are dot_step64's); otherwise the lane row by row. The
-  // two lanes may be the same (one step); out_a and out_b may then be the same vector.
-  static void direction_steps(const State& t, const Mat34<F>& ma, const Vec3<F>& va,
-                              const Mat34<F>& mb, const Vec3<F>& vb, Vec3<F>& out_a,
-                              Vec3<F>& out_b) {
-    const bool da = direction_decides(t, ma, va);
-    const bool same = &ma == &mb && &va == &vb;
-    const bool db = same ? da : direction_decides(t, mb, vb);
-    if (da | db) {
-      const V2d x[3] = {decode_pair<F>(va[0].bits, vb[0].bits),
-                        decode_pair<F>(va[1].bits, vb[1].bits),
-                        decode_pair<F>(va[2].bits, vb[2].bits)};
-      V2u e[3];
-      for (int r = 0; r < 3; ++r) {
-        e[r] = row_pair64<F>(decode_pair<F>(ma[r][0].bits, mb[r][0].bits),
-                             decode_pair<F>(ma[r][1].bits, mb[r][1].bits),
-                             decode_pair<F>(ma[r][2].bits, mb[r][2].bits), V2d{0.0, 0.0}, x);
-      }
-      if (db) out_b = lane_of<F>(e, 1);
-      if (da) out_a = lane_of<F>(e, 0);
-    }
-    if (!da) out_a = direction_rows(t, ma, va);
-    if (!db && !same) out_b = direction_rows(t, mb, vb);
-  }
-  // The row-by-row direction step: dot_step64 per row where its condition holds, else dot_step.
-  static Vec3<F> direction_rows(const State& t, const Mat34<F>& m, const Vec3<F>& v) {
-    ExponentRange rv;
-    rv.include(v[0]);
-    rv.include(v[1]);
-    rv.include(v[2]);
-    Vec3<F> out;
-    for (int r = 0; r < 3; ++r) {
-      const Vec3<F> row{m[r][0], m[r][1], m[r][2]};
-      if (!dot_step64<F>(row, v, rv, t.nearest, out[r])) out[r] = dot_step(t.u.raw, row, v);
-    }
+    D::direction_steps(t, m, v, m, v, out, out);
     return out;
   }
   // A dot product on the transformation unit (a zero-translation row: 3 mul, 3 add).
   static F shade_dot(State& t, const Vec3<F>& a, const Vec3<F>& b) {
     PipelineUnits<F>::count(t.u.transformation_ops, 3, 3, 0, 0);
-    F r;
-    if (dot_step64<F>(a, b, t.nearest, r)) return r;
-    return dot_step(t.u.raw, a, b);
+    return D::dot(t, a, b);
   }
-  // The same with both vectors decoded already (dot_operand of a and of b).
-  static F shade_dot(State& t, const Vec3<F>& a, const DotOperand& da, const Vec3<F>& b,
-                     const DotOperand& db) {
+  // The same with both vectors as the datapath reads them already (D::operand of a and of b).
+  static F shade_dot(State& t, const Vec3<F>& a, const Operand& da, const Vec3<F>& b,
+                     const Operand& db) {
     PipelineUnits<F>::count(t.u.transformation_ops, 3, 3, 0, 0);
-    F r;
-    if (dot_step64<F>(da, db, t.nearest, r)) return r;
-    return dot_step(t.u.raw, a, b);
+    return D::dot(t, a, da, b, db);
   }
-  // -x / sqrt(a * b) on the RGS helper (1 mul, 1 sqrt, 1 div). Normal operands in nearest-even:
-  // the three ops on binary64 values, each rounded to F's precision where round_to_format accepts
-  // it (what ff::fast's mul, sqrt and div compute and round: the product is exact, the root and
-  // the quotient double-rounded innocuously), without encoding the intermediates; anything else,
-  // or a result out of F's normal range, on the encodings.
+  // -x / sqrt(a * b) on the RGS helper (1 mul, 1 sqrt, 1 div).
   static F cosine(State& t, F x, F a, F b) {
     PipelineUnits<F>::count(t.u.rgs_ops, 0, 1, 1, 0);
     ++t.u.rgs_ops.sqrt;
-    using ff::fast::is_normal;
-    constexpr int E = F::kExpBits, M = F::kManBits;
-    if (t.nearest & is_normal<E, M>(x.bits) & is_normal<E, M>(a.bits) & is_normal<E, M>(b.bits)) {
-      bool ok = true;
-      const V2d ab = decode_pair<F>(a.bits, b.bits);
-      const double p = round_to_format<F>(ab[0] * ab[1], ok);
-      const double root = round_to_format<F>(std::sqrt(p), ok);
-      const double q = round_to_format<F>(-decode_pair<F>(x.bits, x.bits)[0] / root, ok);
-      if (ok) return encoding_of<F>(q);
-    }
-    const auto& fp = t.u.raw;
-    return fp.div(x.neg(), fp.sqrt(fp.mul(a, b)));
+    return D::cosine(t, x, a, b);
   }
   // k + k for k = n / d on the RGS helper (1 div, 1 add).
   static F twice_quotient(State& t, F n, F d) {
@@ -319,7 +247,7 @@ class RgsStep {
     s.rec = l.hit;
     const memif::InstanceHeader h = t.image.instance_header(s.rec.instance);
     s.n = world_normal(t, h, s.rec);
-    s.n_op = dot_operand<F>(s.n);
+    s.n_op = D::operand(s.n);
     s.nn = shade_dot(t, s.n, s.n_op, s.n, s.n_op);
     t.u.shading_transformation_steps += 1;  // normal step; the dots count below
     const std::uint32_t record = h.shading_base + s.rec.triangle;
@@ -344,12 +272,12 @@ class RgsStep {
     s.spec = shininess >= 1 && (s.mat.specular_rgb_shininess & 0xFFFFFFu) != 0;
     const bool reflect = t.params.secondary && t.depth < max_depth_ && s.mat.reflectivity > 0;
     if (s.spec || reflect)
-      s.kk = twice_quotient(t, shade_dot(t, s.ray.d, dot_operand<F>(s.ray.d), s.n, s.n_op), s.nn);
+      s.kk = twice_quotient(t, shade_dot(t, s.ray.d, D::operand(s.ray.d), s.n, s.n_op), s.nn);
     if (s.spec) {
       const Mat34<F> tr = reflect_matrix(s.ray, s.n);
       count_transform(t, 1);
       s.r = direction_step(t, tr, Vec3<F>{F::one(), s.kk.neg(), F::zero()});
-      s.r_op = dot_operand<F>(s.r);
+      s.r_op = D::operand(s.r);
       s.rr = shade_dot(t, s.r, s.r_op, s.r, s.r_op);
       t.u.shading_transformation_steps += 1;
     }
@@ -419,7 +347,7 @@ class RgsStep {
       const int j = i + 1 < t.p ? i + 1 : i;
       const GenLane<F>& ga = pk.lanes[static_cast<std::size_t>(i)];
       const GenLane<F>& gb = pk.lanes[static_cast<std::size_t>(j)];
-      direction_steps(t, ga.t, ga.rd, gb.t, gb.rd, t.lane(i).world.d, t.lane(j).world.d);
+      D::direction_steps(t, ga.t, ga.rd, gb.t, gb.rd, t.lane(i).world.d, t.lane(j).world.d);
     }
     shade_light(t);
   }

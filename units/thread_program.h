@@ -30,7 +30,10 @@ namespace saarcor::units {
 // field over kLanes slots, so a small capacity keeps a small packet's values in a few cache lines:
 // the cycle model interleaves 64 programs, whose state has mostly left the L1 cache by the time a
 // unit serves the thread again (P = 4 in 4 slots instead of 64: ~4% of a cycle-model frame).
-template <class F, int kLanes = kMaxPacket>
+// D: the datapath policy, chosen at compile time (units/fast_datapath.h: FastDatapath, what the
+// models run; units/reference_datapath.h: ReferenceDatapath, every step on encodings, built in its
+// own target). Both give the same results bit for bit (testbench/reference_datapath_test.cpp).
+template <class F, int kLanes, class D>
 class ThreadProgram {
  public:
   ThreadProgram(const memif::MemoryImage& image, const FunctionalParams& params,
@@ -150,7 +153,7 @@ class ThreadProgram {
   }
 
  private:
-  PacketState<F, kLanes> s_;
+  PacketState<F, kLanes, D> s_;
 };
 
 }  // namespace saarcor::units

@@ -13,11 +13,11 @@
 
 namespace saarcor::units {
 
-template <class F, int kLanes>
+template <class F, int kLanes, class D>
 class TransformationStep {
  public:
-  using State = PacketState<F, kLanes>;
-  using Mat64 = MatrixValues<F>;
+  using State = PacketState<F, kLanes, D>;
+  using Mat64 = typename State::Mat64;
 
   TransformationStep(const memif::MemoryImage& image, const State& t) {
     const auto& regs = image.registers();
@@ -193,7 +193,7 @@ class TransformationStep {
   }
 
   Mat34<F> cam_{};
-  MatrixValues<F> cam_values_{};  // matrix_values(cam_): primary packets transform through it
+  Mat64 cam_values_{};  // matrix_values(cam_): primary packets transform through it
   F shadow_t_max_{};
   GenPacket<F> gen_;
 };

@@ -4,8 +4,8 @@
 // child, the push of the far child), the stack shared by both levels with its drops at the pop,
 // and the end of a level. Its timing (node fetch, chain rule, pipeline depth: fp add + div + cmp)
 // is units/traversal.cpp; its exact-cycle test units/unit_timing_test.cpp (UnitTimingTraversal.*).
-// The steps take the binary64 paths of units/fast_paths.h where they decide and redo a lane on
-// encodings (units/datapath.h) where they do not.
+// The arithmetic of a clip and of an inner node's lanes is the datapath policy D's (clip_box,
+// decide: units/fast_datapath.h, units/reference_datapath.h).
 #pragma once
 
 #include <algorithm>
@@ -20,10 +20,10 @@
 
 namespace saarcor::units {
 
-template <class F, int kLanes>
+template <class F, int kLanes, class D>
 class TraversalStep {
  public:
-  using State = PacketState<F, kLanes>;
+  using State = PacketState<F, kLanes, D>;
   using LaneSlots = Slots<kLanes>;
 
   TraversalStep(const memif::MemoryImage& image, const FunctionalParams& params, int slots) {
@@ -215,74 +215,9 @@ class TraversalStep {
     start_group(t);
   }
 
-  // The slab clip of the level's box (D29), faces 0..5: x entry, x exit, y entry, ... The entry
-  // face is lo for a positive direction, hi for a negative one; the exit face the other. Two
-  // lanes at a time through the six faces on values; a lane that any face does not decide there
-  // is redone alone from its start values (0, t_best) (clip_lane).
+  // The slab clip of the level's box (D29), faces 0..5: x entry, x exit, y entry, ...
   void clip_box(State& t) {
-    std::array<double, 3> lo_value, hi_value;
-    for (std::size_t k = 0; k < 3; ++k) {
-      lo_value[k] = t.value(box_lo_[k]);
-      hi_value[k] = t.value(box_hi_[k]);
-    }
-    const auto& lo = level_o(t);
-    const auto& inv = level_inv(t);
-    std::uint64_t redo = 0;
-    for (int i = 0; i < t.p; i += 2) {
-      const std::uint64_t lanes = (clip_mask_ >> i) & 3u;
-      if (lanes == 0) continue;
-      const Lane<F>& l0 = t.lane(i);
-      const Lane<F>& l1 = t.lane(i + 1 < t.p ? i + 1 : i);
-      const auto s = static_cast<std::size_t>(i);
-      V2i ok = {-1, -1};
-      V2d tn = load2(&t.v.clip_tn[s]), tf = load2(&t.v.clip_tf[s]);
-      for (int axis = 0; axis < 3; ++axis) {
-        const auto k = static_cast<std::size_t>(axis);
-        // Per lane: the entry face is lo for a positive direction (sign bit clear).
-        const V2i neg = {l0.current.d[axis].sign() ? -1 : 0, l1.current.d[axis].sign() ? -1 : 0};
-        const V2d lo_plane = {lo_value[k], lo_value[k]}, hi_plane = {hi_value[k], hi_value[k]};
-        const V2d o = load2(&lo[k][s]), d = load2(&inv[k][s]);
-        clip_face_pair64<F>(select2(neg, hi_plane, lo_plane), o, d, true, tn, tf, ok);
-        clip_face_pair64<F>(select2(neg, lo_plane, hi_plane), o, d, false, tn, tf, ok);
-      }
-      const std::uint64_t decided = lanes & mask2(ok);
-      if ((decided & 1u) != 0) {
-        t.v.clip_tn[s] = tn[0];
-        t.v.clip_tf[s] = tf[0];
-      }
-      if ((decided & 2u) != 0) {
-        t.v.clip_tn[s + 1] = tn[1];
-        t.v.clip_tf[s + 1] = tf[1];
-      }
-      redo |= (lanes & ~decided) << i;
-    }
-    for (; redo != 0; redo &= redo - 1)
-      clip_lane(t, std::countr_zero(redo), lo_value, hi_value);
-  }
-
-  // One lane's six faces, each on values where it decides, else on encodings.
-  void clip_lane(State& t, int i, const std::array<double, 3>& lo_value,
-                 const std::array<double, 3>& hi_value) {
-    const auto s = static_cast<std::size_t>(i);
-    const Lane<F>& l = t.lane(i);
-    double& clip_tn = t.v.clip_tn[s];
-    double& clip_tf = t.v.clip_tf[s];
-    const auto& lo = level_o(t);
-    const auto& inv = level_inv(t);
-    for (int face = 0; face < 6; ++face) {
-      const int axis = face / 2;
-      const auto k = static_cast<std::size_t>(axis);
-      const bool entry = (face % 2) == 0;
-      const bool lo_face = entry != l.current.d[axis].sign();
-      if (clip_face64<F>(lo_face ? lo_value[k] : hi_value[k], lo[k][s], inv[k][s], entry, clip_tn,
-                         clip_tf))
-        continue;
-      F tn = t.encoding(clip_tn), tf = t.encoding(clip_tf);
-      units::clip_face(t.u.direct, lo_face ? box_lo_[k] : box_hi_[k], l.current.o[axis],
-                       l.current.d[axis], entry, tn, tf);
-      clip_tn = t.value(tn);
-      clip_tf = t.value(tf);
-    }
+    D::clip_box(t, clip_mask_, box_lo_, box_hi_, level_o(t), level_inv(t));
   }
 
   void start_group(State& t) {
@@ -309,11 +244,7 @@ class TraversalStep {
     t.phase = Phase::kList;
   }
 
-  // The lanes' decisions at an inner node: which go near, which go far, and their new segments.
-  struct Decision {
-    std::uint64_t near_mask = 0, far_mask = 0;
-    alignas(16) LaneSlots near_tf, far_tn;  // slots 0..P-1 (rounded up to even) set
-  };
+  using Decision = TraversalDecision<kLanes>;
 
   void inner(State& t, const memif::KdNode& node, std::uint64_t active) {
     ++t.u.inner_steps;
@@ -334,40 +265,9 @@ class TraversalStep {
     descend(t, node, neg, d);
   }
 
-  // traversal_lane for every active lane: two lanes at a time on values (inactive lanes are
-  // computed along and dropped), the lanes the values do not decide on encodings.
+  // traversal_lane for every active lane (D::decide).
   void decide(State& t, int axis, F split, std::uint64_t active, Decision& d) {
-    std::uint64_t fail = 0;
-    const double split_value = t.value(split);
-    const V2d split2 = {split_value, split_value};
-    const auto a = static_cast<std::size_t>(axis);
-    const LaneSlots& o = level_o(t)[a];
-    const LaneSlots& inv = level_inv(t)[a];
-    for (int i = 0; i < t.p; i += 2) {
-      const auto s = static_cast<std::size_t>(i);
-      const TraversalPair64 r = traversal_pair64<F>(split2, load2(&o[s]), load2(&inv[s]),
-                                                    load2(&t.v.tn[s]), load2(&t.v.tf[s]));
-      d.near_mask |= r.go_near << i;
-      d.far_mask |= r.go_far << i;
-      fail |= r.fail << i;
-      store2(&d.near_tf[s], r.near_tf);
-      store2(&d.far_tn[s], r.far_tn);
-    }
-    d.near_mask &= active;
-    d.far_mask &= active;
-    for (std::uint64_t m = fail & active; m != 0; m &= m - 1) {
-      const int i = std::countr_zero(m);
-      const auto s = static_cast<std::size_t>(i);
-      const Lane<F>& l = t.lane(i);
-      const TraversalLane<F> e =
-          traversal_lane(t.u.direct, split, l.current.o[axis], l.current.d[axis],
-                         t.encoding(t.v.tn[s]), t.encoding(t.v.tf[s]));
-      const std::uint64_t bit = std::uint64_t{1} << i;
-      d.near_mask = e.go_near ? d.near_mask | bit : d.near_mask & ~bit;
-      d.far_mask = e.go_far ? d.far_mask | bit : d.far_mask & ~bit;
-      d.near_tf[s] = t.value(e.near_tf);
-      d.far_tn[s] = t.value(e.far_tn);
-    }
+    D::decide(t, axis, split, active, level_o(t), level_inv(t), d);
   }
 
   void tap_step(State& t, int axis, F split, std::uint64_t active, const Decision& d) {
