@@ -28,6 +28,7 @@
 #include "units/cycle_params.h"
 #include "units/dynrtc_units.h"
 #include "units/dynrtp.h"
+#include "units/fast_datapath.h"
 #include "units/functional_model.h"
 #include "units/thread_program.h"
 
@@ -52,8 +53,8 @@ class LockstepThreads final : public units::ThreadTable {
     tiling_ = units::packet_tiling(w_, h_, params.packet);
     sink_.reset(w_, h_);
     for (int i = 0; i < threads; ++i) {
-      programs_.push_back(
-          std::make_unique<units::ThreadProgram<F, kLanes>>(image, params_, units_, sink_));
+      programs_.push_back(std::make_unique<units::ThreadProgram<F, kLanes, units::FastDatapath>>(
+          image, params_, units_, sink_));
       requests_.push_back(programs_.back()->request());
     }
   }
@@ -69,7 +70,7 @@ class LockstepThreads final : public units::ThreadTable {
   const std::vector<units::RgsAccess>& rgs_memory(std::uint32_t t) const override {
     return programs_[t]->rgs_memory();
   }
-  const units::PacketState<F, kLanes>& state(std::uint32_t t) const {
+  const units::PacketState<F, kLanes, units::FastDatapath>& state(std::uint32_t t) const {
     return programs_[t]->state();
   }
 
@@ -79,7 +80,7 @@ class LockstepThreads final : public units::ThreadTable {
   units::FrameSink sink_;
   units::PacketTiling tiling_;
   int w_ = 0, h_ = 0;
-  std::vector<std::unique_ptr<units::ThreadProgram<F, kLanes>>> programs_;
+  std::vector<std::unique_ptr<units::ThreadProgram<F, kLanes, units::FastDatapath>>> programs_;
 };
 
 // Thrown from inside the model's cycle when the comparison found a divergence or the replay
@@ -312,8 +313,9 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   memif::MemorySystem mi(k, image, units::memory_system_config(p));
   units::RayGenerationController rgc(threads.packets(), 1);
   units::DynRtp d(k, mi, p, threads, rgc, 0);
-  units::ListPayload<F, kLanes> payload(
-      threads, [&](units::ThreadToken t) -> const units::PacketState<F, kLanes>& {
+  units::ListPayload<F, kLanes, units::FastDatapath> payload(
+      threads,
+      [&](units::ThreadToken t) -> const units::PacketState<F, kLanes, units::FastDatapath>& {
         return threads.state(t);
       });
   units::BoundaryRecorder rec(threads, p.threads, {UnitId::kList}, payload,

@@ -25,21 +25,21 @@ namespace {
 
 // `packets` primary packets (square tiles of P pixels) spread evenly over the frame, one after
 // another on threads 0, 1, 2, ... (mod 64), through the RTL and the model.
-template <class V, int kL = kLanes>
-TravRun run_scene(const std::string& spec, int packets, int depth, bool reference = false,
-                  int p = kLanes, bool shadows = false) {
+// D: the model's datapath policy the harness's neighbours and reference steps run on.
+template <class V, int kL = kLanes, class D = units::FastDatapath>
+TravRun run_scene(const std::string& spec, int packets, int depth, int p = kLanes,
+                  bool shadows = false) {
   const host::BuiltImage built = host::build_image(host::load_scene(spec));
   const memif::MemoryImage& image = built.image;
   units::FunctionalParams fp;
   fp.packet = p;
   fp.shadows = shadows;
-  fp.reference_datapath = reference;
   units::PipelineUnits<F> pu(fp.mode);
   units::FrameSink sink;
   const auto w = static_cast<int>(image.registers().width);
   const auto h = static_cast<int>(image.registers().height);
   sink.reset(w, h);
-  TravHarness<V, kL> rtl(image, {depth});
+  TravHarness<V, kL, D> rtl(image, {depth});
   const int side = p == 16 ? 4 : p == 4 ? 2 : 1;  // square tiles of P pixels
   const int tiles = (w / side) * (h / side);
   for (int k = 0; k < packets; ++k) {
@@ -51,7 +51,7 @@ TravRun run_scene(const std::string& spec, int packets, int depth, bool referenc
     for (int j = 0; j < side; ++j)
       for (int i = 0; i < side; ++i)
         px.push_back((y + static_cast<std::uint32_t>(j)) * uw + x + static_cast<std::uint32_t>(i));
-    auto s = std::make_unique<typename TravHarness<V, kL>::S>(image, fp, pu, sink);
+    auto s = std::make_unique<typename TravHarness<V, kL, D>::S>(image, fp, pu, sink);
     s->rgs.start_primary(*s, px);
     s->transformation.generate(*s);
     if (!rtl.packet(*s, static_cast<std::uint32_t>(k % 64), shadows)) break;
@@ -86,7 +86,8 @@ TEST(RtlTraversal, RoomMatchesTheModelRequestByRequest) {
 
 // The model's reference datapath (every step on encodings) gives the same requests.
 TEST(RtlTraversal, RoomOnTheReferenceDatapath) {
-  const TravRun r = run_scene<Vtraversal_ctrl>("builtin:room", 60, depth(), true);
+  const TravRun r =
+      run_scene<Vtraversal_ctrl, kLanes, units::ReferenceDatapath>("builtin:room", 60, depth());
   EXPECT_FALSE(r.first.found) << describe(r);
   EXPECT_EQ(r.packets, 60u) << describe(r);
 }
@@ -102,14 +103,14 @@ TEST(RtlTraversal, DynamicSceneTwoLevels) {
 
 // Other packet widths: the Verilated builds with P = 16 and P = 1.
 TEST(RtlTraversal, RoomWithSixteenRayPackets) {
-  const TravRun r = run_scene<Vtraversal_ctrl_p16, 16>("builtin:room", 80, depth(), false, 16);
+  const TravRun r = run_scene<Vtraversal_ctrl_p16, 16>("builtin:room", 80, depth(), 16);
   EXPECT_FALSE(r.first.found) << describe(r);
   EXPECT_EQ(r.packets, 80u) << describe(r);
   std::printf("RtlTraversal room P=16: %s\n", describe(r).c_str());
 }
 
 TEST(RtlTraversal, DynamicSceneWithSingleRayPackets) {
-  const TravRun r = run_scene<Vtraversal_ctrl_p1, 2>("builtin:dynamic", 200, depth(), false, 1);
+  const TravRun r = run_scene<Vtraversal_ctrl_p1, 2>("builtin:dynamic", 200, depth(), 1);
   EXPECT_FALSE(r.first.found) << describe(r);
   EXPECT_EQ(r.packets, 200u) << describe(r);
   std::printf("RtlTraversal dynamic P=1: %s\n", describe(r).c_str());
@@ -118,7 +119,7 @@ TEST(RtlTraversal, DynamicSceneWithSingleRayPackets) {
 // Shadow packets (docs/shading.md 6.4): the RGS hands them to the traversal unit directly, their
 // rays finish at any hit (done), and entries whose rays are all done are dropped at a pop.
 TEST(RtlTraversal, DynamicSceneWithShadowRays) {
-  const TravRun r = run_scene<Vtraversal_ctrl>("builtin:dynamic", 60, depth(), false, kLanes, true);
+  const TravRun r = run_scene<Vtraversal_ctrl>("builtin:dynamic", 60, depth(), kLanes, true);
   EXPECT_FALSE(r.first.found) << describe(r);
   EXPECT_GT(r.packets, 60u) << describe(r);  // the shadow packets count too
   std::printf("RtlTraversal dynamic with shadows: %s\n", describe(r).c_str());

@@ -17,14 +17,16 @@
 
 #include "fixedfloat/float.h"
 #include "memif/image_format.h"
+#include "units/fast_datapath.h"
 #include "units/packet_state.h"
+#include "units/reference_datapath.h"
 #include "verilated.h"
 
 namespace saarcor::rtl::testing {
 
 using F = ff::fp24;
 inline constexpr int kLanes = 4;  // P of the default build
-using State = units::PacketState<F, kLanes>;
+using State = units::PacketState<F, kLanes, units::FastDatapath>;
 
 // The first difference between the RTL and the model.
 struct TravDivergence {
@@ -53,10 +55,10 @@ struct TravLatency {
 };
 
 // V: the Verilated traversal_ctrl; kL: the model's lane capacity (>= P, at least 2).
-template <class V, int kL = kLanes>
+template <class V, int kL = kLanes, class D = units::FastDatapath>
 class TravHarness {
  public:
-  using S = units::PacketState<F, kL>;
+  using S = units::PacketState<F, kL, D>;
 
   TravHarness(const memif::MemoryImage& image, TravLatency lat)
       : image_(image), lat_(lat), top_(std::make_unique<V>()) {

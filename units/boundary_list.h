@@ -26,10 +26,10 @@ enum class ListOut : std::uint8_t { kEntry = 0, kSkip = 1, kPop = 2 };
 inline constexpr const char* kListInputFields[] = {"op", "level", "next", "end", "mask"};
 inline constexpr const char* kListOutputFields[] = {"kind", "level", "next", "entry", "mask"};
 
-template <class F, int kLanes>
+template <class F, int kLanes, class D>
 class ListPayload final : public BoundaryPayload {
  public:
-  using State = PacketState<F, kLanes>;
+  using State = PacketState<F, kLanes, D>;
   using StateOf = std::function<const State&(ThreadToken)>;
 
   ListPayload(const ThreadTable& threads, StateOf state)

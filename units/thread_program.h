@@ -48,7 +48,7 @@ class ThreadProgram {
   RayKind kind() const { return s_.kind; }
   int packet_width() const { return s_.p; }
   // The packet's state as the units hold it (read by the boundary record, units/boundary_list.h).
-  const PacketState<F, kLanes>& state() const { return s_; }
+  const PacketState<F, kLanes, D>& state() const { return s_; }
   // The memory accesses of the RGS request executed last (RgsStep::memory()).
   const std::vector<RgsAccess>& rgs_memory() const { return s_.rgs.memory(); }
 
