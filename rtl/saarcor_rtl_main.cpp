@@ -113,14 +113,25 @@ bool parse_count(const std::string& s, std::uint64_t& out) {
   return true;
 }
 
-int lockstep(const std::vector<std::string>& args) {
-  using saarcor::rtl::LockstepOptions;
-  LockstepOptions o;
-  o.scene = args[1];
-  auto fail = [](const std::string& m) {
-    std::fprintf(stderr, "saarcor-rtl: error: %s\n", m.c_str());
-    return 1;
-  };
+using saarcor::rtl::LockstepOptions;
+
+int fail(const std::string& m) {
+  std::fprintf(stderr, "saarcor-rtl: error: %s\n", m.c_str());
+  return 1;
+}
+
+std::vector<std::string> split_units(const std::string& u) {
+  std::vector<std::string> units;
+  for (std::size_t p = 0; p != std::string::npos;) {
+    const std::size_t q = u.find(',', p);
+    units.push_back(u.substr(p, q == std::string::npos ? q : q - p));
+    p = q == std::string::npos ? q : q + 1;
+  }
+  return units;
+}
+
+// The options after SCENE into o; the error line's text, or "" when they all parse.
+std::string parse_lockstep_args(const std::vector<std::string>& args, LockstepOptions& o) {
   for (std::size_t i = 2; i < args.size(); ++i) {
     const std::string& a = args[i];
     const bool has = i + 1 < args.size();
@@ -130,42 +141,91 @@ int lockstep(const std::vector<std::string>& args) {
     } else if (a == "--bench") {
       o.bench = true;
     } else if (!has) {
-      return fail("unknown or incomplete argument '" + a + "'");
+      return "unknown or incomplete argument '" + a + "'";
     } else if (a == "--units") {
-      o.units.clear();
-      std::string u = args[++i];
-      for (std::size_t p = 0; p != std::string::npos;) {
-        const std::size_t q = u.find(',', p);
-        o.units.push_back(u.substr(p, q == std::string::npos ? q : q - p));
-        p = q == std::string::npos ? q : q + 1;
-      }
+      o.units = split_units(args[++i]);
     } else if (a == "--res") {
       const std::string r = args[++i];
       const std::size_t x = r.find('x');
       std::uint64_t w = 0, h = 0;
       if (x == std::string::npos || !parse_count(r.substr(0, x), w) ||
           !parse_count(r.substr(x + 1), h) || w == 0 || h == 0 || w > 8192 || h > 8192)
-        return fail("--res '" + r + "' is not WxH");
+        return "--res '" + r + "' is not WxH";
       o.width = static_cast<int>(w);
       o.height = static_cast<int>(h);
     } else if (a == "--set") {
       o.set.push_back(args[++i]);
     } else if (a == "--depth") {
-      if (!parse_count(args[++i], n) || n > 16)
-        return fail("--depth '" + args[i] + "' is not 0..16");
+      if (!parse_count(args[++i], n) || n > 16) return "--depth '" + args[i] + "' is not 0..16";
       o.depth = static_cast<int>(n);
     } else if (a == "--until") {
-      if (!parse_count(args[++i], n) || n == 0)
-        return fail("--until '" + args[i] + "' is not a cycle");
+      if (!parse_count(args[++i], n) || n == 0) return "--until '" + args[i] + "' is not a cycle";
       o.until = n;
     } else if (a == "--wave") {
       o.wave = args[++i];
     } else if (a == "--fault") {
       o.fault = args[++i];
     } else {
-      return fail("unknown argument '" + a + "'");
+      return "unknown argument '" + a + "'";
     }
   }
+  return "";
+}
+
+// A divergence: the same run again, traced around the cycle, then its screen, the waveform and
+// the replay command.
+int report_divergence(const LockstepOptions& o, const saarcor::rtl::LockstepResult& r) {
+  LockstepOptions w = o;
+  w.write_wave = true;
+  w.wave_from = r.divergence.cycle > 64 ? r.divergence.cycle - 64 : 0;
+  w.wave_to = r.divergence.cycle + 16;
+  w.until = w.wave_to;
+  (void)saarcor::rtl::run_lockstep(w);  // the same run again, traced around the cycle
+  std::fputs(r.screen.c_str(), stdout);
+  std::printf("  waveform: %s (RTL cycles %llu..%llu, 2 time units per cycle)\n", w.wave.c_str(),
+              static_cast<unsigned long long>(w.wave_from),
+              static_cast<unsigned long long>(w.wave_to));
+  std::printf("  replay:   %s --until %llu --wave %s\n", saarcor::rtl::lockstep_command(o).c_str(),
+              static_cast<unsigned long long>(r.divergence.cycle), w.wave.c_str());
+  return 2;
+}
+
+void report_agreement(const LockstepOptions& o, const saarcor::rtl::LockstepResult& r) {
+  if (o.until != 0 && r.cycles <= o.until + 1)
+    std::printf(
+        "saarcor-rtl lockstep: stopped after cycle %llu (--until), no divergence up to "
+        "it; waveform %s (RTL cycles %llu..%llu)\n",
+        static_cast<unsigned long long>(o.until), o.wave.c_str(),
+        static_cast<unsigned long long>(o.wave_from), static_cast<unsigned long long>(o.wave_to));
+  static constexpr const char* kPorts[] = {"input",          "side_band",     "cache_request",
+                                           "cache_response", "cache_blocked", "output"};
+  std::printf(
+      "saarcor-rtl lockstep: %s %dx%d, list unit (build %s): 0 divergences in %llu cycles\n",
+      o.scene.c_str(), o.width, o.height, r.build.c_str(),
+      static_cast<unsigned long long>(r.model_cycles));
+  std::printf("  driven:  ");
+  for (int p : {0, 1, 3, 4})
+    std::printf(" %s %llu", kPorts[p],
+                static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
+  std::printf("\n  compared:");
+  for (int p : {2, 5})
+    std::printf(" %s %llu", kPorts[p],
+                static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
+  const double c = static_cast<double>(r.model_cycles);
+  std::printf("\n  speed: RTL %.0f k cycles/s, co-simulation %.0f k cycles/s",
+              r.rtl_seconds > 0 ? static_cast<double>(r.cycles) / r.rtl_seconds / 1e3 : 0.0,
+              r.seconds > 0 ? c / r.seconds / 1e3 : 0.0);
+  if (o.bench)
+    std::printf(", cycle model alone %.0f k cycles/s",
+                r.model_seconds > 0 ? c / r.model_seconds / 1e3 : 0.0);
+  std::printf("\n");
+}
+
+int lockstep(const std::vector<std::string>& args) {
+  LockstepOptions o;
+  o.scene = args[1];
+  const std::string error = parse_lockstep_args(args, o);
+  if (!error.empty()) return fail(error);
   try {
     if (o.until != 0) {  // a replay: the waveform of the window before the cycle asked for
       o.write_wave = true;
@@ -173,50 +233,8 @@ int lockstep(const std::vector<std::string>& args) {
       o.wave_to = o.until;
     }
     const saarcor::rtl::LockstepResult r = saarcor::rtl::run_lockstep(o);
-    if (r.diverged) {
-      LockstepOptions w = o;
-      w.write_wave = true;
-      w.wave_from = r.divergence.cycle > 64 ? r.divergence.cycle - 64 : 0;
-      w.wave_to = r.divergence.cycle + 16;
-      w.until = w.wave_to;
-      (void)saarcor::rtl::run_lockstep(w);  // the same run again, traced around the cycle
-      std::fputs(r.screen.c_str(), stdout);
-      std::printf("  waveform: %s (RTL cycles %llu..%llu, 2 time units per cycle)\n",
-                  w.wave.c_str(), static_cast<unsigned long long>(w.wave_from),
-                  static_cast<unsigned long long>(w.wave_to));
-      std::printf("  replay:   %s --until %llu --wave %s\n",
-                  saarcor::rtl::lockstep_command(o).c_str(),
-                  static_cast<unsigned long long>(r.divergence.cycle), w.wave.c_str());
-      return 2;
-    }
-    if (o.until != 0 && r.cycles <= o.until + 1)
-      std::printf(
-          "saarcor-rtl lockstep: stopped after cycle %llu (--until), no divergence up to "
-          "it; waveform %s (RTL cycles %llu..%llu)\n",
-          static_cast<unsigned long long>(o.until), o.wave.c_str(),
-          static_cast<unsigned long long>(o.wave_from), static_cast<unsigned long long>(o.wave_to));
-    static constexpr const char* kPorts[] = {"input",          "side_band",     "cache_request",
-                                             "cache_response", "cache_blocked", "output"};
-    std::printf(
-        "saarcor-rtl lockstep: %s %dx%d, list unit (build %s): 0 divergences in %llu cycles\n",
-        o.scene.c_str(), o.width, o.height, r.build.c_str(),
-        static_cast<unsigned long long>(r.model_cycles));
-    std::printf("  driven:  ");
-    for (int p : {0, 1, 3, 4})
-      std::printf(" %s %llu", kPorts[p],
-                  static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
-    std::printf("\n  compared:");
-    for (int p : {2, 5})
-      std::printf(" %s %llu", kPorts[p],
-                  static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
-    const double c = static_cast<double>(r.model_cycles);
-    std::printf("\n  speed: RTL %.0f k cycles/s, co-simulation %.0f k cycles/s",
-                r.rtl_seconds > 0 ? static_cast<double>(r.cycles) / r.rtl_seconds / 1e3 : 0.0,
-                r.seconds > 0 ? c / r.seconds / 1e3 : 0.0);
-    if (o.bench)
-      std::printf(", cycle model alone %.0f k cycles/s",
-                  r.model_seconds > 0 ? c / r.model_seconds / 1e3 : 0.0);
-    std::printf("\n");
+    if (r.diverged) return report_divergence(o, r);
+    report_agreement(o, r);
     return 0;
   } catch (const std::exception& e) {
     return fail(e.what());

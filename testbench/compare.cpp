@@ -90,6 +90,56 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
+// Both runs hit the same triangle: the relative error of t, B taken as the reference.
+void count_t_error(const PixelHit& ha, const PixelHit& hb, PixelRef at, std::size_t p,
+                   CompareResult& r, std::vector<double>& t_err, double& worst, Rgb8Image* diff) {
+  const double tb = hb.t, ta = ha.t;
+  double e = ta == tb ? 0.0 : std::abs(ta - tb) / std::abs(tb);
+  if (std::isnan(e)) e = std::numeric_limits<double>::infinity();
+  t_err.push_back(e);
+  if (e > worst) {
+    worst = e;
+    r.worst_t = at;
+  }
+  if (diff) {
+    // Same triangle: grey when t agrees bit for bit, else green brighter with the error.
+    if (e == 0.0) {
+      put(*diff, p, {48, 48, 48});
+    } else {
+      const double s = std::clamp((std::log10(e) + 9.0) / 7.0, 0.0, 1.0);
+      put(*diff, p, {0, static_cast<std::uint8_t>(80 + std::lround(175 * s)), 0});
+    }
+  }
+}
+
+void count_mismatch(MismatchClass c, const PixelHit& ha, const PixelHit& hb,
+                    const CompareParams& params, PixelRef at, std::size_t p, CompareResult& r,
+                    Rgb8Image* diff) {
+  PixelRef& first = r.first_mismatch[static_cast<int>(c)];
+  if (!first.valid()) first = at;
+  switch (c) {
+    case MismatchClass::kHitVsMiss: {
+      ++r.mismatches.hit_vs_miss;
+      const PixelHit& h = ha.hit() ? ha : hb;
+      if (edge_distance(h) < params.bary_tolerance) ++r.mismatches.hit_vs_miss_near_edge;
+      if (diff) put(*diff, p, {255, 0, 0});
+      break;
+    }
+    case MismatchClass::kEdgeTie:
+      ++r.mismatches.edge_tie;
+      if (diff) put(*diff, p, {255, 255, 0});
+      break;
+    case MismatchClass::kGrazing:
+      ++r.mismatches.grazing;
+      if (diff) put(*diff, p, {0, 255, 255});
+      break;
+    default:
+      ++r.mismatches.other;
+      if (diff) put(*diff, p, {255, 0, 255});
+      break;
+  }
+}
+
 }  // namespace
 
 const char* mismatch_class_name(MismatchClass c) {
@@ -137,55 +187,15 @@ CompareResult compare_hits(const HitBuffer& a, const HitBuffer& b, const Compare
   for (std::size_t p = 0; p < a.pixels.size(); ++p) {
     const PixelHit& ha = a.pixels[p];
     const PixelHit& hb = b.pixels[p];
-    const int x = static_cast<int>(p % a.width), y = static_cast<int>(p / a.width);
+    const PixelRef at{static_cast<int>(p % a.width), static_cast<int>(p / a.width)};
     if (!records_bit_identical(ha, hb)) r.bit_identical = false;
     const MismatchClass c = classify_mismatch(ha, hb, params);
     if (c == MismatchClass::kNone) {
       ++r.same_triangle;
-      if (ha.hit()) {
-        const double tb = hb.t, ta = ha.t;
-        double e = ta == tb ? 0.0 : std::abs(ta - tb) / std::abs(tb);
-        if (std::isnan(e)) e = std::numeric_limits<double>::infinity();
-        t_err.push_back(e);
-        if (e > worst) {
-          worst = e;
-          r.worst_t = {x, y};
-        }
-        if (diff) {
-          // Same triangle: grey when t agrees bit for bit, else green brighter with the error.
-          if (e == 0.0) {
-            put(*diff, p, {48, 48, 48});
-          } else {
-            const double s = std::clamp((std::log10(e) + 9.0) / 7.0, 0.0, 1.0);
-            put(*diff, p, {0, static_cast<std::uint8_t>(80 + std::lround(175 * s)), 0});
-          }
-        }
-      }
+      if (ha.hit()) count_t_error(ha, hb, at, p, r, t_err, worst, diff);
       continue;
     }
-    PixelRef& first = r.first_mismatch[static_cast<int>(c)];
-    if (!first.valid()) first = {x, y};
-    switch (c) {
-      case MismatchClass::kHitVsMiss: {
-        ++r.mismatches.hit_vs_miss;
-        const PixelHit& h = ha.hit() ? ha : hb;
-        if (edge_distance(h) < params.bary_tolerance) ++r.mismatches.hit_vs_miss_near_edge;
-        if (diff) put(*diff, p, {255, 0, 0});
-        break;
-      }
-      case MismatchClass::kEdgeTie:
-        ++r.mismatches.edge_tie;
-        if (diff) put(*diff, p, {255, 255, 0});
-        break;
-      case MismatchClass::kGrazing:
-        ++r.mismatches.grazing;
-        if (diff) put(*diff, p, {0, 255, 255});
-        break;
-      default:
-        ++r.mismatches.other;
-        if (diff) put(*diff, p, {255, 0, 255});
-        break;
-    }
+    count_mismatch(c, ha, hb, params, at, p, r, diff);
   }
   r.same_triangle_pct = r.pixels ? 100.0 * double(r.same_triangle) / double(r.pixels) : 100.0;
   r.t_compared = t_err.size();

@@ -223,6 +223,99 @@ std::string value_line(std::uint32_t bits, const Format& f) {
   return s + g + "  (exact " + exact_decimal(v) + ")";
 }
 
+// Edge patterns: zeros, infinities, NaN, smallest/largest normals and subnormals, values near
+// overflow and underflow, one and its neighbours, halves (for ties); each also negated.
+std::vector<std::uint32_t> edge_operands(const Format& f) {
+  const std::uint32_t top = f.exp_field_max();
+  const std::uint32_t sign = f.sign_mask();
+  const std::uint32_t man = f.man_mask();
+  auto enc = [&](std::uint32_t e, std::uint32_t mm) { return (e << f.man_bits) | (mm & man); };
+  std::vector<std::uint32_t> edges = {
+      0u,
+      f.inf_bits(),
+      f.nan_bits(),
+      f.max_finite_bits(),
+      f.max_finite_bits() - 1u,
+      enc(top - 1u, 0u),
+      enc(1u, 0u),
+      enc(1u, 1u),
+      enc(2u, 0u),
+      man,  // largest subnormal
+      1u,   // smallest subnormal
+      f.one_bits(),
+      f.one_bits() + 1u,
+      f.one_bits() - 1u,
+      f.one_bits() | (1u << (f.man_bits - 1)),  // 1.5
+      enc(static_cast<std::uint32_t>(f.bias()) - static_cast<std::uint32_t>(f.man_bits) - 1u, 0u),
+      enc(static_cast<std::uint32_t>(f.bias()) + static_cast<std::uint32_t>(f.man_bits) + 1u, 0u),
+      enc(static_cast<std::uint32_t>(f.bias() / 2), 0u),  // squares near the smallest normal
+      enc(static_cast<std::uint32_t>(f.bias() + f.bias() / 2 + 1), man),  // squares overflow
+  };
+  for (auto& e : edges)
+    e &= f.bits_mask();
+  const std::size_t n_edges = edges.size();
+  for (std::size_t i = 0; i < n_edges; ++i)
+    edges.push_back(edges[i] | sign);
+  return edges;
+}
+
+std::uint32_t random_mantissa(std::mt19937_64& rng, const Format& f) {
+  const std::uint32_t man = f.man_mask();
+  switch (rng() % 4) {
+    case 0:
+      return 0u;
+    case 1:
+      return man;
+    case 2:
+      return static_cast<std::uint32_t>(rng() % 4);
+    default:
+      return static_cast<std::uint32_t>(rng()) & man;
+  }
+}
+
+std::uint32_t random_operand(std::mt19937_64& rng, const Format& f) {
+  return static_cast<std::uint32_t>(rng()) & f.bits_mask();
+}
+
+// One operand pair, a quarter each: edge against edge, edge against random, nearby exponents
+// (cancellation, carries, ties), random against random.
+void random_pair(std::mt19937_64& rng, const Format& f, const std::vector<std::uint32_t>& edges,
+                 std::uint32_t* a_out, std::uint32_t* b_out) {
+  const std::uint32_t top = f.exp_field_max();
+  const std::uint32_t sign = f.sign_mask();
+  const std::uint32_t man = f.man_mask();
+  auto enc = [&](std::uint32_t e, std::uint32_t mm) { return (e << f.man_bits) | (mm & man); };
+  std::uint32_t a;
+  std::uint32_t b;
+  switch (rng() % 4) {
+    case 0:  // edge against edge
+      a = edges[rng() % edges.size()];
+      b = edges[rng() % edges.size()];
+      break;
+    case 1:  // edge against random
+      a = edges[rng() % edges.size()];
+      b = random_operand(rng, f);
+      if (rng() % 2) std::swap(a, b);
+      break;
+    case 2: {  // nearby exponents: cancellation, carries, ties
+      a = random_operand(rng, f);
+      const int ea = static_cast<int>((a >> f.man_bits) & top);
+      const int span = f.man_bits + 2;
+      const int eb = std::clamp(ea + static_cast<int>(rng() % (2 * span + 1)) - span, 0,
+                                static_cast<int>(top));
+      b = (static_cast<std::uint32_t>(rng()) & sign) |
+          enc(static_cast<std::uint32_t>(eb), random_mantissa(rng, f));
+      break;
+    }
+    default:
+      a = random_operand(rng, f);
+      b = random_operand(rng, f);
+      break;
+  }
+  *a_out = a;
+  *b_out = b;
+}
+
 }  // namespace
 
 void float_info(const FloatInfoOptions& opts, std::ostream& out) {
@@ -320,54 +413,7 @@ void float_gen(const FloatGenOptions& opts, std::ostream& out) {
   const Format f = parse_format_or_throw(opts.format);
   const Mode m = parse_mode_or_throw(opts.round, opts.subnormals);
   std::mt19937_64 rng(opts.seed);
-  const std::uint32_t top = f.exp_field_max();
-  const std::uint32_t sign = f.sign_mask();
-  const std::uint32_t man = f.man_mask();
-  auto enc = [&](std::uint32_t e, std::uint32_t mm) { return (e << f.man_bits) | (mm & man); };
-  // Edge patterns: zeros, infinities, NaN, smallest/largest normals and subnormals, values near
-  // overflow and underflow, one and its neighbours, halves (for ties).
-  std::vector<std::uint32_t> edges = {
-      0u,
-      f.inf_bits(),
-      f.nan_bits(),
-      f.max_finite_bits(),
-      f.max_finite_bits() - 1u,
-      enc(top - 1u, 0u),
-      enc(1u, 0u),
-      enc(1u, 1u),
-      enc(2u, 0u),
-      man,  // largest subnormal
-      1u,   // smallest subnormal
-      f.one_bits(),
-      f.one_bits() + 1u,
-      f.one_bits() - 1u,
-      f.one_bits() | (1u << (f.man_bits - 1)),  // 1.5
-      enc(static_cast<std::uint32_t>(f.bias()) - static_cast<std::uint32_t>(f.man_bits) - 1u, 0u),
-      enc(static_cast<std::uint32_t>(f.bias()) + static_cast<std::uint32_t>(f.man_bits) + 1u, 0u),
-      enc(static_cast<std::uint32_t>(f.bias() / 2), 0u),  // squares near the smallest normal
-      enc(static_cast<std::uint32_t>(f.bias() + f.bias() / 2 + 1), man),  // squares overflow
-  };
-  for (auto& e : edges)
-    e &= f.bits_mask();
-  const std::size_t n_edges = edges.size();
-  for (std::size_t i = 0; i < n_edges; ++i)
-    edges.push_back(edges[i] | sign);
-
-  auto random_mantissa = [&]() -> std::uint32_t {
-    switch (rng() % 4) {
-      case 0:
-        return 0u;
-      case 1:
-        return man;
-      case 2:
-        return static_cast<std::uint32_t>(rng() % 4);
-      default:
-        return static_cast<std::uint32_t>(rng()) & man;
-    }
-  };
-  auto random_operand = [&]() -> std::uint32_t {
-    return static_cast<std::uint32_t>(rng()) & f.bits_mask();
-  };
+  const std::vector<std::uint32_t> edges = edge_operands(f);
   const bool unary = is_unary(op);
   const bool compare = is_compare(op);
   const int digits = hex_digits(f);
@@ -375,31 +421,7 @@ void float_gen(const FloatGenOptions& opts, std::ostream& out) {
   for (std::uint64_t i = 0; i < opts.count; ++i) {
     std::uint32_t a;
     std::uint32_t b;
-    switch (rng() % 4) {
-      case 0:  // edge against edge
-        a = edges[rng() % edges.size()];
-        b = edges[rng() % edges.size()];
-        break;
-      case 1:  // edge against random
-        a = edges[rng() % edges.size()];
-        b = random_operand();
-        if (rng() % 2) std::swap(a, b);
-        break;
-      case 2: {  // nearby exponents: cancellation, carries, ties
-        a = random_operand();
-        const int ea = static_cast<int>((a >> f.man_bits) & top);
-        const int span = f.man_bits + 2;
-        const int eb = std::clamp(ea + static_cast<int>(rng() % (2 * span + 1)) - span, 0,
-                                  static_cast<int>(top));
-        b = (static_cast<std::uint32_t>(rng()) & sign) |
-            enc(static_cast<std::uint32_t>(eb), random_mantissa());
-        break;
-      }
-      default:
-        a = random_operand();
-        b = random_operand();
-        break;
-    }
+    random_pair(rng, f, edges, &a, &b);
     const std::uint32_t r = eval(op, a, b, f, m);
     append_hex(&buffer, a, digits);
     buffer.push_back(' ');

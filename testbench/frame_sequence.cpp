@@ -266,20 +266,26 @@ double SequenceResult::break_even_mb_s() const {
   return worst;
 }
 
-SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
-                            const RenderSettings& settings, const SequenceOptions& opts,
-                            const FrameSink& sink) {
-  check_options(model, opts);
-  const bool cycle = model.kind == ModelKind::kCycle;
-  units::CycleParams cp;
-  if (cycle) cp = resolve_cycle_params(settings.cycle);  // a bad --set fails before the load
-  RenderSettings s = settings;
-  s.time = opts.start;
-  s.top_level_buffers = opts.frame_gap ? 1 : 2;
-  PreparedScene prep = prepare_scene(spec, s, ff::Format{7, model.mantissa});
-  host::BuiltImage& host = prep.built;
-  host::Scene& scene = prep.scene;
+namespace {
 
+// What stays fixed over one sequence's frames.
+struct SequenceRun {
+  const SequenceOptions& opts;
+  const RenderSettings& s;
+  const units::CycleParams& cp;
+  const units::FunctionalParams& fparams;
+  bool cycle;
+  host::Scene& scene;
+  host::BuiltImage& host;
+  memif::MemoryImage& board;
+  Heartbeat& beat;
+  const FrameSink& sink;
+};
+
+SequenceResult sequence_header(const std::string& spec, const ModelSpec& model,
+                               const RenderSettings& s, const SequenceOptions& opts,
+                               const units::CycleParams& cp, bool cycle, const host::Scene& scene,
+                               const host::BuiltImage& host) {
   SequenceResult r;
   r.scene = spec;
   r.model = model.name;
@@ -297,13 +303,14 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
   r.top_copy_bytes = 8ull * host.top_node_capacity + 4ull * host.top_list_capacity +
                      4ull * static_cast<std::uint64_t>(ff::row_words(host.params.format)) *
                          memif::kInstanceRows * host.instances.size();
-  const units::FunctionalParams fparams =
-      cycle ? units::functional_params(cp, functional_params(s)) : functional_params(s);
+  return r;
+}
 
-  // The initial load: the board's banks written over the bus before anything renders.
+// The initial load: the board's banks written over the bus before anything renders.
+void initial_upload(memif::MemoryImage& board, const host::BuiltImage& host,
+                    const units::CycleParams& cp, bool cycle, SequenceResult& r) {
   const memif::HostUpload load = initial_load(host);
   r.initial_load_bytes = load.bytes();
-  memif::MemoryImage board(host.image.format(), host.image.bank_words());
   if (cycle) {
     progress("uploading the scene over the host bus (" + std::to_string(load.bytes()) + " bytes)");
     r.initial_load_cycles = upload_alone(board, cp, load);
@@ -311,6 +318,79 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
     apply_runs(board, load.runs);
   }
   require_same_data(board, host.image, 0);
+}
+
+// One frame: the swap, the render (with the next frame's upload beside it on the cycle model),
+// the check, the sink; then the next frame's row becomes current.
+void run_frame(SequenceRun& run, int k, SequenceFrame& cur, SequenceResult& r) {
+  const auto t0 = Clock::now();
+  const SequenceOptions& opts = run.opts;
+  host::BuiltImage& host = run.host;
+  memif::MemoryImage& board = run.board;
+  // The swap: the registers the host sent latch, the frame buffers alternate.
+  cur.index = k;
+  cur.frame_bank = k % 2 == 0 ? memif::kFrameBank0 : memif::kFrameBank1;
+  cur.top_copy = static_cast<int>(host.top_buffer);
+  host.image.registers().frame_bank = static_cast<std::uint32_t>(cur.frame_bank);
+  board.registers() = host.image.registers();
+  board.regions() = host.image.regions();  // they move only with a relayout (in a gap)
+  const std::vector<memif::BankRange> reads = host::frame_reads(host, cur.frame_bank);
+  units::FunctionalFrame reference;
+  if (!run.cycle || opts.check) reference = units::run_functional(board, run.fparams);
+  // The host prepares the next frame while this one renders.
+  const bool more = k + 1 < opts.frames;
+  NextFrame next;
+  if (more) next = prepare_next(run.scene, host, board, reads, k + 1, opts.start + (k + 1) * r.dt);
+  std::uint64_t gap_cycles = 0;
+  units::FunctionalFrame frame;
+  if (run.cycle) {
+    const CycleRunOptions ro = cycle_run_options(run.s, run.beat, k, opts.frames);
+    CycleFrame c = more && !next.row.gap ? run_cycle(board, run.cp, ro, next.upload)
+                                         : run_cycle(std::as_const(board), run.cp, ro);
+    if (more && next.row.gap) gap_cycles = upload_alone(board, run.cp, next.upload);
+    next.row.upload_cycles = c.upload_cycles;
+    take_figures(cur, c);
+    if (opts.check) {
+      check_frame(c.frame, reference, k, cur.time);
+      cur.checked = true;
+    }
+    frame = std::move(c.frame);
+  } else {
+    if (more) apply_runs(board, next.upload.runs);
+    cur.rays = rays_of(reference);
+    frame = std::move(reference);
+  }
+  if (more) require_same_data(board, host.image, k + 1);
+  cur.digest = digest(frame);
+  cur.host_seconds = seconds_since(t0);
+  if (run.sink) run.sink(cur, image_of(frame));
+  run.beat.beat("frame " + std::to_string(k + 1) + " / " + std::to_string(opts.frames) + " done");
+  if (more && run.cycle) place(next.row, cur, gap_cycles);
+  r.frames.push_back(cur);
+  if (more) cur = next.row;
+}
+
+}  // namespace
+
+SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
+                            const RenderSettings& settings, const SequenceOptions& opts,
+                            const FrameSink& sink) {
+  check_options(model, opts);
+  const bool cycle = model.kind == ModelKind::kCycle;
+  units::CycleParams cp;
+  if (cycle) cp = resolve_cycle_params(settings.cycle);  // a bad --set fails before the load
+  RenderSettings s = settings;
+  s.time = opts.start;
+  s.top_level_buffers = opts.frame_gap ? 1 : 2;
+  PreparedScene prep = prepare_scene(spec, s, ff::Format{7, model.mantissa});
+  host::BuiltImage& host = prep.built;
+  host::Scene& scene = prep.scene;
+
+  SequenceResult r = sequence_header(spec, model, s, opts, cp, cycle, scene, host);
+  const units::FunctionalParams fparams =
+      cycle ? units::functional_params(cp, functional_params(s)) : functional_params(s);
+  memif::MemoryImage board(host.image.format(), host.image.bank_words());
+  initial_upload(board, host, cp, cycle, r);
 
   Heartbeat beat("sequence", s.heartbeat && heartbeat_enabled());
   SequenceFrame cur;
@@ -319,57 +399,18 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
   cur.top_level_builds = host.stats.top_level_builds;
   cur.bottom_level_builds = host.stats.bottom_level_builds;
   cur.host_rebuild_seconds = host.stats.top_build_seconds;
-  for (int k = 0; k < opts.frames; ++k) {
-    const auto t0 = Clock::now();
-    // The swap: the registers the host sent latch, the frame buffers alternate.
-    cur.index = k;
-    cur.frame_bank = k % 2 == 0 ? memif::kFrameBank0 : memif::kFrameBank1;
-    cur.top_copy = static_cast<int>(host.top_buffer);
-    host.image.registers().frame_bank = static_cast<std::uint32_t>(cur.frame_bank);
-    board.registers() = host.image.registers();
-    board.regions() = host.image.regions();  // they move only with a relayout (in a gap)
-    const std::vector<memif::BankRange> reads = host::frame_reads(host, cur.frame_bank);
-    units::FunctionalFrame reference;
-    if (!cycle || opts.check) reference = units::run_functional(board, fparams);
-    // The host prepares the next frame while this one renders.
-    const bool more = k + 1 < opts.frames;
-    NextFrame next;
-    if (more) next = prepare_next(scene, host, board, reads, k + 1, opts.start + (k + 1) * r.dt);
-    std::uint64_t gap_cycles = 0;
-    units::FunctionalFrame frame;
-    if (cycle) {
-      const CycleRunOptions ro = cycle_run_options(s, beat, k, opts.frames);
-      CycleFrame c = more && !next.row.gap ? run_cycle(board, cp, ro, next.upload)
-                                           : run_cycle(std::as_const(board), cp, ro);
-      if (more && next.row.gap) gap_cycles = upload_alone(board, cp, next.upload);
-      next.row.upload_cycles = c.upload_cycles;
-      take_figures(cur, c);
-      if (opts.check) {
-        check_frame(c.frame, reference, k, cur.time);
-        cur.checked = true;
-      }
-      frame = std::move(c.frame);
-    } else {
-      if (more) apply_runs(board, next.upload.runs);
-      cur.rays = rays_of(reference);
-      frame = std::move(reference);
-    }
-    if (more) require_same_data(board, host.image, k + 1);
-    cur.digest = digest(frame);
-    cur.host_seconds = seconds_since(t0);
-    if (sink) sink(cur, image_of(frame));
-    beat.beat("frame " + std::to_string(k + 1) + " / " + std::to_string(opts.frames) + " done");
-    if (more && cycle) place(next.row, cur, gap_cycles);
-    r.frames.push_back(cur);
-    if (more) cur = next.row;
-  }
+  SequenceRun run{opts, s, cp, fparams, cycle, scene, host, board, beat, sink};
+  for (int k = 0; k < opts.frames; ++k)
+    run_frame(run, k, cur, r);
   beat.finish("frames " + std::to_string(opts.frames) + " / " + std::to_string(opts.frames));
   return r;
 }
 
 // ---- report ---------------------------------------------------------------------------------
 
-std::string sequence_table(const SequenceResult& r) {
+namespace {
+
+std::string table_header(const SequenceResult& r) {
   std::string s;
   char buf[400];
   std::snprintf(
@@ -396,37 +437,46 @@ std::string sequence_table(const SequenceResult& r) {
   } else {
     s += "frame  time s bank copy moved top bot  upload B  gap  rebuild ms\n";
   }
-  for (const SequenceFrame& f : r.frames) {
-    std::snprintf(buf, sizeof buf, "%5d %7.3f %4d %4d %5u %3" PRIu64 " %3" PRIu64 " ", f.index,
-                  f.time, f.frame_bank, f.top_copy, f.moved_instances, f.top_level_builds,
-                  f.bottom_level_builds);
+  return s;
+}
+
+std::string table_row(const SequenceResult& r, const SequenceFrame& f) {
+  std::string s;
+  char buf[400];
+  std::snprintf(buf, sizeof buf, "%5d %7.3f %4d %4d %5u %3" PRIu64 " %3" PRIu64 " ", f.index,
+                f.time, f.frame_bank, f.top_copy, f.moved_instances, f.top_level_builds,
+                f.bottom_level_builds);
+  s += buf;
+  if (f.index == 0) {
+    s += r.cycle ? "   (initial load)                   " : "   (initial load)";
+  } else if (r.cycle) {
+    std::snprintf(buf, sizeof buf, "%9" PRIu64 " %11" PRIu64 " %-6s %8" PRIu64 " ", f.upload_bytes,
+                  f.upload_cycles,
+                  f.gap      ? "gap"
+                  : f.hidden ? "yes"
+                             : "no",
+                  f.stall_cycles);
     s += buf;
-    if (f.index == 0) {
-      s += r.cycle ? "   (initial load)                   " : "   (initial load)";
-    } else if (r.cycle) {
-      std::snprintf(buf, sizeof buf, "%9" PRIu64 " %11" PRIu64 " %-6s %8" PRIu64 " ",
-                    f.upload_bytes, f.upload_cycles,
-                    f.gap      ? "gap"
-                    : f.hidden ? "yes"
-                               : "no",
-                    f.stall_cycles);
-      s += buf;
-    } else {
-      std::snprintf(buf, sizeof buf, "%9" PRIu64 "  %-3s", f.upload_bytes, f.gap ? "yes" : "no");
-      s += buf;
-    }
-    if (r.cycle) {
-      std::snprintf(buf, sizeof buf,
-                    "%11" PRIu64 " %6.1f %4.0f %4.0f %4.0f %4.0f %4.0f %2.0f %2.0f", f.cycles,
-                    f.fps, f.figures.usage(0), f.figures.usage(1), f.figures.usage(2),
-                    f.figures.usage(3), f.figures.cache_hit(0), f.figures.cache_hit(1),
-                    f.figures.cache_hit(2));
-      s += buf;
-    }
-    // The host's top-level (re)build on this machine: not on the model's clock (D46).
-    std::snprintf(buf, sizeof buf, " %11.2f\n", f.host_rebuild_seconds * 1e3);
+  } else {
+    std::snprintf(buf, sizeof buf, "%9" PRIu64 "  %-3s", f.upload_bytes, f.gap ? "yes" : "no");
     s += buf;
   }
+  if (r.cycle) {
+    std::snprintf(buf, sizeof buf, "%11" PRIu64 " %6.1f %4.0f %4.0f %4.0f %4.0f %4.0f %2.0f %2.0f",
+                  f.cycles, f.fps, f.figures.usage(0), f.figures.usage(1), f.figures.usage(2),
+                  f.figures.usage(3), f.figures.cache_hit(0), f.figures.cache_hit(1),
+                  f.figures.cache_hit(2));
+    s += buf;
+  }
+  // The host's top-level (re)build on this machine: not on the model's clock (D46).
+  std::snprintf(buf, sizeof buf, " %11.2f\n", f.host_rebuild_seconds * 1e3);
+  s += buf;
+  return s;
+}
+
+std::string table_summary(const SequenceResult& r) {
+  std::string s;
+  char buf[400];
   const nlohmann::json j = sequence_json(r);
   const nlohmann::json& sum = j["summary"];
   std::snprintf(buf, sizeof buf,
@@ -450,6 +500,15 @@ std::string sequence_table(const SequenceResult& r) {
     s += buf;
   }
   return s;
+}
+
+}  // namespace
+
+std::string sequence_table(const SequenceResult& r) {
+  std::string s = table_header(r);
+  for (const SequenceFrame& f : r.frames)
+    s += table_row(r, f);
+  return s + table_summary(r);
 }
 
 // ---- bus sweep ------------------------------------------------------------------------------

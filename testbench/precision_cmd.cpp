@@ -237,110 +237,138 @@ std::string precision_table(const std::vector<PrecisionRow>& rows) {
   return s;
 }
 
-PrecisionPlot plot_precision(const std::vector<PrecisionRow>& rows, const std::string& title) {
-  if (rows.empty()) throw std::runtime_error("precision plot: no rows");
-  constexpr int kW = 720, kH = 440;
-  constexpr int kLeft = 80, kRight = kW - 80, kTop = 60, kBottom = kH - 70;
-  const Rgb white{255, 255, 255}, black{0, 0, 0}, grey{170, 170, 170};
-  const Rgb blue{kSameColour[0], kSameColour[1], kSameColour[2]};
-  const Rgb red{kPsnrColour[0], kPsnrColour[1], kPsnrColour[2]};
-  Canvas cv(kW, kH, white);
+namespace {
 
-  // Ranges. x: the mantissas (padded when there is one). Left: share, from a round floor below
-  // the smallest value (and below the 99 % guide) to 100. Right: PSNR from 0 to a round ceiling;
-  // identical images (infinite PSNR) are drawn at the top and labelled.
-  int mlo = rows.front().mantissa, mhi = rows.back().mantissa;
-  if (mlo == mhi) {
-    --mlo;
-    ++mhi;
+constexpr int kW = 720, kH = 440;
+constexpr int kLeft = 80, kRight = kW - 80, kTop = 60, kBottom = kH - 70;
+const Rgb kWhite{255, 255, 255}, kBlack{0, 0, 0}, kGrey{170, 170, 170};
+const Rgb kBlue{kSameColour[0], kSameColour[1], kSameColour[2]};
+const Rgb kRed{kPsnrColour[0], kPsnrColour[1], kPsnrColour[2]};
+
+// Ranges. x: the mantissas (padded when there is one). Left: share, from a round floor below
+// the smallest value (and below the 99 % guide) to 100. Right: PSNR from 0 to a round ceiling;
+// identical images (infinite PSNR) are drawn at the top and labelled.
+struct PlotAxes {
+  int mlo = 0, mhi = 0;
+  double sstep = 0.1, slo = 0.0;
+  double pstep = 20.0, phi = 0.0;
+  bool any_inf = false;
+
+  int xmap(double m) const {
+    return kLeft + static_cast<int>(std::lround((m - mlo) / (mhi - mlo) * (kRight - kLeft)));
+  }
+  int ys(double v) const {
+    return kBottom - static_cast<int>(std::lround((v - slo) / (100.0 - slo) * (kBottom - kTop)));
+  }
+  int yp(double v) const {
+    if (!std::isfinite(v)) v = phi;
+    v = std::clamp(v, 0.0, phi);
+    return kBottom - static_cast<int>(std::lround(v / phi * (kBottom - kTop)));
+  }
+};
+
+PlotAxes plot_axes(const std::vector<PrecisionRow>& rows) {
+  PlotAxes a;
+  a.mlo = rows.front().mantissa;
+  a.mhi = rows.back().mantissa;
+  if (a.mlo == a.mhi) {
+    --a.mlo;
+    ++a.mhi;
   }
   double smin = 99.0;
   double pmax = 40.0;
-  bool any_inf = false;
   for (const PrecisionRow& r : rows) {
     smin = std::min(smin, r.same_triangle_pct);
     if (std::isfinite(r.psnr_db)) {
       pmax = std::max(pmax, r.psnr_db);
     } else {
-      any_inf = true;
+      a.any_inf = true;
     }
   }
   // A tick step from 1-2-5 steps giving at most six intervals.
-  double sstep = 0.1;
   for (double st : {0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0}) {
-    sstep = st;
+    a.sstep = st;
     if ((100.0 - smin) / st <= 6.0) break;
   }
-  const double slo = std::max(0.0, std::floor(smin / sstep - 1e-9) * sstep);
-  const double pstep = 20.0;
-  const double phi = std::ceil((pmax + (any_inf ? 10.0 : 1.0)) / pstep) * pstep;
-  auto xmap = [&](double m) {
-    return kLeft + static_cast<int>(std::lround((m - mlo) / (mhi - mlo) * (kRight - kLeft)));
-  };
-  auto ys = [&](double v) {
-    return kBottom - static_cast<int>(std::lround((v - slo) / (100.0 - slo) * (kBottom - kTop)));
-  };
-  auto yp = [&](double v) {
-    if (!std::isfinite(v)) v = phi;
-    v = std::clamp(v, 0.0, phi);
-    return kBottom - static_cast<int>(std::lround(v / phi * (kBottom - kTop)));
-  };
+  a.slo = std::max(0.0, std::floor(smin / a.sstep - 1e-9) * a.sstep);
+  a.phi = std::ceil((pmax + (a.any_inf ? 10.0 : 1.0)) / a.pstep) * a.pstep;
+  return a;
+}
 
-  // Guides first, so curves draw over them.
-  cv.line(xmap(16), kTop, xmap(16), kBottom, grey, 1, 4);
-  cv.text(xmap(16) - Canvas::text_width("FP24", 1) / 2, kTop - 10, "FP24", grey, 1);
-  cv.line(kLeft, ys(99.0), kRight, ys(99.0), blue, 1, 3);
-  cv.line(kLeft, yp(35.0), kRight, yp(35.0), red, 1, 3);
-
-  // Axes, ticks and labels.
-  cv.line(kLeft, kTop, kLeft, kBottom, black);
-  cv.line(kRight, kTop, kRight, kBottom, black);
-  cv.line(kLeft, kBottom, kRight, kBottom, black);
-  for (int m = mlo; m <= mhi; ++m) {
-    const int x = xmap(m);
-    cv.line(x, kBottom, x, kBottom + 5, black);
+// Axes, ticks and labels.
+void draw_axes(Canvas& cv, const PlotAxes& a) {
+  cv.line(kLeft, kTop, kLeft, kBottom, kBlack);
+  cv.line(kRight, kTop, kRight, kBottom, kBlack);
+  cv.line(kLeft, kBottom, kRight, kBottom, kBlack);
+  for (int m = a.mlo; m <= a.mhi; ++m) {
+    const int x = a.xmap(m);
+    cv.line(x, kBottom, x, kBottom + 5, kBlack);
     const std::string l = std::to_string(m);
-    cv.text(x - Canvas::text_width(l) / 2, kBottom + 10, l, black);
+    cv.text(x - Canvas::text_width(l) / 2, kBottom + 10, l, kBlack);
   }
   const std::string xl = "MANTISSA BITS M  (FLOAT<7,M>)";
-  cv.text((kLeft + kRight - Canvas::text_width(xl)) / 2, kBottom + 35, xl, black);
-  for (int k = 0; slo + k * sstep <= 100.0 + 1e-9; ++k) {
-    const double v = slo + k * sstep;
-    const int y = ys(v);
-    cv.line(kLeft - 5, y, kLeft, y, blue);
-    const std::string l = fmt(sstep < 1.0 ? "%.1f" : "%.0f", v);
-    cv.text(kLeft - 8 - Canvas::text_width(l), y - 7, l, blue);
+  cv.text((kLeft + kRight - Canvas::text_width(xl)) / 2, kBottom + 35, xl, kBlack);
+  for (int k = 0; a.slo + k * a.sstep <= 100.0 + 1e-9; ++k) {
+    const double v = a.slo + k * a.sstep;
+    const int y = a.ys(v);
+    cv.line(kLeft - 5, y, kLeft, y, kBlue);
+    const std::string l = fmt(a.sstep < 1.0 ? "%.1f" : "%.0f", v);
+    cv.text(kLeft - 8 - Canvas::text_width(l), y - 7, l, kBlue);
   }
-  for (double v = 0.0; v <= phi + 1e-9; v += pstep) {
-    const int y = yp(v);
-    cv.line(kRight, y, kRight + 5, y, red);
-    cv.text(kRight + 8, y - 7, fmt("%.0f", v), red);
+  for (double v = 0.0; v <= a.phi + 1e-9; v += a.pstep) {
+    const int y = a.yp(v);
+    cv.line(kRight, y, kRight + 5, y, kRed);
+    cv.text(kRight + 8, y - 7, fmt("%.0f", v), kRed);
   }
-  cv.text(8, kTop - 26, "SAME TRIANGLE %", blue);
+}
+
+void draw_labels(Canvas& cv, const PlotAxes& a, const std::string& title) {
+  cv.text(8, kTop - 26, "SAME TRIANGLE %", kBlue);
   const std::string rl = "PSNR DB";
-  cv.text(kW - 8 - Canvas::text_width(rl), kTop - 26, rl, red);
+  cv.text(kW - 8 - Canvas::text_width(rl), kTop - 26, rl, kRed);
   std::string t = title;
   if (t.size() > 56) t = "..." + t.substr(t.size() - 53);
-  cv.text((kW - Canvas::text_width(t)) / 2, 6, t, black);
-  if (any_inf) cv.text(kRight - Canvas::text_width("INF", 1) - 2, yp(phi) + 4, "INF", red, 1);
+  cv.text((kW - Canvas::text_width(t)) / 2, 6, t, kBlack);
+  if (a.any_inf) {
+    cv.text(kRight - Canvas::text_width("INF", 1) - 2, a.yp(a.phi) + 4, "INF", kRed, 1);
+  }
+}
 
-  // Curves with square markers.
+// Curves with square markers.
+PrecisionPlot draw_curves(Canvas& cv, const PlotAxes& a, const std::vector<PrecisionRow>& rows) {
   PrecisionPlot plot;
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    const PixelCoord s{xmap(rows[i].mantissa), ys(rows[i].same_triangle_pct)};
-    const PixelCoord p{xmap(rows[i].mantissa), yp(rows[i].psnr_db)};
+    const PixelCoord s{a.xmap(rows[i].mantissa), a.ys(rows[i].same_triangle_pct)};
+    const PixelCoord p{a.xmap(rows[i].mantissa), a.yp(rows[i].psnr_db)};
     if (i > 0) {
-      cv.line(plot.same_points.back().x, plot.same_points.back().y, s.x, s.y, blue, 2);
-      cv.line(plot.psnr_points.back().x, plot.psnr_points.back().y, p.x, p.y, red, 2);
+      cv.line(plot.same_points.back().x, plot.same_points.back().y, s.x, s.y, kBlue, 2);
+      cv.line(plot.psnr_points.back().x, plot.psnr_points.back().y, p.x, p.y, kRed, 2);
     }
     plot.same_points.push_back(s);
     plot.psnr_points.push_back(p);
   }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const PixelCoord s = plot.same_points[i], p = plot.psnr_points[i];
-    cv.rect(p.x - 3, p.y - 3, p.x + 3, p.y + 3, red);
-    cv.rect(s.x - 3, s.y - 3, s.x + 3, s.y + 3, blue);
+    cv.rect(p.x - 3, p.y - 3, p.x + 3, p.y + 3, kRed);
+    cv.rect(s.x - 3, s.y - 3, s.x + 3, s.y + 3, kBlue);
   }
+  return plot;
+}
+
+}  // namespace
+
+PrecisionPlot plot_precision(const std::vector<PrecisionRow>& rows, const std::string& title) {
+  if (rows.empty()) throw std::runtime_error("precision plot: no rows");
+  Canvas cv(kW, kH, kWhite);
+  const PlotAxes a = plot_axes(rows);
+  // Guides first, so curves draw over them.
+  cv.line(a.xmap(16), kTop, a.xmap(16), kBottom, kGrey, 1, 4);
+  cv.text(a.xmap(16) - Canvas::text_width("FP24", 1) / 2, kTop - 10, "FP24", kGrey, 1);
+  cv.line(kLeft, a.ys(99.0), kRight, a.ys(99.0), kBlue, 1, 3);
+  cv.line(kLeft, a.yp(35.0), kRight, a.yp(35.0), kRed, 1, 3);
+  draw_axes(cv, a);
+  draw_labels(cv, a, title);
+  PrecisionPlot plot = draw_curves(cv, a, rows);
   plot.image = cv.take();
   return plot;
 }

@@ -145,47 +145,57 @@ json bottom_json(const Trees& t, const host::Scene& scene) {
               {"objects", per_object}};
 }
 
-}  // namespace
-
-int run_scene(const SceneOptions& options) {
+void check_scene_options(const SceneOptions& options) {
   if (!(options.bank_mb > 0.0) || options.bank_mb > 16384.0)
     throw std::runtime_error("--bank-mb must be in (0, 16384], got " +
                              std::to_string(options.bank_mb));
   if (!std::isfinite(options.time) || options.time < 0.0)
     throw std::runtime_error("--time must be a finite number >= 0, got " +
                              std::to_string(options.time));
-  const auto t0 = std::chrono::steady_clock::now();
-  host::Scene scene = host::load_scene(options.scene);
-  const double load_seconds = seconds_since(t0);
-  if (options.time != 0.0) scene.set_time(options.time);
-  if (!options.export_path.empty()) host::export_gltf(scene, options.export_path);
+}
 
+// The memory image, or when it does not fit its banks the reason and the trees built alone.
+struct SceneImage {
   std::optional<host::BuiltImage> built;
-  std::string image_error;
-  const auto t1 = std::chrono::steady_clock::now();
+  std::string error;
   host::ImageParams params;
-  params.bank_words = static_cast<std::uint32_t>(std::llround(options.bank_mb * 262144.0));
-  for (const std::string& kv : options.set)
-    host::apply_tree_setting(params, kv);
-  try {
-    built = host::build_image(scene, params);
-  } catch (const std::runtime_error& e) {
-    image_error = e.what();
-  }
   Trees trees;
-  if (built) {
-    trees.top = built->top.stats;
-    for (std::size_t o = 0; o < built->objects.size(); ++o)
-      if (built->objects[o].stored)
-        trees.bottom.emplace_back(static_cast<std::uint32_t>(o), built->objects[o].tree.stats);
-  } else {
-    trees = build_trees_directly(scene, params);
-  }
-  const double image_seconds = seconds_since(t1);
+  double seconds = 0.0;
+};
 
+SceneImage build_scene_image(const host::Scene& scene, const SceneOptions& options) {
+  SceneImage img;
+  const auto t1 = std::chrono::steady_clock::now();
+  img.params.bank_words = static_cast<std::uint32_t>(std::llround(options.bank_mb * 262144.0));
+  for (const std::string& kv : options.set)
+    host::apply_tree_setting(img.params, kv);
+  try {
+    img.built = host::build_image(scene, img.params);
+  } catch (const std::runtime_error& e) {
+    img.error = e.what();
+  }
+  if (img.built) {
+    const host::BuiltImage& built = *img.built;
+    img.trees.top = built.top.stats;
+    for (std::size_t o = 0; o < built.objects.size(); ++o)
+      if (built.objects[o].stored)
+        img.trees.bottom.emplace_back(static_cast<std::uint32_t>(o), built.objects[o].tree.stats);
+  } else {
+    img.trees = build_trees_directly(scene, img.params);
+  }
+  img.seconds = seconds_since(t1);
+  return img;
+}
+
+std::uint64_t dynamic_instances(const host::Scene& scene) {
   std::uint64_t dynamic = 0;
   for (const host::Instance& i : scene.instances)
     dynamic += i.dynamic ? 1 : 0;
+  return dynamic;
+}
+
+json scene_json(const SceneOptions& options, const host::Scene& scene, double load_seconds,
+                const SceneImage& img) {
   json j;
   j["scene"] = options.scene;
   j["time"] = scene.time;
@@ -193,7 +203,7 @@ int run_scene(const SceneOptions& options) {
   j["unique_triangles"] = scene.unique_triangles();
   j["objects"] = scene.objects.size();
   j["instances"] = scene.instances.size();
-  j["dynamic_instances"] = dynamic;
+  j["dynamic_instances"] = dynamic_instances(scene);
   j["materials"] = scene.materials.size();
   j["textures"] = scene.textures.size();
   j["lights"] = scene.lights.size();
@@ -209,22 +219,22 @@ int run_scene(const SceneOptions& options) {
   j["skipped_primitives"] = scene.skipped_primitives;
   j["warnings"] = scene.warnings;
   j["load_seconds"] = load_seconds;
-  j["kdtree"] = json{{"top", tree_json(trees.top)}, {"bottom", bottom_json(trees, scene)}};
-  if (built) {
-    j["bytes_per_bank"] = built->stats.bytes_per_bank;
-    j["bank_bytes"] = static_cast<std::uint64_t>(params.bank_words) * 4u;
-    j["image_seconds"] = image_seconds;
+  j["kdtree"] = json{{"top", tree_json(img.trees.top)}, {"bottom", bottom_json(img.trees, scene)}};
+  if (img.built) {
+    j["bytes_per_bank"] = img.built->stats.bytes_per_bank;
+    j["bank_bytes"] = static_cast<std::uint64_t>(img.params.bank_words) * 4u;
+    j["image_seconds"] = img.seconds;
     j["image_error"] = nullptr;
   } else {
     j["bytes_per_bank"] = nullptr;
-    j["image_error"] = image_error;
+    j["image_error"] = img.error;
   }
   if (!options.export_path.empty()) j["exported"] = options.export_path;
+  return j;
+}
 
-  if (options.json) {
-    std::printf("%s\n", j.dump(2).c_str());
-    return 0;
-  }
+void print_scene_counts(const SceneOptions& options, const host::Scene& scene,
+                        double load_seconds) {
   std::printf("scene               %s (t = %.3f s)\n", options.scene.c_str(), scene.time);
   std::printf("triangles           %llu after instancing, %llu unique\n",
               static_cast<unsigned long long>(scene.instanced_triangles()),
@@ -236,7 +246,7 @@ int run_scene(const SceneOptions& options) {
               static_cast<unsigned long long>(scene.skipped_primitives));
   std::printf("objects             %zu\n", scene.objects.size());
   std::printf("instances           %zu (%llu dynamic)\n", scene.instances.size(),
-              static_cast<unsigned long long>(dynamic));
+              static_cast<unsigned long long>(dynamic_instances(scene)));
   std::printf("materials/textures  %zu / %zu\n", scene.materials.size(), scene.textures.size());
   std::printf("lights              %zu%s\n", scene.lights.size(),
               scene.light_defaulted ? " (default light)" : "");
@@ -252,25 +262,19 @@ int run_scene(const SceneOptions& options) {
               scene.cameras.empty() ? " (default framing)" : views.c_str());
   std::printf("animation           %.3f s\n", scene.animation_seconds);
   std::printf("load time           %.3f s\n", load_seconds);
-  const auto tree_line = [](const char* name, const KdTreeStats& s) {
-    std::printf(
-        "%-19s %u nodes, %u leaves (%u empty), %u chain links (%u mergeable), depth %u, %.2f "
-        "items/leaf, SAH %.2f, per ray %.2f steps / %.2f leaves / %.2f tests, %.3f s\n",
-        name, s.nodes, s.leaves, s.empty_leaves, s.empty_chain_links, s.mergeable_chain_links,
-        s.depth, s.items_per_leaf, s.sah_cost, s.expected_traversal_steps, s.expected_leaf_visits,
-        s.expected_item_tests, s.build_seconds);
-  };
-  tree_line("kd-tree top", trees.top);
-  const json b = j["kdtree"]["bottom"];
+}
+
+void print_tree_line(const char* name, const KdTreeStats& s) {
   std::printf(
-      "kd-tree bottom      %zu trees, %llu nodes (%.2f per triangle), %llu leaves (%llu empty), "
-      "%llu chain links (%llu mergeable), max depth %u, %.2f items/leaf, %.3f s\n",
-      trees.bottom.size(), b["nodes"].get<unsigned long long>(),
-      b["nodes_per_triangle"].get<double>(), b["leaves"].get<unsigned long long>(),
-      b["empty_leaves"].get<unsigned long long>(), b["empty_chain_links"].get<unsigned long long>(),
-      b["mergeable_chain_links"].get<unsigned long long>(), b["max_depth"].get<unsigned>(),
-      b["items_per_leaf"].get<double>(), b["build_seconds"].get<double>());
-  // Every tree's expectations, largest first (all of them in --json).
+      "%-19s %u nodes, %u leaves (%u empty), %u chain links (%u mergeable), depth %u, %.2f "
+      "items/leaf, SAH %.2f, per ray %.2f steps / %.2f leaves / %.2f tests, %.3f s\n",
+      name, s.nodes, s.leaves, s.empty_leaves, s.empty_chain_links, s.mergeable_chain_links,
+      s.depth, s.items_per_leaf, s.sah_cost, s.expected_traversal_steps, s.expected_leaf_visits,
+      s.expected_item_tests, s.build_seconds);
+}
+
+// Every tree's expectations, largest first (all of them in --json).
+void print_object_trees(const json& b) {
   std::vector<json> objs(b["objects"].begin(), b["objects"].end());
   std::stable_sort(objs.begin(), objs.end(), [](const json& x, const json& y) {
     return x["triangles"].get<std::uint64_t>() > y["triangles"].get<std::uint64_t>();
@@ -294,15 +298,54 @@ int run_scene(const SceneOptions& options) {
   }
   if (objs.size() > kShown)
     std::printf("  (%zu smaller trees: --json lists every tree)\n", objs.size() - kShown);
-  if (built) {
+}
+
+void print_trees(const Trees& trees, const json& j) {
+  print_tree_line("kd-tree top", trees.top);
+  const json b = j["kdtree"]["bottom"];
+  std::printf(
+      "kd-tree bottom      %zu trees, %llu nodes (%.2f per triangle), %llu leaves (%llu empty), "
+      "%llu chain links (%llu mergeable), max depth %u, %.2f items/leaf, %.3f s\n",
+      trees.bottom.size(), b["nodes"].get<unsigned long long>(),
+      b["nodes_per_triangle"].get<double>(), b["leaves"].get<unsigned long long>(),
+      b["empty_leaves"].get<unsigned long long>(), b["empty_chain_links"].get<unsigned long long>(),
+      b["mergeable_chain_links"].get<unsigned long long>(), b["max_depth"].get<unsigned>(),
+      b["items_per_leaf"].get<double>(), b["build_seconds"].get<double>());
+  print_object_trees(b);
+}
+
+void print_image(const SceneImage& img) {
+  if (img.built) {
     std::printf("bytes per bank     ");
-    for (std::uint64_t v : built->stats.bytes_per_bank)
+    for (std::uint64_t v : img.built->stats.bytes_per_bank)
       std::printf(" %llu", static_cast<unsigned long long>(v));
-    std::printf("  (of %llu each)\n", static_cast<unsigned long long>(params.bank_words) * 4ull);
-    std::printf("image build         %.3f s\n", image_seconds);
+    std::printf("  (of %llu each)\n",
+                static_cast<unsigned long long>(img.params.bank_words) * 4ull);
+    std::printf("image build         %.3f s\n", img.seconds);
   } else {
-    std::printf("memory image        does not build: %s\n", image_error.c_str());
+    std::printf("memory image        does not build: %s\n", img.error.c_str());
   }
+}
+
+}  // namespace
+
+int run_scene(const SceneOptions& options) {
+  check_scene_options(options);
+  const auto t0 = std::chrono::steady_clock::now();
+  host::Scene scene = host::load_scene(options.scene);
+  const double load_seconds = seconds_since(t0);
+  if (options.time != 0.0) scene.set_time(options.time);
+  if (!options.export_path.empty()) host::export_gltf(scene, options.export_path);
+
+  const SceneImage img = build_scene_image(scene, options);
+  const json j = scene_json(options, scene, load_seconds, img);
+  if (options.json) {
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
+  }
+  print_scene_counts(options, scene, load_seconds);
+  print_trees(img.trees, j);
+  print_image(img);
   for (const std::string& w : scene.warnings)
     std::printf("warning             %s\n", w.c_str());
   if (!options.export_path.empty())

@@ -142,6 +142,99 @@ std::pair<std::size_t, std::size_t> parse_shard(const std::string& text) {
   return {k - 1, n};
 }
 
+namespace {
+
+// Points are grouped by the trees they build: a point that varies kd.* keys has its own image
+// and its own functional reference frame (points with the same trees share both). The group
+// without kd.* keys reads `prepared`, and its reference gives functional_rays even when no
+// point of this shard belongs to it. One group's image is alive at a time.
+struct Group {
+  std::string trees;
+  std::vector<std::size_t> points;
+};
+
+std::vector<Group> group_by_trees(const std::vector<std::vector<std::string>>& points,
+                                  const SweepRun& run) {
+  std::vector<Group> groups = {{"", {}}};
+  for (std::size_t i = run.shard; i < points.size(); i += run.shards) {
+    std::string trees;
+    for (const std::string& kv : points[i])
+      if (host::is_tree_setting(kv)) trees += kv + " ";
+    auto g = std::ranges::find_if(groups, [&](const Group& x) { return x.trees == trees; });
+    if (g == groups.end()) {
+      groups.push_back({trees, {}});
+      g = groups.end() - 1;
+    }
+    g->points.push_back(i);
+  }
+  return groups;
+}
+
+// What every group of one sweep shares.
+struct SweepContext {
+  const std::vector<std::vector<std::string>>& points;
+  const PreparedScene& prepared;
+  const RenderSettings& settings;
+  const ModelSpec& cycle;
+  const ModelSpec& functional;
+  int jobs;
+  Heartbeat& beat;
+  std::atomic<std::size_t>& done;
+  std::size_t selected;
+};
+
+// One group: its image (rebuilt when it varies kd.* keys), its functional reference frame and
+// its points on the cycle model, each checked against the reference.
+std::vector<SweepPoint> run_group(const Group& g, const SweepContext& cx, SweepResult& r) {
+  const std::vector<std::vector<std::string>>& points = cx.points;
+  std::optional<PreparedScene> rebuilt;
+  RenderSettings group_settings = cx.settings;
+  group_settings.heartbeat = false;  // the sweep's heartbeat counts points instead of packets
+  if (!g.trees.empty()) {
+    const std::vector<std::string>& first = points[g.points.front()];
+    group_settings.cycle.set.insert(group_settings.cycle.set.end(), first.begin(), first.end());
+    rebuilt = cx.prepared;
+    build_prepared_image(*rebuilt, group_settings, cx.prepared.built.params.format);
+  }
+  const PreparedScene& prep = rebuilt ? *rebuilt : cx.prepared;
+  progress("functional " + r.functional_model + " model: the reference frame" +
+           (g.trees.empty() ? "" : " (" + g.trees.substr(0, g.trees.size() - 1) + ")"));
+  // Task 0 renders the reference; tasks 1.. the points, which wait for it only to compare.
+  std::promise<FrameResult> reference_promise;
+  std::shared_future<FrameResult> reference = reference_promise.get_future().share();
+  std::vector<SweepPoint> group_points(g.points.size());
+  run_tasks(g.points.size() + 1, cx.jobs, [&](std::size_t task) {
+    if (task == 0) {
+      try {
+        reference_promise.set_value(render_model(cx.functional, prep, group_settings));
+      } catch (...) {
+        reference_promise.set_exception(std::current_exception());
+        throw;
+      }
+      return;
+    }
+    const std::size_t i = g.points[task - 1];
+    RenderSettings s = cx.settings;
+    s.heartbeat = group_settings.heartbeat;
+    s.cycle.set.insert(s.cycle.set.end(), points[i].begin(), points[i].end());
+    if (cx.jobs > 1) {
+      run_beside_others(s);
+    }
+    const FrameResult f = render_model(cx.cycle, prep, s);
+    check_sweep_point(f, reference.get(), join_words(points[i]));
+    SweepPoint& p = group_points[task - 1];
+    p.index = i;
+    p.settings = points[i];
+    p.cycle = f.cycle;
+    cx.beat.beat("points " + std::to_string(++cx.done) + " / " + std::to_string(cx.selected) +
+                 (cx.jobs > 1 ? ", " + std::to_string(cx.jobs) + " at once" : ""));
+  });
+  if (g.trees.empty()) r.functional_rays = reference.get().rays;
+  return group_points;
+}
+
+}  // namespace
+
 SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedScene& prepared,
                              const RenderSettings& settings, const SweepRun& run) {
   SweepResult r;
@@ -156,79 +249,17 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
   const ModelSpec cycle = parse_model(wide ? "cycle-e7m23" : "cycle");
   const ModelSpec functional = parse_model(r.functional_model);
   const int jobs = std::max(1, run.jobs);
-
-  // Points are grouped by the trees they build: a point that varies kd.* keys has its own image
-  // and its own functional reference frame (points with the same trees share both). The group
-  // without kd.* keys reads `prepared`, and its reference gives functional_rays even when no
-  // point of this shard belongs to it. One group's image is alive at a time.
-  struct Group {
-    std::string trees;
-    std::vector<std::size_t> points;
-  };
-  std::vector<Group> groups = {{"", {}}};
-  for (std::size_t i = run.shard; i < points.size(); i += run.shards) {
-    std::string trees;
-    for (const std::string& kv : points[i])
-      if (host::is_tree_setting(kv)) trees += kv + " ";
-    auto g = std::ranges::find_if(groups, [&](const Group& x) { return x.trees == trees; });
-    if (g == groups.end()) {
-      groups.push_back({trees, {}});
-      g = groups.end() - 1;
-    }
-    g->points.push_back(i);
-  }
+  const std::vector<Group> groups = group_by_trees(points, run);
 
   Heartbeat beat("sweep", run.heartbeat && heartbeat_enabled());
   std::atomic<std::size_t> done{0};
   std::size_t selected = 0;
   for (const Group& g : groups)
     selected += g.points.size();
+  const SweepContext cx{points, prepared, settings, cycle, functional, jobs, beat, done, selected};
   std::vector<SweepPoint> results;
   for (const Group& g : groups) {
-    std::optional<PreparedScene> rebuilt;
-    RenderSettings group_settings = settings;
-    group_settings.heartbeat = false;  // the sweep's heartbeat counts points instead of packets
-    if (!g.trees.empty()) {
-      const std::vector<std::string>& first = points[g.points.front()];
-      group_settings.cycle.set.insert(group_settings.cycle.set.end(), first.begin(), first.end());
-      rebuilt = prepared;
-      build_prepared_image(*rebuilt, group_settings, prepared.built.params.format);
-    }
-    const PreparedScene& prep = rebuilt ? *rebuilt : prepared;
-    progress("functional " + r.functional_model + " model: the reference frame" +
-             (g.trees.empty() ? "" : " (" + g.trees.substr(0, g.trees.size() - 1) + ")"));
-    // Task 0 renders the reference; tasks 1.. the points, which wait for it only to compare.
-    std::promise<FrameResult> reference_promise;
-    std::shared_future<FrameResult> reference = reference_promise.get_future().share();
-    std::vector<SweepPoint> group_points(g.points.size());
-    run_tasks(g.points.size() + 1, jobs, [&](std::size_t task) {
-      if (task == 0) {
-        try {
-          reference_promise.set_value(render_model(functional, prep, group_settings));
-        } catch (...) {
-          reference_promise.set_exception(std::current_exception());
-          throw;
-        }
-        return;
-      }
-      const std::size_t i = g.points[task - 1];
-      RenderSettings s = settings;
-      s.heartbeat = group_settings.heartbeat;
-      s.cycle.set.insert(s.cycle.set.end(), points[i].begin(), points[i].end());
-      if (jobs > 1) {
-        run_beside_others(s);
-      }
-      const FrameResult f = render_model(cycle, prep, s);
-      check_sweep_point(f, reference.get(), join_words(points[i]));
-      SweepPoint& p = group_points[task - 1];
-      p.index = i;
-      p.settings = points[i];
-      p.cycle = f.cycle;
-      beat.beat("points " + std::to_string(++done) + " / " + std::to_string(selected) +
-                (jobs > 1 ? ", " + std::to_string(jobs) + " at once" : ""));
-    });
-    if (g.trees.empty()) r.functional_rays = reference.get().rays;
-    for (SweepPoint& p : group_points)
+    for (SweepPoint& p : run_group(g, cx, r))
       results.push_back(std::move(p));
   }
   beat.finish();

@@ -45,6 +45,91 @@ std::string words(const std::vector<std::string>& w) {
   return s;
 }
 
+std::runtime_error bad_line(std::size_t number, const std::string& why) {
+  return std::runtime_error("vector file line " + std::to_string(number) + ": " + why);
+}
+
+units::VectorUnit header_unit(const std::string& line, std::size_t number) {
+  try {
+    return units::parse_vector_unit(line.substr(8));
+  } catch (const std::runtime_error& e) {
+    throw bad_line(number, printable(e.what()));
+  }
+}
+
+// One field of a vector line: a 0/1 flag or a 6-digit hex fp24 encoding, by the field's name.
+std::uint32_t parse_field(const std::string& name, const std::string& tok, std::size_t number) {
+  std::size_t used = 0;
+  unsigned long v = 0;
+  try {
+    v = std::stoul(tok, &used, units::vector_field_is_flag(name) ? 10 : 16);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const unsigned long limit = units::vector_field_is_flag(name) ? 1u : 0xffffffu;
+  if (used != tok.size() || v > limit) {
+    std::string why = "field ";
+    why += name;
+    why += " '";
+    why += printable(tok);
+    why += "' is not ";
+    why += units::vector_field_is_flag(name) ? "0 or 1" : "a hex fp24 encoding";
+    throw bad_line(number, why);
+  }
+  return static_cast<std::uint32_t>(v);
+}
+
+std::vector<std::uint32_t> parse_fields(const std::string& line, std::size_t number,
+                                        const std::vector<std::string>& ins,
+                                        const std::vector<std::string>& outs) {
+  std::istringstream fields(line);
+  std::vector<std::uint32_t> values;
+  std::string tok;
+  while (fields >> tok) {
+    const std::size_t k = values.size();
+    const std::string& name = k < ins.size()                 ? ins[k]
+                              : k - ins.size() < outs.size() ? outs[k - ins.size()]
+                                                             : std::string("(extra)");
+    values.push_back(parse_field(name, tok, number));
+  }
+  return values;
+}
+
+// One vector line: its outputs against what the bit-accurate datapath computes from its inputs.
+void check_vector_line(const std::string& line, std::size_t number, VectorCheck& r) {
+  const auto& ins = units::vector_inputs(r.unit);
+  const auto& outs = units::vector_outputs(r.unit);
+  const std::vector<std::uint32_t> values = parse_fields(line, number, ins, outs);
+  if (values.size() != ins.size() + outs.size()) {
+    throw bad_line(number, std::to_string(values.size()) + " fields, a " +
+                               units::vector_unit_name(r.unit) + " vector has " +
+                               std::to_string(ins.size() + outs.size()));
+  }
+  const std::vector<std::uint32_t> input(values.begin(),
+                                         values.begin() + static_cast<long>(ins.size()));
+  std::vector<std::uint32_t> expected;
+  try {
+    expected = units::expected_outputs(r.unit, input);
+  } catch (const std::runtime_error& e) {
+    throw bad_line(number, e.what());
+  }
+  ++r.vectors;
+  bool differs = false;
+  for (std::size_t k = 0; k < outs.size(); ++k) {
+    const std::uint32_t got = values[ins.size() + k];
+    if (got == expected[k]) {
+      continue;
+    }
+    differs = true;
+    if (r.first_differences.size() < 5) {
+      r.first_differences.push_back("line " + std::to_string(number) + ": " + outs[k] + " is " +
+                                    field_text(outs[k], got) + ", the datapath gives " +
+                                    field_text(outs[k], expected[k]));
+    }
+  }
+  r.differing += differs ? 1 : 0;
+}
+
 }  // namespace
 
 std::string format_vector_file(units::VectorUnit unit, const units::VectorCapture& capture,
@@ -78,94 +163,32 @@ VectorCheck check_vector_text(const std::string& text) {
   std::size_t number = 0;
   bool have_unit = false;
   VectorCheck r;
-  auto bad = [&](const std::string& why) {
-    return std::runtime_error("vector file line " + std::to_string(number) + ": " + why);
-  };
   while (std::getline(in, line)) {
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF files read alike
     if (number == 1 && line != kMagic) {
-      throw bad("expected '" + std::string(kMagic) + "'");
+      throw bad_line(number, "expected '" + std::string(kMagic) + "'");
     }
     if (line.empty()) {
       continue;
     }
     if (line[0] == '#') {
       if (line.rfind("# unit: ", 0) == 0) {
-        try {
-          r.unit = units::parse_vector_unit(line.substr(8));
-        } catch (const std::runtime_error& e) {
-          throw bad(printable(e.what()));
-        }
+        r.unit = header_unit(line, number);
         have_unit = true;
       }
       continue;
     }
     if (!have_unit) {
-      throw bad("a vector before the '# unit: ' line");
+      throw bad_line(number, "a vector before the '# unit: ' line");
     }
-    const auto& ins = units::vector_inputs(r.unit);
-    const auto& outs = units::vector_outputs(r.unit);
-    std::istringstream fields(line);
-    std::vector<std::uint32_t> values;
-    std::string tok;
-    while (fields >> tok) {
-      const std::size_t k = values.size();
-      const std::string& name = k < ins.size()                 ? ins[k]
-                                : k - ins.size() < outs.size() ? outs[k - ins.size()]
-                                                               : std::string("(extra)");
-      std::size_t used = 0;
-      unsigned long v = 0;
-      try {
-        v = std::stoul(tok, &used, units::vector_field_is_flag(name) ? 10 : 16);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      const unsigned long limit = units::vector_field_is_flag(name) ? 1u : 0xffffffu;
-      if (used != tok.size() || v > limit) {
-        std::string why = "field ";
-        why += name;
-        why += " '";
-        why += printable(tok);
-        why += "' is not ";
-        why += units::vector_field_is_flag(name) ? "0 or 1" : "a hex fp24 encoding";
-        throw bad(why);
-      }
-      values.push_back(static_cast<std::uint32_t>(v));
-    }
-    if (values.size() != ins.size() + outs.size()) {
-      throw bad(std::to_string(values.size()) + " fields, a " + units::vector_unit_name(r.unit) +
-                " vector has " + std::to_string(ins.size() + outs.size()));
-    }
-    const std::vector<std::uint32_t> input(values.begin(),
-                                           values.begin() + static_cast<long>(ins.size()));
-    std::vector<std::uint32_t> expected;
-    try {
-      expected = units::expected_outputs(r.unit, input);
-    } catch (const std::runtime_error& e) {
-      throw bad(e.what());
-    }
-    ++r.vectors;
-    bool differs = false;
-    for (std::size_t k = 0; k < outs.size(); ++k) {
-      const std::uint32_t got = values[ins.size() + k];
-      if (got == expected[k]) {
-        continue;
-      }
-      differs = true;
-      if (r.first_differences.size() < 5) {
-        r.first_differences.push_back("line " + std::to_string(number) + ": " + outs[k] + " is " +
-                                      field_text(outs[k], got) + ", the datapath gives " +
-                                      field_text(outs[k], expected[k]));
-      }
-    }
-    r.differing += differs ? 1 : 0;
+    check_vector_line(line, number, r);
   }
   if (number == 0) {
-    throw bad("empty file");
+    throw bad_line(number, "empty file");
   }
   if (!have_unit) {
-    throw bad("no '# unit: ' line");
+    throw bad_line(number, "no '# unit: ' line");
   }
   return r;
 }
