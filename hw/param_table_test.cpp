@@ -33,7 +33,8 @@ const ParamTable<Config>& table() {
         .real("clock_mhz", &Config::clock, "MHz", 0.001, 1e5, "modelled clock")
         .boolean("reorder", &Config::reorder, "prefer the open bank")
         .choice("paths", &Config::paths, "paths", {1, 3}, "issue paths")
-        .real("inner.cost", [](auto& c) -> auto& { return c.inner.cost; }, "cost", 0, 10, "cost");
+        .real(
+            "inner.cost", [](auto& c) -> auto& { return c.inner.cost; }, "cost", 0, 10, "cost");
     return p;
   }();
   return t;
@@ -71,8 +72,8 @@ TEST(ParamTable, DefaultsAreTheStructsInitialisers) {
 
 TEST(ParamTable, ApplyThenDescribeGivesTheValuesBack) {
   Config c;
-  for (const char* kv : {"depth=-1", "limit=1e12", "cache.lines=64", "clock_mhz=120.5",
-                         "reorder=0", "paths=1", "inner.cost=0.25"})
+  for (const char* kv : {"depth=-1", "limit=1e12", "cache.lines=64", "clock_mhz=120.5", "reorder=0",
+                         "paths=1", "inner.cost=0.25"})
     table().apply(c, kv);
   EXPECT_EQ(c.depth, -1);
   EXPECT_EQ(c.limit, 1000000000000ull);
