@@ -1,10 +1,11 @@
-// The lockstep co-simulation (issue 34; docs/rtl.md "Lockstep"): the cycle model runs a frame and
-// the Verilated list unit (rtl/list_unit.sv) runs beside it, cycle by cycle. In every cycle the
-// RTL gets what the model's list unit gets (threads arriving on its paths with their payload,
-// packet starts, the cache's back-pressure, the cache responses with the SRAM words: the boundary
-// record's input events, units/boundary.h), and each of its outputs (cache requests, threads
-// leaving with their payload) is compared with the model's. Events are matched `window` cycles
-// behind the RTL's clock, so a divergence is classified with both sides' neighbourhood known:
+// The lockstep co-simulation (docs/rtl.md "The list unit in lockstep with the cycle model"): the
+// cycle model runs a frame and the Verilated list unit (rtl/list_unit.sv) runs beside it, cycle by
+// cycle. In every cycle the RTL gets what the model's list unit gets (threads arriving on its paths
+// with their payload, packet starts, the cache's back-pressure, the cache responses with the SRAM
+// words: the boundary record's input events, units/boundary.h), and each of its outputs (cache
+// requests, threads leaving with their payload) is compared with the model's. Events are matched
+// `window` cycles behind the RTL's clock, so a divergence is classified with both sides'
+// neighbourhood known:
 //   payload  the same port, cycle and thread, other bits;
 //   order    the same port and cycle, another thread;
 //   timing   the same event (port, thread, bits) in another cycle;

@@ -1,10 +1,10 @@
-// The boundary record (issue 34): one record per event on a port of a DynRTP unit, emitted
-// identically by the cycle model (through a UnitObserver, below) and by the RTL's port monitors
-// (rtl/lockstep.cpp), so the two can be compared cycle by cycle. A unit's ports (paper section 3.1,
-// Figure 2): its input paths (a thread arriving with the payload its sender hands over), its cache
-// port (a request with its item address and label; a response with the SRAM words), the side-band
-// inputs a unit needs from its neighbours (the list unit's packet start, D28), and its output
-// paths (a thread leaving with its payload).
+// The boundary record (docs/hw-interface.md): one record per event on a port of a DynRTP unit,
+// emitted identically by the cycle model (through a UnitObserver, below) and by the RTL's port
+// monitors (rtl/lockstep.cpp), so the two can be compared cycle by cycle. A unit's ports (paper
+// section 3.1, Figure 2): its input paths (a thread arriving with the payload its sender hands
+// over), its cache port (a request with its item address and label; a response with the SRAM
+// words), the side-band inputs a unit needs from its neighbours (the list unit's packet start,
+// D28), and its output paths (a thread leaving with its payload).
 //
 // What the payload of a port is for each unit is a BoundaryPayload's business: the default one
 // carries the thread program's request (phase, item, mask); units/boundary_list.h gives the
