@@ -58,6 +58,25 @@ struct Histogram {
   void sample(double v);
 };
 
+// The formulas the registry's derived figures are computed with (gem5's Formula operators), each
+// written once: a cache's hit rate and a memory client's bandwidth (memif/), and the Table 4
+// figures over the chip's sums of the same counters (units/figures.h).
+
+// part / whole; 0 when whole is 0.
+inline double ratio(std::uint64_t part, std::uint64_t whole) {
+  return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
+}
+// 100 part / whole; 0 when whole is 0.
+inline double percent(std::uint64_t part, std::uint64_t whole) {
+  return whole == 0 ? 0.0 : 100.0 * static_cast<double>(part) / static_cast<double>(whole);
+}
+// Bytes moved in `cycles` cycles at `clock_hz` as MB per second, MB = 2^20 bytes (D39); 0 over no
+// cycles.
+inline double mb_per_s(std::uint64_t bytes, std::uint64_t cycles, double clock_hz) {
+  if (cycles == 0) return 0.0;
+  return static_cast<double>(bytes) * clock_hz / static_cast<double>(cycles) / 1048576.0;
+}
+
 class Stats {
  public:
   enum class Kind { kCounter, kAverage, kHistogram, kFormula };
