@@ -101,12 +101,19 @@ std::vector<StatLine> cycle_stat_lines(const nlohmann::json& cycle);
 
 // ---- frame sequences (render --frames N) -------------------------------------------------------
 
-// The report (host timing only with host_times: each frame's top-level rebuild on this host, which
-// a run folder keeps in host.json) and the CSV of the frames (no host timing), both from the
-// per-frame rows' one declaration; the bus sweep's report (one sequence report per bandwidth).
+// The per-frame rows' columns and the summary's statistics are each declared once (kRowColumns,
+// kSummaryColumns in report.cpp). The report (host timing only with host_times: each frame's
+// top-level rebuild on this host, which a run folder keeps in host.json) and the CSV of the frames
+// (no host timing), both from the per-frame rows' one declaration; the bus sweep's report (one
+// sequence report per bandwidth).
 nlohmann::json sequence_json(const SequenceResult& r, bool host_times = false);
 std::string sequence_csv(const SequenceResult& r);
 nlohmann::json bus_sweep_json(const std::vector<SequenceResult>& points);
+// The printed per-frame table (with the host's rebuild times) and summary, and the bus sweep's
+// table (a row per bandwidth: its summary statistics), from the same declarations as the JSON,
+// the CSV and stats.txt.
+std::string sequence_table(const SequenceResult& r);
+std::string bus_sweep_table(const std::vector<SequenceResult>& points);
 // host.json of a sequence: each frame's host seconds and top-level rebuild seconds, and the
 // largest rebuild after frame 0.
 nlohmann::json sequence_host_json(const SequenceResult& r);
