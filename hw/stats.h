@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace saarcor::hw {
@@ -119,6 +120,9 @@ class Stats {
   // The series as sampled: the names of its columns, and its rows ([cycle, v0, v1, ...]).
   const std::vector<std::string>& time_series_names() const { return series_names_; }
   const std::vector<std::vector<double>>& time_series() const { return series_; }
+  // The column of the rows that holds counter `c` (column 0 is the cycle); throws
+  // std::logic_error when `c` is not sampled (no sample yet, or not this registry's).
+  std::size_t time_series_column(const Counter& c) const;
 
  private:
   struct Entry {
@@ -138,6 +142,7 @@ class Stats {
   std::uint64_t period_ = 0;
   std::vector<std::size_t> series_entries_;
   std::vector<std::string> series_names_;
+  std::unordered_map<const Counter*, std::size_t> series_columns_;
   std::vector<std::vector<double>> series_;
 };
 

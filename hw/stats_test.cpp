@@ -103,6 +103,14 @@ TEST(Stats, KernelSamplesTheTimeSeriesEveryPeriod) {
             "  [8, 2.75, 4, 4, 4, 0],\n"
             "  [12, 3.1666666666666665, 4, 4, 4, 0]]}\n");
   EXPECT_THROW(k.stats().counter("late", "x", "y"), std::logic_error);
+  // A counter's column found by reference: pusher.busy_cycles is the fourth name, column 4 (the
+  // cycle is column 0); 4 busy cycles in every sample. Formulas and histograms have none.
+  const Counter& busy = p.busy_counter();
+  EXPECT_EQ(k.stats().time_series_column(busy), 4u);
+  EXPECT_EQ(k.stats().time_series()[2][k.stats().time_series_column(busy)], 4.0);
+  EXPECT_EQ(k.stats().time_series_column(p.stall_counter()), 5u);
+  const Counter elsewhere;
+  EXPECT_THROW(k.stats().time_series_column(elsewhere), std::logic_error);
 }
 
 }  // namespace
