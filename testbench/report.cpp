@@ -12,11 +12,14 @@
 #include <string_view>
 
 #include "host/tree_settings.h"
+#include "testbench/compare.h"
+#include "testbench/cycle_render.h"
 #include "testbench/frame_sequence.h"
 #include "testbench/image_io.h"
 #include "testbench/paper_cmd.h"
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
+#include "testbench/scene_cmd.h"
 #include "testbench/sweep_cmd.h"
 
 namespace saarcor {
@@ -1217,11 +1220,73 @@ double paper_ratio(const PaperFigure& f) {
   return f.paper == 0.0 ? 0.0 : f.model / f.paper;
 }
 
+double stat(const nlohmann::json& cycle, const char* name) {
+  return json_at(cycle, name).get<double>();
+}
+
+// The paper's cycles per 4-ray packet and Mrays/s at its fps and resolution (90 MHz).
+void add_rate_figures(std::vector<PaperFigure>& v, const nlohmann::json& cycle, double fps,
+                      int width, int height) {
+  const double rays = fps * width * height;
+  v.push_back({"cycles_per_packet", stat(cycle, "cycles_per_packet"),
+               rays > 0.0 ? 90e6 / (rays / 4.0) : 0.0});
+  v.push_back({"mrays_per_s", stat(cycle, "rays_per_s") / 1e6, rays / 1e6});
+}
+
+std::vector<PaperFigure> table4_figures(const nlohmann::json& cycle, double fps,
+                                        const std::string& paper) {
+  const Table4Row none{"", 0, {0, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  const auto row =
+      std::ranges::find_if(paper_table4(), [&](const Table4Row& r) { return paper == r.scene; });
+  const Table4Row& p = row != paper_table4().end() ? *row : none;
+  const nlohmann::json& fb = json_at(cycle, "bandwidth_mb_s.frame_buffer");
+  std::vector<PaperFigure> v = {
+      {"fps", fps, p.fps},
+      {"usage_traversal", stat(cycle, "usage.traversal"), p.usage[0]},
+      {"usage_list", stat(cycle, "usage.list"), p.usage[1]},
+      {"usage_transformation", stat(cycle, "usage.transformation"), p.usage[2]},
+      {"usage_intersection", stat(cycle, "usage.intersection"), p.usage[3]},
+      {"hit_traversal", stat(cycle, "cache_hit.traversal"), p.hit[0]},
+      {"hit_list", stat(cycle, "cache_hit.list"), p.hit[1]},
+      {"hit_transformation", stat(cycle, "cache_hit.transformation"), p.hit[2]},
+      {"mb_s_dynrtc", stat(cycle, "bandwidth_mb_s.dynrtc"), p.bw[0]},
+      // The paper's shading bandwidth includes the frame buffer (docs/fidelity.md).
+      {"mb_s_shading",
+       stat(cycle, "bandwidth_mb_s.shading") + (fb.is_number() ? fb.get<double>() : 0.0), p.bw[1]},
+      {"mb_s_total", stat(cycle, "bandwidth_mb_s.total"), p.bw[2]},
+  };
+  add_rate_figures(v, cycle, p.fps, 1024, 768);
+  // Shading and frame-buffer bytes per pixel: the paper's from its shading MB/s over its frame
+  // rate at 1024x768 (Scene6: 19.0).
+  const double paper_bpp = p.fps > 0 ? p.bw[1] * 1048576.0 / (p.fps * 1024.0 * 768.0) : 0.0;
+  const nlohmann::json& bpp = json_at(cycle, "rgs.shading_bytes_per_pixel");
+  v.push_back({"shading_bytes_per_pixel", bpp.is_number() ? bpp.get<double>() : 0.0, paper_bpp});
+  return v;
+}
+
+std::vector<PaperFigure> table3_figures(const nlohmann::json& cycle, double fps,
+                                        const std::string& paper) {
+  const Table3Row* r = paper_table3_row(paper);
+  const double paper_fps = r ? r->saarcor_fps : 0.0;
+  std::vector<PaperFigure> v = {{"fps", fps, paper_fps}};
+  add_rate_figures(v, cycle, paper_fps, 512, 384);
+  return v;
+}
+
 }  // namespace
 
+std::vector<PaperFigure> paper_figures(int table, const std::string& paper,
+                                       const nlohmann::json& cycle, int width, int height) {
+  // A frame at 1/scale of the table's resolution: its fps as the paper's frame would have it
+  // (cycles per packet and rays/s do not depend on the resolution but through the image's
+  // content).
+  const int pw = table == 3 ? 512 : 1024, ph = table == 3 ? 384 : 768;
+  const double fps = stat(cycle, "fps") * (width * height) / (pw * ph);
+  return table == 3 ? table3_figures(cycle, fps, paper) : table4_figures(cycle, fps, paper);
+}
+
 nlohmann::json paper_entry_json(int table, const std::string& paper, const std::string& scene,
-                                bool reference, const std::string& resolution,
-                                const std::vector<PaperFigure>& figures,
+                                bool reference, int width, int height,
                                 const std::vector<std::string>& settings,
                                 const nlohmann::json& cycle) {
   nlohmann::json e;
@@ -1229,10 +1294,10 @@ nlohmann::json paper_entry_json(int table, const std::string& paper, const std::
   e["paper_scene"] = paper;
   e["scene"] = scene;
   e["kind"] = reference ? "reference" : "stand-in";
-  e["resolution"] = resolution;
+  e["resolution"] = std::to_string(width) + "x" + std::to_string(height);
   e["paper_resolution"] = table == 3 ? "512x384" : "1024x768";
   nlohmann::json fj = nlohmann::json::object();
-  for (const PaperFigure& g : figures)
+  for (const PaperFigure& g : paper_figures(table, paper, cycle, width, height))
     fj[g.key] = {{"model", g.model}, {"paper", g.paper}, {"ratio", paper_ratio(g)}};
   e["figures"] = fj;
   e["configuration"] = settings;
@@ -1276,6 +1341,156 @@ nlohmann::json thread_curve_json(const std::vector<int>& counts,
     last = fps;
   }
   return {{"scene", "builtin:room"}, {"resolution", resolution}, {"rows", rows}};
+}
+
+// ---- scene and compare ------------------------------------------------------------------------
+
+namespace {
+
+nlohmann::json tree_json(const host::KdTreeStats& s) {
+  return {{"nodes", s.nodes},
+          {"leaves", s.leaves},
+          {"empty_leaves", s.empty_leaves},
+          {"empty_chain_links", s.empty_chain_links},
+          {"mergeable_chain_links", s.mergeable_chain_links},
+          {"depth", s.depth},
+          {"items_per_leaf", s.items_per_leaf},
+          {"sah_cost", s.sah_cost},
+          {"expected_traversal_steps", s.expected_traversal_steps},
+          {"expected_leaf_visits", s.expected_leaf_visits},
+          {"expected_item_tests", s.expected_item_tests},
+          {"build_seconds", s.build_seconds}};
+}
+
+// A bottom tree's entry adds the busiest-unit objective's record (the top level keeps the plain
+// SAH: host/tree_objective.h).
+nlohmann::json bottom_tree_json(const host::KdTreeStats& s) {
+  nlohmann::json j = tree_json(s);
+  j["traversal_cost"] = s.chosen_traversal_cost;
+  j["expected_unit_cycles"] = {{"traversal", s.expected_traversal_cycles},
+                               {"list", s.expected_list_cycles},
+                               {"transformation", s.expected_transformation_cycles},
+                               {"intersection", s.expected_intersection_cycles}};
+  return j;
+}
+
+// Every bottom tree (per object) and their sums.
+nlohmann::json bottom_json(const SceneTrees& t, const host::Scene& scene) {
+  host::KdTreeStats sum;
+  std::uint64_t triangles = 0;
+  double leaf_items = 0.0;
+  std::uint64_t nonempty = 0;
+  nlohmann::json per_object = nlohmann::json::array();
+  for (const auto& [o, s] : t.bottom) {
+    sum.nodes += s.nodes;
+    sum.leaves += s.leaves;
+    sum.empty_leaves += s.empty_leaves;
+    sum.empty_chain_links += s.empty_chain_links;
+    sum.mergeable_chain_links += s.mergeable_chain_links;
+    sum.depth = std::max(sum.depth, s.depth);
+    sum.build_seconds += s.build_seconds;
+    leaf_items += s.items_per_leaf * (s.leaves - s.empty_leaves);
+    nonempty += s.leaves - s.empty_leaves;
+    nlohmann::json j = bottom_tree_json(s);
+    j["object"] = o;
+    j["name"] = scene.objects[o].name;
+    j["triangles"] = scene.objects[o].triangles.size();
+    j["nodes_per_triangle"] =
+        static_cast<double>(s.nodes) / std::max<double>(1.0, scene.objects[o].triangles.size());
+    triangles += scene.objects[o].triangles.size();
+    per_object.push_back(j);
+  }
+  return {{"trees", t.bottom.size()},
+          {"nodes", sum.nodes},
+          {"leaves", sum.leaves},
+          {"empty_leaves", sum.empty_leaves},
+          {"empty_chain_links", sum.empty_chain_links},
+          {"mergeable_chain_links", sum.mergeable_chain_links},
+          {"max_depth", sum.depth},
+          {"nodes_per_triangle",
+           static_cast<double>(sum.nodes) / std::max<double>(1.0, static_cast<double>(triangles))},
+          {"items_per_leaf", nonempty ? leaf_items / static_cast<double>(nonempty) : 0.0},
+          {"build_seconds", sum.build_seconds},
+          {"objects", per_object}};
+}
+
+// What the scene holds: counts, cameras, animation, the loader's warnings.
+nlohmann::json scene_counts_json(const host::Scene& scene) {
+  nlohmann::json j;
+  j["time"] = scene.time;
+  j["triangles"] = scene.instanced_triangles();
+  j["unique_triangles"] = scene.unique_triangles();
+  j["objects"] = scene.objects.size();
+  j["instances"] = scene.instances.size();
+  j["dynamic_instances"] = dynamic_instances(scene);
+  j["materials"] = scene.materials.size();
+  j["textures"] = scene.textures.size();
+  j["lights"] = scene.lights.size();
+  j["light_defaulted"] = scene.light_defaulted;
+  j["cameras"] = scene.cameras.size();
+  j["camera_names"] = nlohmann::json::array();
+  for (const host::Camera& c : scene.cameras)
+    j["camera_names"].push_back(c.name);
+  j["animation_seconds"] = scene.animation_seconds;
+  j["dropped_triangles"] = scene.dropped_triangles();
+  j["dropped_triangles_instanced"] = scene.instanced_dropped_triangles();
+  j["skipped_primitives"] = scene.skipped_primitives;
+  j["warnings"] = scene.warnings;
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json scene_report_json(const SceneOptions& options, const host::Scene& scene,
+                                 double load_seconds, const SceneImage& img) {
+  nlohmann::json j = scene_counts_json(scene);
+  j["scene"] = options.scene;
+  j["load_seconds"] = load_seconds;
+  j["kdtree"] = {{"top", tree_json(img.trees.top)}, {"bottom", bottom_json(img.trees, scene)}};
+  if (img.built) {
+    j["bytes_per_bank"] = img.built->stats.bytes_per_bank;
+    j["bank_bytes"] = static_cast<std::uint64_t>(img.params.bank_words) * 4u;
+    j["image_seconds"] = img.seconds;
+    j["image_error"] = nullptr;
+  } else {
+    j["bytes_per_bank"] = nullptr;
+    j["image_error"] = img.error;
+  }
+  if (!options.export_path.empty()) j["exported"] = options.export_path;
+  return j;
+}
+
+nlohmann::json compare_report_json(const CompareResult& r) {
+  // JSON has no infinity: an infinite or absent figure is null (docs/compare.md).
+  auto finite = [](const std::optional<double>& v) -> nlohmann::json {
+    if (!v || !std::isfinite(*v)) return nullptr;
+    return *v;
+  };
+  nlohmann::json j;
+  j["kind"] = r.hit_records ? "hit_records" : "images";
+  j["width"] = r.width;
+  j["height"] = r.height;
+  j["pixels"] = r.pixels;
+  j["bit_identical"] = r.bit_identical;
+  if (r.hit_records) {
+    j["same_triangle_pct"] = r.same_triangle_pct;
+    j["t_compared_pixels"] = r.t_compared;
+    j["mismatches"] = {{"hit_vs_miss", r.mismatches.hit_vs_miss},
+                       {"hit_vs_miss_near_edge", r.mismatches.hit_vs_miss_near_edge},
+                       {"edge_tie", r.mismatches.edge_tie},
+                       {"grazing", r.mismatches.grazing},
+                       {"other", r.mismatches.other},
+                       {"total", r.mismatches.total()}};
+  } else {
+    j["same_triangle_pct"] = nullptr;
+    j["mismatches"] = {{"differing_pixels", r.differing_pixels}};
+  }
+  j["t_rel_err_max"] = finite(r.t_rel_err_max);
+  j["t_rel_err_median"] = finite(r.t_rel_err_median);
+  j["psnr_db"] = finite(r.psnr_db);
+  j["max_channel_diff"] = finite(r.max_channel_diff);
+  if (!r.hit_records) j["max_channel_diff_unit"] = r.eight_bit ? "8-bit levels" : "float";
+  return j;
 }
 
 // ---- the run folder ----------------------------------------------------------------------------

@@ -40,6 +40,9 @@ struct PrecisionRow;
 struct SweepOptions;
 struct SweepPoint;
 struct SweepResult;
+struct SceneOptions;
+struct SceneImage;
+struct CompareResult;
 
 // ---- statistics and their declarations ---------------------------------------------------------
 
@@ -154,11 +157,18 @@ void write_precision_report(const std::string& json, const std::string& out_dir,
 
 // ---- the paper's tables ---------------------------------------------------------------------
 
+// One table's figures for the paper's scene `paper` (Table 3: fps, cycles per packet, Mrays/s;
+// Table 4: fps, the four usages, three hit rates, DynRTC, shading and total MB/s, those two and
+// the shading bytes per pixel), each the model's, read from the frame's cycle report by its
+// declared name, beside the paper's. The frame ran at width x height (the table's resolution over
+// --scale): its fps is the one the table's frame would have, scaled by their pixels.
+std::vector<PaperFigure> paper_figures(int table, const std::string& paper,
+                                       const nlohmann::json& cycle, int width, int height);
 // One table's entry for one scene of `saarcor paper`: the scene, the frame's resolution, each
-// figure beside the paper's with their ratio, the settings and the model's whole cycle report.
+// figure beside the paper's with their ratio (paper_figures), the settings and the model's whole
+// cycle report.
 nlohmann::json paper_entry_json(int table, const std::string& paper, const std::string& scene,
-                                bool reference, const std::string& resolution,
-                                const std::vector<PaperFigure>& figures,
+                                bool reference, int width, int height,
                                 const std::vector<std::string>& settings,
                                 const nlohmann::json& cycle);
 // The tables' result: the entries, scene after scene (moved out of `per_scene`).
@@ -169,6 +179,16 @@ nlohmann::json paper_tables_json(int scale, const std::vector<std::string>& set,
 nlohmann::json thread_curve_json(const std::vector<int>& counts,
                                  const std::vector<nlohmann::json>& reports,
                                  const std::string& resolution);
+
+// ---- scene and compare ------------------------------------------------------------------------
+
+// `saarcor scene --json` (the printout reads it too): the scene's counts, both kd-tree levels'
+// statistics (per bottom tree and summed), the bytes per bank or why the image does not build.
+nlohmann::json scene_report_json(const SceneOptions& options, const host::Scene& scene,
+                                 double load_seconds, const SceneImage& image);
+// `saarcor compare --report`: keys pixels, same_triangle_pct, bit_identical, t_rel_err_max,
+// t_rel_err_median, psnr_db, max_channel_diff, mismatches (and a few more, docs/compare.md).
+nlohmann::json compare_report_json(const CompareResult& r);
 
 // ---- the run folder ----------------------------------------------------------------------------
 
