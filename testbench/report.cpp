@@ -310,18 +310,6 @@ nlohmann::json pipelines_json(const CycleFrame& c) {
   return pipes;
 }
 
-// Every cycle-model key resolved, with the unit depths they give.
-nlohmann::json cycle_configuration_json(const units::CycleParams& p) {
-  nlohmann::json conf;
-  for (const units::CycleParamInfo& i : units::describe(p))
-    conf[i.name] = {{"value", i.value}, {"unit", i.unit}, {"help", i.help}};
-  conf["depth.traversal"] = p.traversal_depth();
-  conf["depth.list"] = p.list_depth();
-  conf["depth.transformation"] = p.transformation_depth();
-  conf["depth.intersection"] = p.intersection_depth();
-  return conf;
-}
-
 // The figures of a span (units/figures.h kFigures) the frame's report writes, into `j` at their
 // dotted names ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}).
 void add_figures(nlohmann::json& j, const units::CycleFigures& f) {
@@ -343,7 +331,7 @@ std::vector<ReportStat> cycle_stats(const CycleFrame& c) {
   return out;
 }
 
-nlohmann::json cycle_report_json(const CycleFrame& c) {
+nlohmann::json cycle_report_json(const CycleFrame& c, const host::ImageParams* trees) {
   nlohmann::json j = nest(cycle_stats(c));
   j["host"] = {{"seconds", c.host_seconds},
                {"sim_cycles_per_s", c.sim_cycles_per_s},
@@ -351,7 +339,7 @@ nlohmann::json cycle_report_json(const CycleFrame& c) {
                {"programs", units::program_mode_name(c.programs)},
                {"skipped_cycles", c.skipped_cycles}};
   j["pipelines"] = pipelines_json(c);
-  j["configuration"] = cycle_configuration_json(c.params);
+  j["configuration"] = parameters_json(&c.params, trees);
   // The hw/ statistics registry in full: per unit, cache, path and memory client.
   j["stats"] = nlohmann::json::parse(c.stats_json);
   if (!c.series.empty()) {
@@ -894,13 +882,14 @@ nlohmann::json sequence_host_json(const SequenceResult& r) {
 nlohmann::json sequence_configuration_json(double time, const RenderSettings& s, bool cycle) {
   nlohmann::json c = {
       {"time", time}, {"shadows", s.shadows}, {"depth", s.depth}, {"bank_mb", s.bank_mb}};
-  if (cycle)
-    for (const units::CycleParamInfo& p : units::describe(resolve_cycle_params(s.cycle)))
-      c["cycle"][p.name] = {{"value", p.value}, {"unit", p.unit}, {"help", p.help}};
+  if (cycle) {
+    const units::CycleParams p = resolve_cycle_params(s.cycle);
+    c["cycle"] = parameters_json(&p, nullptr);
+  }
   host::ImageParams trees;
   for (const std::string& kv : s.cycle.set)
     if (host::is_tree_setting(kv)) host::apply_tree_setting(trees, kv);
-  c["trees"] = tree_configuration_json(trees);
+  c["trees"] = parameters_json(nullptr, &trees);
   return c;
 }
 
@@ -1207,7 +1196,8 @@ void write_precision_report(const std::string& json, const std::string& out_dir,
   config["reference"] = "float";
   config["shadows"] = settings.shadows;
   config["depth"] = settings.depth;
-  config["trees"] = tree_configuration_json(host::ImageParams{});
+  const host::ImageParams trees;
+  config["trees"] = parameters_json(nullptr, &trees);
   write_run_folder({out_dir, j, std::move(config), std::move(host), stats_text(stats), argv, {}});
 }
 
@@ -1561,10 +1551,20 @@ std::string describe_format(ff::Format f) {
          ff::format_name(f) + ")";
 }
 
-nlohmann::json tree_configuration_json(const host::ImageParams& trees) {
+nlohmann::json parameters_json(const units::CycleParams* cycle, const host::ImageParams* trees) {
   nlohmann::json j = nlohmann::json::object();
-  for (const host::TreeSettingInfo& t : host::describe_tree_settings(trees))
-    j[t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
+  const auto add = [&j](const std::vector<hw::ParamInfo>& keys) {
+    for (const hw::ParamInfo& k : keys)
+      j[k.name] = {{"value", k.value}, {"unit", k.unit}, {"help", k.help}};
+  };
+  if (cycle != nullptr) {
+    add(units::describe(*cycle));
+    j["depth.traversal"] = cycle->traversal_depth();
+    j["depth.list"] = cycle->list_depth();
+    j["depth.transformation"] = cycle->transformation_depth();
+    j["depth.intersection"] = cycle->intersection_depth();
+  }
+  if (trees != nullptr) add(host::describe_tree_settings(*trees));
   return j;
 }
 
@@ -1610,7 +1610,7 @@ nlohmann::json render_report_json(const std::string& scene, const std::string& m
     c.erase("configuration");
     j.update(c);
   } else {  // the other models read the same trees: their keys are configuration too
-    j["configuration"]["trees"] = tree_configuration_json(prep.built.params);
+    j["configuration"]["trees"] = parameters_json(nullptr, &prep.built.params);
   }
   return j;
 }

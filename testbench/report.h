@@ -94,9 +94,10 @@ std::vector<ReportStat> op_stats(const units::UnitStats& u);
 // The frame's statistics as the report writes them: cycles, fps, rays, rates, the Table 4 figures
 // (units/figures.h), the RGS's traffic, per-ray counters, per-unit and per-cache counts.
 std::vector<ReportStat> cycle_stats(const CycleFrame& frame);
-// The per-frame report: cycle_stats, host, pipelines, configuration, the hw/ registry (stats),
+// The per-frame report: cycle_stats, host, pipelines, configuration (the cycle keys and, given
+// `trees`, the kd-tree keys the image was built with: parameters_json), the hw/ registry (stats),
 // (time_series).
-nlohmann::json cycle_report_json(const CycleFrame& frame);
+nlohmann::json cycle_report_json(const CycleFrame& frame, const host::ImageParams* trees = nullptr);
 // stats.txt's lines of a cycle report (as cycle_report_json wrote it; a sweep's points travel as
 // JSON): each frame statistic as "frame.NAME" with its declaration's description and unit, then
 // every statistic of the hw/ registry with its own.
@@ -227,8 +228,11 @@ void list_run_folder(const RunFolder& folder,
 
 // "Float<7,16> (e7m16)".
 std::string describe_format(ff::Format f);
-// The kd-tree builder's keys as configuration ({"kd.KEY": {value, unit, help}}).
-nlohmann::json tree_configuration_json(const host::ImageParams& trees);
+// The parameter tables' keys resolved (hw::ParamTable): the cycle keys with the unit depths they
+// give (`cycle`), the kd-tree builder's keys (`trees`), each {"KEY": {value, unit, help}} as its
+// table declares it. The one builder of the keys every config.json and every report's
+// configuration holds (the render, sequence, precision and sweep folders, the cycle report).
+nlohmann::json parameters_json(const units::CycleParams* cycle, const host::ImageParams* trees);
 // `saarcor render`'s report: the scene, model, resolution, host time, rays, the model's counters,
 // the configuration (frame, image, trees or cycle keys) and, with the cycle model, its frame
 // report's figures at the top.
