@@ -58,9 +58,13 @@ class Module {
   // (bound_idle_skip) and only when a cycle made no progress.
   virtual std::uint64_t skip_bound(std::uint64_t /*now*/) const { return kNever; }
 
-  // Kernel-kept per-module statistics: <name>.busy_cycles, <name>.stall_cycles.
+  // Kernel-kept per-module statistics: <name>.busy_cycles, <name>.stall_cycles (the registry's
+  // counters, for readers that keep a reference instead of looking them up by name; brought up to
+  // date when a run returns).
   bool busy() const { return last_progress_ > 0; }
   bool stalled() const { return stalled_; }
+  const Counter& busy_counter() const { return *busy_stat_; }
+  const Counter& stall_counter() const { return *stall_stat_; }
   // Whether the module sleeps between events (see sleep_when_idle).
   bool sleeps() const { return sleeps_; }
 

@@ -189,10 +189,12 @@ void Stats::sample(std::uint64_t cycle) {
   if (series_.empty()) {
     series_entries_.clear();
     series_names_.clear();
+    series_columns_.clear();
     for (const auto& [name, idx] : index_) {
       if (entries_[idx]->kind == Kind::kHistogram) continue;
       series_entries_.push_back(idx);
       series_names_.push_back(name);
+      if (entries_[idx]->c) series_columns_[entries_[idx]->c.get()] = series_names_.size();
     }
   }
   std::vector<double> row;
@@ -201,6 +203,13 @@ void Stats::sample(std::uint64_t cycle) {
   for (std::size_t idx : series_entries_)
     row.push_back(entry_value(*entries_[idx]));
   series_.push_back(std::move(row));
+}
+
+std::size_t Stats::time_series_column(const Counter& c) const {
+  const auto it = series_columns_.find(&c);
+  if (it == series_columns_.end())
+    throw std::logic_error("stats: the counter is not in the time series");
+  return it->second;
 }
 
 std::string Stats::time_series_json() const {

@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace saarcor::hw {
@@ -58,6 +59,25 @@ struct Histogram {
   void sample(double v);
 };
 
+// The formulas the registry's derived figures are computed with (gem5's Formula operators), each
+// written once: a cache's hit rate and a memory client's bandwidth (memif/), and the Table 4
+// figures over the chip's sums of the same counters (units/figures.h).
+
+// part / whole; 0 when whole is 0.
+inline double ratio(std::uint64_t part, std::uint64_t whole) {
+  return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
+}
+// 100 part / whole; 0 when whole is 0.
+inline double percent(std::uint64_t part, std::uint64_t whole) {
+  return whole == 0 ? 0.0 : 100.0 * static_cast<double>(part) / static_cast<double>(whole);
+}
+// Bytes moved in `cycles` cycles at `clock_hz` as MB per second, MB = 2^20 bytes (D39); 0 over no
+// cycles.
+inline double mb_per_s(std::uint64_t bytes, std::uint64_t cycles, double clock_hz) {
+  if (cycles == 0) return 0.0;
+  return static_cast<double>(bytes) * clock_hz / static_cast<double>(cycles) / 1048576.0;
+}
+
 class Stats {
  public:
   enum class Kind { kCounter, kAverage, kHistogram, kFormula };
@@ -100,6 +120,9 @@ class Stats {
   // The series as sampled: the names of its columns, and its rows ([cycle, v0, v1, ...]).
   const std::vector<std::string>& time_series_names() const { return series_names_; }
   const std::vector<std::vector<double>>& time_series() const { return series_; }
+  // The column of the rows that holds counter `c` (column 0 is the cycle); throws
+  // std::logic_error when `c` is not sampled (no sample yet, or not this registry's).
+  std::size_t time_series_column(const Counter& c) const;
 
  private:
   struct Entry {
@@ -119,6 +142,7 @@ class Stats {
   std::uint64_t period_ = 0;
   std::vector<std::size_t> series_entries_;
   std::vector<std::string> series_names_;
+  std::unordered_map<const Counter*, std::size_t> series_columns_;
   std::vector<std::vector<double>> series_;
 };
 

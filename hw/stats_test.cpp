@@ -47,6 +47,17 @@ TEST(Stats, CountersAveragesHistogramsAndFormulasReportTheirValues) {
             "}\n");
 }
 
+TEST(Stats, FormulaOperatorsComputeRatiosPercentagesAndBandwidth) {
+  EXPECT_EQ(ratio(3, 4), 0.75);
+  EXPECT_EQ(ratio(5, 0), 0.0);  // no requests: no rate
+  EXPECT_EQ(percent(3, 4), 75.0);
+  EXPECT_EQ(percent(1, 3), 100.0 / 3.0);  // 100 * 1 = 100, then / 3
+  EXPECT_EQ(percent(7, 0), 0.0);
+  // 2 MiB in 45 cycles at 90 MHz: 2 MiB per 0.5 us = 4,000,000 MiB/s.
+  EXPECT_EQ(mb_per_s(2 * 1048576, 45, 90e6), 4e6);
+  EXPECT_EQ(mb_per_s(1000, 0, 90e6), 0.0);
+}
+
 TEST(Stats, BadDeclarationsAndUnknownNamesThrow) {
   Stats s;
   s.counter("a.b", "x", "y");
@@ -92,6 +103,14 @@ TEST(Stats, KernelSamplesTheTimeSeriesEveryPeriod) {
             "  [8, 2.75, 4, 4, 4, 0],\n"
             "  [12, 3.1666666666666665, 4, 4, 4, 0]]}\n");
   EXPECT_THROW(k.stats().counter("late", "x", "y"), std::logic_error);
+  // A counter's column found by reference: pusher.busy_cycles is the fourth name, column 4 (the
+  // cycle is column 0); 4 busy cycles in every sample. Formulas and histograms have none.
+  const Counter& busy = p.busy_counter();
+  EXPECT_EQ(k.stats().time_series_column(busy), 4u);
+  EXPECT_EQ(k.stats().time_series()[2][k.stats().time_series_column(busy)], 4.0);
+  EXPECT_EQ(k.stats().time_series_column(p.stall_counter()), 5u);
+  const Counter elsewhere;
+  EXPECT_THROW(k.stats().time_series_column(elsewhere), std::logic_error);
 }
 
 }  // namespace

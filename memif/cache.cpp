@@ -79,15 +79,11 @@ Cache::Cache(hw::Kernel& kernel, std::string name, ItemType type, const MemoryIm
   merges_ = &s.counter(n + ".merges", "requests",
                        "requests merged into an outstanding miss of the same item");
   const hw::Counter *req = requests_stat_, *hit = hits_, *merge = merges_;
-  s.formula(n + ".hit_rate", "ratio", "hits / requests", [req, hit] {
-    return req->value ? static_cast<double>(hit->value) / static_cast<double>(req->value) : 0.0;
-  });
+  s.formula(n + ".hit_rate", "ratio", "hits / requests",
+            [req, hit] { return hw::ratio(hit->value, req->value); });
   s.formula(n + ".hit_rate_with_merges", "ratio",
-            "(hits + merges) / requests: the hit rate of a blocking cache", [req, hit, merge] {
-              return req->value ? static_cast<double>(hit->value + merge->value) /
-                                      static_cast<double>(req->value)
-                                : 0.0;
-            });
+            "(hits + merges) / requests: the hit rate of a blocking cache",
+            [req, hit, merge] { return hw::ratio(hit->value + merge->value, req->value); });
 }
 
 void Cache::invalidate() {

@@ -85,6 +85,11 @@ class Cache : public hw::Module {
   std::uint64_t hits() const { return hits_->value; }
   std::uint64_t misses() const { return misses_->value; }
   std::uint64_t merges() const { return merges_->value; }
+  // The same counts as the registry's counters, for readers that keep them.
+  struct Counters {
+    const hw::Counter *requests, *hits, *misses, *merges;
+  };
+  Counters counters() const { return {requests_stat_, hits_, misses_, merges_}; }
   bool idle() const;  // no miss outstanding, all four channels empty
 
  private:

@@ -317,11 +317,7 @@ std::uint16_t MemoryController::add_client(const std::string& name) {
   const hw::Counter* bytes = c.bytes;
   hw::Kernel* k = &kernel();
   stats().formula(name + ".mem_mb_per_s", "MB/s", "external memory bandwidth at the modelled clock",
-                  [bytes, clock, k] {
-                    return k->now() == 0 ? 0.0
-                                         : static_cast<double>(bytes->value) * clock /
-                                               static_cast<double>(k->now()) / 1048576.0;
-                  });
+                  [bytes, clock, k] { return hw::mb_per_s(bytes->value, k->now(), clock); });
   clients_.push_back(std::move(c));
   return id;
 }
@@ -331,9 +327,7 @@ std::uint64_t MemoryController::client_bytes(std::uint16_t client) const {
 }
 
 double MemoryController::client_mb_per_s(std::uint16_t client, std::uint64_t cycles) const {
-  if (cycles == 0) return 0.0;
-  return static_cast<double>(client_bytes(client)) * config_.clock_hz /
-         static_cast<double>(cycles) / 1048576.0;
+  return hw::mb_per_s(client_bytes(client), cycles, config_.clock_hz);
 }
 
 const std::string& MemoryController::client_name(std::uint16_t client) const {

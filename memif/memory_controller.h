@@ -87,6 +87,10 @@ class MemoryController : public hw::Module {
 
   // Bandwidth per client: bytes so far, and MB/s over `cycles` cycles at the modelled clock.
   std::uint64_t client_bytes(std::uint16_t client) const;
+  // The client's bytes as the registry's counter (<client>.mem_bytes).
+  const hw::Counter& client_counter(std::uint16_t client) const {
+    return *clients_.at(client).bytes;
+  }
   double client_mb_per_s(std::uint16_t client, std::uint64_t cycles) const;
   const std::string& client_name(std::uint16_t client) const;
   int clients() const { return static_cast<int>(clients_.size()); }

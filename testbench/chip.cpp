@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -100,75 +99,89 @@ class Chip {
   std::vector<std::unique_ptr<DynRtp>> pipes_;
 };
 
-// Where the counts the figures are computed from (units/figures.h FigureCounts) live in the
-// registry, per DynRTP: its units' issue cycles, its caches' requests, hits, merges and memory
-// bytes, its RGS's shading and frame-buffer bytes. The frame's counts and each interval's (the
-// registry's time series, --interval) are read from the same statistics.
-struct FigureStats {
-  std::vector<std::string> issued, requests, hits, merges, bytes, shading, frame;
-  int pipelines = 1;
+// The chip's counters the frame reads, per DynRTP: references into the hw/ registry taken once
+// from the modules that declare them, read in place (no name lookup): the Table 4 units' issue,
+// stall and served counts, the caches' requests, hits, merges, misses and memory bytes, the RGS's
+// packets, requests served and its shading and frame-buffer bytes. The frame's counts and each
+// interval's (the registry's time series, --interval) are read from the same counters.
+struct ChipCounters {
+  struct Unit {
+    const hw::Counter *issued, *stalled, *served;
+  };
+  struct CacheCounters {
+    memif::Cache::Counters counts;
+    const hw::Counter* bytes;
+  };
+  struct Pipeline {
+    std::array<Unit, kTable4Units> units;
+    std::array<CacheCounters, kCacheUnits> caches;
+    const hw::Counter *admitted, *served, *shading, *frame;
+  };
+  std::vector<Pipeline> pipelines;
 
-  explicit FigureStats(Chip& chip) : pipelines(chip.pipelines()) {
+  explicit ChipCounters(Chip& chip) {
+    memif::MemorySystem& mi = chip.memory();
     for (int p = 0; p < chip.pipelines(); ++p) {
       DynRtp& d = chip.pipeline(p);
-      for (int i = 0; i < kTable4Units; ++i)
-        issued.push_back(d.unit(kTable4Unit[i]).name() + ".issue_cycles");
-      for (int c = 0; c < kCacheUnits; ++c) {
-        const std::string& n = chip.memory().cache(p, kCacheItem[c]).name();
-        requests.push_back(n + ".requests");
-        hits.push_back(n + ".hits");
-        merges.push_back(n + ".merges");
-        bytes.push_back(n + ".mem_bytes");
+      Pipeline& pc = pipelines.emplace_back();
+      for (int i = 0; i < kTable4Units; ++i) {
+        const CycleUnit& u = d.unit(kTable4Unit[i]);
+        pc.units[static_cast<std::size_t>(i)] = {&u.issue_counter(), &u.stall_counter(),
+                                                 &u.served_counter()};
       }
-      const std::string pre = "dynrtp" + std::to_string(p) + ".";
-      shading.push_back(pre + "shading.mem_bytes");
-      frame.push_back(pre + "frame.mem_bytes");
+      for (int c = 0; c < kCacheUnits; ++c) {
+        const memif::Cache& cache = mi.cache(p, kCacheItem[c]);
+        pc.caches[static_cast<std::size_t>(c)] = {cache.counters(),
+                                                  &mi.controller().client_counter(cache.client())};
+      }
+      pc.admitted = &d.rgs().admitted_counter();
+      pc.served = &d.rgs().served_counter();
+      pc.shading = &mi.controller().client_counter(mi.shading_client(p));
+      pc.frame = &mi.controller().client_counter(mi.frame_client(p));
     }
   }
 
-  // The counts at `cycle`, each statistic's value given by `value(name)`.
-  template <class Value>
-  FigureCounts counts(std::uint64_t cycle, const Value& value) const {
+  // Table 4's counts at `cycle`, each counter's value given by `read(counter)`.
+  template <class Read>
+  FigureCounts figure_counts(std::uint64_t cycle, const Read& read) const {
     FigureCounts s;
     s.cycle = cycle;
-    s.pipelines = pipelines;
-    for (std::size_t p = 0; p < shading.size(); ++p) {
+    s.pipelines = static_cast<int>(pipelines.size());
+    for (const Pipeline& p : pipelines) {
       for (std::size_t i = 0; i < kTable4Units; ++i)
-        s.issued[i] += value(issued[p * kTable4Units + i]);
+        s.issued[i] += read(p.units[i].issued);
       for (std::size_t c = 0; c < kCacheUnits; ++c) {
-        const std::size_t at = p * kCacheUnits + c;
-        s.requests[c] += value(requests[at]);
-        s.hits[c] += value(hits[at]) + value(merges[at]);
-        s.bytes[c] += value(bytes[at]);
+        const CacheCounters& cc = p.caches[c];
+        s.requests[c] += read(cc.counts.requests);
+        s.hits[c] += read(cc.counts.hits) + read(cc.counts.merges);
+        s.bytes[c] += read(cc.bytes);
       }
-      s.shading_bytes += value(shading[p]);
-      s.frame_bytes += value(frame[p]);
+      s.shading_bytes += read(p.shading);
+      s.frame_bytes += read(p.frame);
     }
     return s;
   }
 };
 
-FigureCounts snapshot(const hw::Kernel& k, const FigureStats& fs) {
-  return fs.counts(k.now(), [&](const std::string& n) { return k.stats().get_counter(n).value; });
+FigureCounts snapshot(const hw::Kernel& k, const ChipCounters& cc) {
+  return cc.figure_counts(k.now(), [](const hw::Counter* c) { return c->value; });
 }
 
 // The figures of each span of the registry's time series (sampled by simulate every `interval`
 // cycles and at the frame's end), from the frame's start counts on.
-std::vector<CycleFigures> interval_figures(hw::Kernel& k, const FigureStats& fs,
+std::vector<CycleFigures> interval_figures(hw::Kernel& k, const ChipCounters& cc,
                                            const FigureCounts& start, std::uint64_t interval,
                                            double clock_mhz) {
   hw::Stats& st = k.stats();
   st.set_time_series_period(interval);
-  std::map<std::string, std::size_t> column;
-  for (std::size_t i = 0; i < st.time_series_names().size(); ++i)
-    column[st.time_series_names()[i]] = i + 1;  // column 0 is the cycle
   std::vector<CycleFigures> series;
   FigureCounts last = start;
   for (const std::vector<double>& row : st.time_series()) {
     const auto cycle = static_cast<std::uint64_t>(row[0]);
     if (cycle <= last.cycle) continue;
-    const FigureCounts now = fs.counts(
-        cycle, [&](const std::string& n) { return static_cast<std::uint64_t>(row[column.at(n)]); });
+    const FigureCounts now = cc.figure_counts(cycle, [&](const hw::Counter* c) {
+      return static_cast<std::uint64_t>(row[st.time_series_column(*c)]);
+    });
     series.push_back(compute_figures(last, now, clock_mhz));
     last = now;
   }
@@ -251,38 +264,38 @@ void finish_upload(hw::Kernel& k, Chip& chip, const CycleParams& p, CycleFrame& 
   out.upload_cycles = k.now();
 }
 
-// Per pipeline and in total: packets, unit issue and stall cycles, requests, cache counts.
-void collect_units(const hw::Kernel& k, Chip& chip, const FigureCounts& end, CycleFrame& out) {
+// Per pipeline and in total: packets, unit issue and stall cycles, requests, cache counts, read
+// from the chip's counters.
+void collect_units(const ChipCounters& cc, const FigureCounts& end, CycleFrame& out) {
   std::uint64_t served = 0;
-  out.per_pipeline.resize(static_cast<std::size_t>(chip.pipelines()));
-  for (int pi = 0; pi < chip.pipelines(); ++pi) {
-    DynRtp& d = chip.pipeline(pi);
-    CycleFrame::PipelineCount& pc = out.per_pipeline[static_cast<std::size_t>(pi)];
-    pc.packets = d.rgs().packets_admitted();
-    served += d.rgs().requests_served();
-    for (int i = 0; i < kTable4Units; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      CycleUnit& u = d.unit(kTable4Unit[i]);
-      pc.issue_cycles[ui] = u.issue_cycles();
-      out.issue_cycles[ui] += u.issue_cycles();
-      out.stall_cycles[ui] += k.stats().get_counter(u.name() + ".stall_cycles").value;
-      out.requests[ui] += u.requests_served();
+  out.per_pipeline.resize(cc.pipelines.size());
+  for (std::size_t pi = 0; pi < cc.pipelines.size(); ++pi) {
+    const ChipCounters::Pipeline& p = cc.pipelines[pi];
+    CycleFrame::PipelineCount& pc = out.per_pipeline[pi];
+    pc.packets = p.admitted->value;
+    served += p.served->value;
+    for (std::size_t i = 0; i < kTable4Units; ++i) {
+      const ChipCounters::Unit& u = p.units[i];
+      pc.issue_cycles[i] = u.issued->value;
+      out.issue_cycles[i] += u.issued->value;
+      out.stall_cycles[i] += u.stalled->value;
+      out.requests[i] += u.served->value;
     }
-    for (int c = 0; c < kCacheUnits; ++c) {
-      const memif::Cache& cache = chip.memory().cache(pi, kCacheItem[c]);
-      auto& cc = out.caches[static_cast<std::size_t>(c)];
-      cc.requests += cache.requests_count();
-      cc.hits += cache.hits();
-      cc.misses += cache.misses();
-      cc.merges += cache.merges();
+    for (std::size_t c = 0; c < kCacheUnits; ++c) {
+      const memif::Cache::Counters& k = p.caches[c].counts;
+      CycleFrame::CacheCount& count = out.caches[c];
+      count.requests += k.requests->value;
+      count.hits += k.hits->value;
+      count.misses += k.misses->value;
+      count.merges += k.merges->value;
     }
   }
   for (std::uint64_t r : out.requests)
     served += r;
   out.frame.units.requests = served;
   out.frame.units.packets = out.packets;
-  for (int c = 0; c < kCacheUnits; ++c)
-    out.caches[static_cast<std::size_t>(c)].mem_bytes = end.bytes[static_cast<std::size_t>(c)];
+  for (std::size_t c = 0; c < kCacheUnits; ++c)
+    out.caches[c].mem_bytes = end.bytes[c];
 }
 
 // The frame's rays, rates and SIMD efficiency at the modelled clock.
@@ -358,15 +371,15 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   CycleFrame out;
   out.params = p;
   out.packets = static_cast<std::uint64_t>(threads.packets());
-  const FigureStats figure_stats(chip);
-  const FigureCounts start = snapshot(k, figure_stats);
+  const ChipCounters counters(chip);
+  const FigureCounts start = snapshot(k, counters);
   const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
   simulate(k, chip, threads, p, opt);
   if (opt.vcd != nullptr) k.finish_trace();
   if (tracer) tracer->finish();
-  const FigureCounts end = snapshot(k, figure_stats);
+  const FigureCounts end = snapshot(k, counters);
   if (opt.interval != 0)
-    out.series = interval_figures(k, figure_stats, start, opt.interval, p.clock_mhz);
+    out.series = interval_figures(k, counters, start, opt.interval, p.clock_mhz);
   out.cycles = k.now();
   if (uploading) finish_upload(k, chip, p, out);
 
@@ -374,7 +387,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   collect(out.frame, threads);
   collect_rgs(image, frame_bank, end, out);
   out.figures = compute_figures(start, end, p.clock_mhz);
-  collect_units(k, chip, end, out);
+  collect_units(counters, end, out);
   frame_rates(p, out);
   out.packets_retired = chip.packets_retired();
   out.skipped_cycles = k.skipped_cycles();

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "testbench/hit_exr.h"
+#include "testbench/report.h"
 
 namespace saarcor {
 namespace {
@@ -278,40 +279,6 @@ double psnr_rgb8(const Rgb8Image& a, const Rgb8Image& b) {
   return 10.0 * std::log10(255.0 * 255.0 / mse);
 }
 
-nlohmann::json compare_to_json(const CompareResult& r) {
-  using nlohmann::json;
-  // JSON has no infinity: an infinite or absent figure is null (docs/compare.md).
-  auto num = [](const std::optional<double>& v) -> json {
-    if (!v || !std::isfinite(*v)) return nullptr;
-    return *v;
-  };
-  json j;
-  j["kind"] = r.hit_records ? "hit_records" : "images";
-  j["width"] = r.width;
-  j["height"] = r.height;
-  j["pixels"] = r.pixels;
-  j["bit_identical"] = r.bit_identical;
-  if (r.hit_records) {
-    j["same_triangle_pct"] = r.same_triangle_pct;
-    j["t_compared_pixels"] = r.t_compared;
-    j["mismatches"] = {{"hit_vs_miss", r.mismatches.hit_vs_miss},
-                       {"hit_vs_miss_near_edge", r.mismatches.hit_vs_miss_near_edge},
-                       {"edge_tie", r.mismatches.edge_tie},
-                       {"grazing", r.mismatches.grazing},
-                       {"other", r.mismatches.other},
-                       {"total", r.mismatches.total()}};
-  } else {
-    j["same_triangle_pct"] = nullptr;
-    j["mismatches"] = {{"differing_pixels", r.differing_pixels}};
-  }
-  j["t_rel_err_max"] = num(r.t_rel_err_max);
-  j["t_rel_err_median"] = num(r.t_rel_err_median);
-  j["psnr_db"] = num(r.psnr_db);
-  j["max_channel_diff"] = num(r.max_channel_diff);
-  if (!r.hit_records) j["max_channel_diff_unit"] = r.eight_bit ? "8-bit levels" : "float";
-  return j;
-}
-
 std::string compare_summary(const CompareResult& r) {
   std::string s;
   auto line = [&](const std::string& k, const std::string& v) { s += "  " + k + v + "\n"; };
@@ -388,7 +355,7 @@ int run_compare(const CompareOptions& opts) {
     std::printf("  difference image: %s\n", opts.diff.c_str());
   }
   if (!opts.report.empty()) {
-    write_text_file(opts.report, compare_to_json(r).dump(2) + "\n");
+    write_text_file(opts.report, compare_report_json(r).dump(2) + "\n");
     std::printf("  report:           %s\n", opts.report.c_str());
   }
   return 0;

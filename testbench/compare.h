@@ -74,9 +74,7 @@ CompareResult compare_images(const FloatImage& a, const FloatImage& b, Rgb8Image
 // PSNR in dB of two 8-bit images over all channels (peak 255); +inf when identical.
 double psnr_rgb8(const Rgb8Image& a, const Rgb8Image& b);
 
-// The JSON report: keys pixels, same_triangle_pct, bit_identical, t_rel_err_max,
-// t_rel_err_median, psnr_db, max_channel_diff, mismatches (and a few more, docs/compare.md).
-nlohmann::json compare_to_json(const CompareResult& r);
+// The JSON report is testbench/report.h's compare_report_json.
 // The lines `saarcor compare` prints.
 std::string compare_summary(const CompareResult& r);
 

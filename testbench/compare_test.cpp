@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "testbench/hit_exr.h"
+#include "testbench/report.h"
 #include "testbench/testing.h"
 
 namespace saarcor {
@@ -58,7 +59,7 @@ TEST(CompareHits, IdenticalBuffers) {
   EXPECT_EQ(diff.width, 10);
   EXPECT_EQ(diff.rgb[0], 0);         // miss/miss: black
   EXPECT_EQ(diff.rgb[(5) * 3], 48);  // same hit, same t: grey
-  const nlohmann::json j = compare_to_json(r);
+  const nlohmann::json j = compare_report_json(r);
   EXPECT_EQ(j["bit_identical"], true);
   EXPECT_EQ(j["pixels"], 100);
   EXPECT_EQ(j["same_triangle_pct"], 100.0);
@@ -131,7 +132,7 @@ TEST(CompareHits, EachMismatchClassIsDetected) {
   EXPECT_EQ(px(8, 2), (std::array<int, 3>{0, 255, 255}));
   EXPECT_EQ(px(9, 3), (std::array<int, 3>{255, 0, 255}));
   EXPECT_GT(px(5, 5)[1], px(6, 5)[1]);  // larger t error, brighter green
-  const nlohmann::json j = compare_to_json(r);
+  const nlohmann::json j = compare_report_json(r);
   EXPECT_EQ(j["mismatches"]["hit_vs_miss"], 2);
   EXPECT_EQ(j["mismatches"]["edge_tie"], 1);
   EXPECT_EQ(j["mismatches"]["grazing"], 1);

@@ -109,17 +109,13 @@ SequenceResult run_sequence(const std::string& scene, const ModelSpec& model,
                             const RenderSettings& settings, const SequenceOptions& opts,
                             const FrameSink& sink = {});
 
-// The per-frame table and summary as printed (with the host's rebuild times). The report and the
-// CSV are testbench/report.h's (sequence_json, sequence_csv).
-std::string sequence_table(const SequenceResult& r);
-
 // --bus-sweep: the sequence once per host-bus bandwidth (MB/s); every point's frames must have
-// the first point's digests. Returns one result per bandwidth.
+// the first point's digests. Returns one result per bandwidth (printed by testbench/report.h's
+// bus_sweep_table).
 std::vector<SequenceResult> run_bus_sweep(const std::string& scene, const ModelSpec& model,
                                           const RenderSettings& settings,
                                           const SequenceOptions& opts,
                                           const std::vector<double>& mb_s);
-std::string bus_sweep_table(const std::vector<SequenceResult>& points);
 
 // "1,4,16.5" as bandwidths in (0, 10^6] MB/s; throws "bad --bus-sweep ..." otherwise.
 std::vector<double> parse_bus_sweep(const std::string& text);

@@ -33,21 +33,6 @@ const std::vector<Table3Row>& paper_table3() {
   return rows;
 }
 
-const Table4Row* table4_row(const std::string& paper) {
-  for (const Table4Row& r : paper_table4())
-    if (paper == r.scene) return &r;
-  return nullptr;
-}
-
-// The paper's cycles per 4-ray packet and Mrays/s at its fps and resolution (90 MHz).
-void add_rate_figures(std::vector<PaperFigure>& v, const nlohmann::json& cycle, double fps,
-                      int width, int height) {
-  const double rays = fps * width * height;
-  v.push_back({"cycles_per_packet", cycle["cycles_per_packet"].get<double>(),
-               rays > 0.0 ? 90e6 / (rays / 4.0) : 0.0});
-  v.push_back({"mrays_per_s", cycle["rays_per_s"].get<double>() / 1e6, rays / 1e6});
-}
-
 void check_options(const PaperOptions& opts) {
   if (opts.table != 0 && opts.table != 3 && opts.table != 4)
     throw std::runtime_error("bad --table " + std::to_string(opts.table) + ": 3 or 4");
@@ -123,17 +108,8 @@ nlohmann::json table_entry(int table, const PaperScene& ps, PreparedScene& prep,
   if (rebuild) build_prepared_image(prep, s, ff::kFp24);
   pool.progress("Table " + std::to_string(table) + ": " + ps.paper + " (" + ps.spec + ")");
   const FrameResult f = render_model(parse_model("cycle"), prep, s);
-  // A frame at 1/scale of the resolution: its fps as the paper's frame would have it (cycles
-  // per packet and rays/s do not depend on the resolution but through the image's content).
-  const int pw = table == 3 ? 512 : 1024, ph = table == 3 ? 384 : 768;
-  nlohmann::json at_paper_res = f.cycle;
-  at_paper_res["fps"] = f.cycle["fps"].get<double>() * (s.res.width * s.res.height) / (pw * ph);
-  const std::vector<PaperFigure> figs = table == 3 ? table3_figures(at_paper_res, ps.paper, pw, ph)
-                                                   : table4_figures(at_paper_res, ps.paper, pw, ph);
-  nlohmann::json e = paper_entry_json(
-      table, ps.paper, ps.spec, ps.reference,
-      std::to_string(s.res.width) + "x" + std::to_string(s.res.height), figs, s.cycle.set, f.cycle);
-  return e;
+  return paper_entry_json(table, ps.paper, ps.spec, ps.reference, s.res.width, s.res.height,
+                          s.cycle.set, f.cycle);
 }
 
 }  // namespace
@@ -162,47 +138,6 @@ const Table3Row* paper_table3_row(const std::string& paper_scene) {
   for (const Table3Row& r : paper_table3())
     if (paper_scene == r.scene) return &r;
   return nullptr;
-}
-
-std::vector<PaperFigure> table4_figures(const nlohmann::json& cycle, const std::string& paper,
-                                        int width, int height) {
-  const Table4Row* r = table4_row(paper);
-  const Table4Row none{"", 0, {0, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  const Table4Row& p = r ? *r : none;
-  const nlohmann::json& u = cycle["usage"];
-  const nlohmann::json& h = cycle["cache_hit"];
-  const nlohmann::json& b = cycle["bandwidth_mb_s"];
-  std::vector<PaperFigure> v = {
-      {"fps", cycle["fps"].get<double>(), p.fps},
-      {"usage_traversal", u["traversal"].get<double>(), p.usage[0]},
-      {"usage_list", u["list"].get<double>(), p.usage[1]},
-      {"usage_transformation", u["transformation"].get<double>(), p.usage[2]},
-      {"usage_intersection", u["intersection"].get<double>(), p.usage[3]},
-      {"hit_traversal", h["traversal"].get<double>(), p.hit[0]},
-      {"hit_list", h["list"].get<double>(), p.hit[1]},
-      {"hit_transformation", h["transformation"].get<double>(), p.hit[2]},
-      {"mb_s_dynrtc", b["dynrtc"].get<double>(), p.bw[0]},
-      // The paper's shading bandwidth includes the frame buffer (docs/fidelity.md).
-      {"mb_s_shading", b["shading"].get<double>() + b.value("frame_buffer", 0.0), p.bw[1]},
-      {"mb_s_total", b["total"].get<double>(), p.bw[2]},
-  };
-  add_rate_figures(v, cycle, p.fps, width, height);
-  // Shading and frame-buffer bytes per pixel: the paper's from its shading MB/s over its frame
-  // rate at 1024x768 (Scene6: 19.0).
-  const double paper_bpp = p.fps > 0 ? p.bw[1] * 1048576.0 / (p.fps * 1024.0 * 768.0) : 0.0;
-  const double model_bpp =
-      cycle.contains("rgs") ? cycle["rgs"]["shading_bytes_per_pixel"].get<double>() : 0.0;
-  v.push_back({"shading_bytes_per_pixel", model_bpp, paper_bpp});
-  return v;
-}
-
-std::vector<PaperFigure> table3_figures(const nlohmann::json& cycle, const std::string& paper,
-                                        int width, int height) {
-  const Table3Row* r = paper_table3_row(paper);
-  const double fps = r ? r->saarcor_fps : 0.0;
-  std::vector<PaperFigure> v = {{"fps", cycle["fps"].get<double>(), fps}};
-  add_rate_figures(v, cycle, fps, width, height);
-  return v;
 }
 
 // The paper's texture filter for `paper` (a Table 3/4 scene name): "all scenes use bilinear

@@ -38,12 +38,9 @@ struct PaperFigure {
   double model = 0.0;
   double paper = 0.0;
 };
-// Model figures from a cycle report (cycle_report_json) beside the paper's Table 4 row, whose
-// cycles per packet and Mrays/s follow from its fps at width x height and 4-ray packets.
-std::vector<PaperFigure> table4_figures(const nlohmann::json& cycle, const std::string& paper,
-                                        int width, int height);
-std::vector<PaperFigure> table3_figures(const nlohmann::json& cycle, const std::string& paper,
-                                        int width, int height);
+// A table's figures are made by the report module from the frame's cycle report
+// (testbench/report.h paper_figures): the paper's cycles per packet and Mrays/s follow from its
+// fps at the table's resolution and 4-ray packets.
 
 struct PaperOptions {
   int table = 0;         // 3 or 4; 0 = both (and the thread curve with `threads`)

@@ -235,9 +235,8 @@ FrameResult render_cycle_frame(const ModelSpec& model, const PreparedScene& prep
   r.image.height = c.frame.height;
   r.image.rgb = c.frame.rgb;
   r.rays = c.rays;
-  r.cycle = cycle_report_json(c);
   // The trees are part of the configuration an architect sweeps (kd.* keys).
-  r.cycle["configuration"].update(tree_configuration_json(prep.built.params));
+  r.cycle = cycle_report_json(c, &prep.built.params);
   r.table4 = table4_text(c, prep.spec);
   // The per-ray counters of the frame report and the float units' op counts.
   for (ReportStat& st : cycle_stats(c))

@@ -12,11 +12,14 @@
 #include <string_view>
 
 #include "host/tree_settings.h"
+#include "testbench/compare.h"
+#include "testbench/cycle_render.h"
 #include "testbench/frame_sequence.h"
 #include "testbench/image_io.h"
 #include "testbench/paper_cmd.h"
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
+#include "testbench/scene_cmd.h"
 #include "testbench/sweep_cmd.h"
 
 namespace saarcor {
@@ -307,18 +310,6 @@ nlohmann::json pipelines_json(const CycleFrame& c) {
   return pipes;
 }
 
-// Every cycle-model key resolved, with the unit depths they give.
-nlohmann::json cycle_configuration_json(const units::CycleParams& p) {
-  nlohmann::json conf;
-  for (const units::CycleParamInfo& i : units::describe(p))
-    conf[i.name] = {{"value", i.value}, {"unit", i.unit}, {"help", i.help}};
-  conf["depth.traversal"] = p.traversal_depth();
-  conf["depth.list"] = p.list_depth();
-  conf["depth.transformation"] = p.transformation_depth();
-  conf["depth.intersection"] = p.intersection_depth();
-  return conf;
-}
-
 // The figures of a span (units/figures.h kFigures) the frame's report writes, into `j` at their
 // dotted names ({"usage": {...}, "cache_hit": {...}, "bandwidth_mb_s": {...}}).
 void add_figures(nlohmann::json& j, const units::CycleFigures& f) {
@@ -340,7 +331,7 @@ std::vector<ReportStat> cycle_stats(const CycleFrame& c) {
   return out;
 }
 
-nlohmann::json cycle_report_json(const CycleFrame& c) {
+nlohmann::json cycle_report_json(const CycleFrame& c, const host::ImageParams* trees) {
   nlohmann::json j = nest(cycle_stats(c));
   j["host"] = {{"seconds", c.host_seconds},
                {"sim_cycles_per_s", c.sim_cycles_per_s},
@@ -348,7 +339,7 @@ nlohmann::json cycle_report_json(const CycleFrame& c) {
                {"programs", units::program_mode_name(c.programs)},
                {"skipped_cycles", c.skipped_cycles}};
   j["pipelines"] = pipelines_json(c);
-  j["configuration"] = cycle_configuration_json(c.params);
+  j["configuration"] = parameters_json(&c.params, trees);
   // The hw/ statistics registry in full: per unit, cache, path and memory client.
   j["stats"] = nlohmann::json::parse(c.stats_json);
   if (!c.series.empty()) {
@@ -379,9 +370,23 @@ std::vector<StatLine> cycle_stat_lines(const nlohmann::json& cycle) {
 
 namespace {
 
+using Row = const SequenceFrame&;
+using Run = const SequenceResult&;
+
+// Which of the two per-frame tables (the cycle model's, a functional model's) prints a column.
+enum class Printed : unsigned char { kNo, kAlways, kCycle, kFunctional };
+
+// A declared column's cell in a printed table: its header and the printf format of its value.
+struct Cell {
+  Printed printed = Printed::kNo;
+  const char* head = "";
+  const char* format = "%.0f";
+};
+
 // One column of a frame sequence's per-frame rows, declared once: its JSON key (dotted: nested)
-// and CSV column ('.' -> '_'), unit, description and value. The rows are written from this table
-// as JSON (report.json), CSV (frames.csv) and statistics (stats.txt).
+// and CSV column ('.' -> '_'), unit, description, value and printed cell. The rows are written
+// from this table as JSON (report.json), CSV (frames.csv), statistics (stats.txt) and the printed
+// table (sequence_table).
 struct RowColumn {
   const char* name;
   const char* unit;
@@ -389,60 +394,149 @@ struct RowColumn {
   bool cycle_only;  // timed: the cycle model's rows only
   bool in_csv;      // frames.csv has it
   nlohmann::json (*value)(const SequenceFrame&);
+  Cell cell = {};
+  const char* (*word)(const SequenceFrame&) = nullptr;  // printed in place of the value
+  bool upload = false;  // frame 0 prints "-": its upload is the initial load (the table's header)
+  bool host = false;    // the host's wall clock: the printout, and the report outside a run folder
 };
 
-using Row = const SequenceFrame&;
+const char* yes_no(bool b) {
+  return b ? "yes" : "no";
+}
+
 // A Table 4 figure of the frame, as units/figures.h declares it.
 template <int kFigure>
-constexpr RowColumn figure_column() {
+constexpr RowColumn figure_column(Cell cell = {}) {
   const units::FigureInfo& f = units::kFigures[kFigure];
   return {f.name, f.unit, f.help,
-          true,   true,   [](Row r) { return nlohmann::json(r.figures.at(kFigure)); }};
+          true,   true,   [](Row r) { return nlohmann::json(r.figures.at(kFigure)); },
+          cell};
 }
 
 constexpr RowColumn kRowColumns[] = {
-    {"frame", "frame", "the frame's index", false, true,
-     [](Row f) { return nlohmann::json(f.index); }},
-    {"time", "s", "animation time", false, true, [](Row f) { return nlohmann::json(f.time); }},
-    {"frame_bank", "bank", "the frame-buffer bank written", false, true,
-     [](Row f) { return nlohmann::json(f.frame_bank); }},
-    {"top_copy", "copy", "the top-level copy the frame reads", false, true,
-     [](Row f) { return nlohmann::json(f.top_copy); }},
+    {"frame",
+     "frame",
+     "the frame's index",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.index); },
+     {Printed::kAlways, "frame"}},
+    {"time",
+     "s",
+     "animation time",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.time); },
+     {Printed::kAlways, "time s", "%.3f"}},
+    {"frame_bank",
+     "bank",
+     "the frame-buffer bank written",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.frame_bank); },
+     {Printed::kAlways, "bank"}},
+    {"top_copy",
+     "copy",
+     "the top-level copy the frame reads",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.top_copy); },
+     {Printed::kAlways, "copy"}},
     {"top_rebuilt", "bool", "the top-level tree was rebuilt (1 = yes)", false, true,
      [](Row f) { return nlohmann::json(f.top_rebuilt); }},
-    {"moved_instances", "instances", "instances moved since the previous frame", false, true,
-     [](Row f) { return nlohmann::json(f.moved_instances); }},
-    {"top_level_builds", "trees", "top-level trees built for the frame", false, true,
-     [](Row f) { return nlohmann::json(f.top_level_builds); }},
-    {"bottom_level_builds", "trees", "bottom-level trees built for the frame", false, true,
-     [](Row f) { return nlohmann::json(f.bottom_level_builds); }},
-    {"upload_bytes", "bytes", "bytes uploaded: changed SRAM words and the registers", false, true,
-     [](Row f) { return nlohmann::json(f.upload_bytes); }},
+    {"moved_instances",
+     "instances",
+     "instances moved since the previous frame",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.moved_instances); },
+     {Printed::kAlways, "moved"}},
+    {"top_level_builds",
+     "trees",
+     "top-level trees built for the frame",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.top_level_builds); },
+     {Printed::kAlways, "top"}},
+    {"bottom_level_builds",
+     "trees",
+     "bottom-level trees built for the frame",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.bottom_level_builds); },
+     {Printed::kAlways, "bot"}},
+    {"upload_bytes",
+     "bytes",
+     "bytes uploaded: changed SRAM words and the registers",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.upload_bytes); },
+     {Printed::kAlways, "upload B"},
+     nullptr,
+     true},
     {"upload_words", "words", "changed SRAM words uploaded", false, true,
      [](Row f) { return nlohmann::json(f.upload_words); }},
     {"upload_runs", "runs", "runs of consecutive words uploaded", false, true,
      [](Row f) { return nlohmann::json(f.upload_runs); }},
-    {"upload_in_gap", "bool", "the upload waited for the previous frame's end (1 = yes)", false,
-     true, [](Row f) { return nlohmann::json(f.gap); }},
-    {"upload_cycles", "cycles", "from the previous frame's start until the upload was stored", true,
-     true, [](Row f) { return nlohmann::json(f.upload_cycles); }},
-    {"upload_hidden", "bool", "the upload was done within the previous frame (1 = yes)", true, true,
-     [](Row f) { return nlohmann::json(f.hidden); }},
-    {"stall_cycles", "cycles", "cycles the frame started after the previous frame's end", true,
-     true, [](Row f) { return nlohmann::json(f.stall_cycles); }},
+    {"upload_in_gap",
+     "bool",
+     "the upload waited for the previous frame's end (1 = yes)",
+     false,
+     true,
+     [](Row f) { return nlohmann::json(f.gap); },
+     {Printed::kFunctional, "gap"},
+     [](Row f) { return yes_no(f.gap); },
+     true},
+    {"upload_cycles",
+     "cycles",
+     "from the previous frame's start until the upload was stored",
+     true,
+     true,
+     [](Row f) { return nlohmann::json(f.upload_cycles); },
+     {Printed::kCycle, "upload cyc"},
+     nullptr,
+     true},
+    {"upload_hidden",
+     "bool",
+     "the upload was done within the previous frame (1 = yes)",
+     true,
+     true,
+     [](Row f) { return nlohmann::json(f.hidden); },
+     {Printed::kCycle, "hidden"},
+     [](Row f) { return f.gap ? "gap" : yes_no(f.hidden); },
+     true},
+    {"stall_cycles",
+     "cycles",
+     "cycles the frame started after the previous frame's end",
+     true,
+     true,
+     [](Row f) { return nlohmann::json(f.stall_cycles); },
+     {Printed::kCycle, "stall"},
+     nullptr,
+     true},
     {"start_cycle", "cycles", "the frame's start on the sequence's clock", true, true,
      [](Row f) { return nlohmann::json(f.start_cycle); }},
-    {"cycles", "cycles", "simulated cycles of the frame", true, true,
-     [](Row f) { return nlohmann::json(f.cycles); }},
-    {"fps", "frames/s", "frames per second rendering alone, at the modelled clock", true, true,
-     [](Row f) { return nlohmann::json(f.fps); }},
-    figure_column<units::figure_index("usage.traversal")>(),
-    figure_column<units::figure_index("usage.list")>(),
-    figure_column<units::figure_index("usage.transformation")>(),
-    figure_column<units::figure_index("usage.intersection")>(),
-    figure_column<units::figure_index("cache_hit.traversal")>(),
-    figure_column<units::figure_index("cache_hit.list")>(),
-    figure_column<units::figure_index("cache_hit.transformation")>(),
+    {"cycles",
+     "cycles",
+     "simulated cycles of the frame",
+     true,
+     true,
+     [](Row f) { return nlohmann::json(f.cycles); },
+     {Printed::kCycle, "render cyc"}},
+    {"fps",
+     "frames/s",
+     "frames per second rendering alone, at the modelled clock",
+     true,
+     true,
+     [](Row f) { return nlohmann::json(f.fps); },
+     {Printed::kCycle, "fps", "%.1f"}},
+    figure_column<units::figure_index("usage.traversal")>({Printed::kCycle, "trav"}),
+    figure_column<units::figure_index("usage.list")>({Printed::kCycle, "list"}),
+    figure_column<units::figure_index("usage.transformation")>({Printed::kCycle, "xfrm"}),
+    figure_column<units::figure_index("usage.intersection")>({Printed::kCycle, "int"}),
+    figure_column<units::figure_index("cache_hit.traversal")>({Printed::kCycle, "hit t"}),
+    figure_column<units::figure_index("cache_hit.list")>({Printed::kCycle, "hit l"}),
+    figure_column<units::figure_index("cache_hit.transformation")>({Printed::kCycle, "hit x"}),
     figure_column<units::figure_index("bandwidth_mb_s.dynrtc")>(),
     {"cycles_per_packet", "cycles", "cycles per packet", true, true,
      [](Row f) { return nlohmann::json(f.cycles_per_packet); }},
@@ -457,47 +551,120 @@ constexpr RowColumn kRowColumns[] = {
      [](Row f) { return nlohmann::json(f.rays); }},
     {"digest", "hash", "FNV-1a of the hit records and the image", false, true,
      [](Row f) { return nlohmann::json(f.digest); }},
+    // The host's top-level (re)build on this machine: not on the model's clock (D46).
+    {"host_rebuild_ms",
+     "ms",
+     "the host's top-level rebuild for the frame (wall clock)",
+     false,
+     false,
+     [](Row f) { return nlohmann::json(f.host_rebuild_seconds * 1e3); },
+     {Printed::kAlways, "rebuild ms", "%.2f"},
+     nullptr,
+     false,
+     true},
 };
 
-std::vector<ReportStat> row_stats(const SequenceFrame& f, bool cycle) {
+bool in_rows(const RowColumn& c, bool cycle, bool host_times) {
+  return (cycle || !c.cycle_only) && (host_times || !c.host);
+}
+
+std::vector<ReportStat> row_stats(const SequenceFrame& f, bool cycle, bool host_times = false) {
   std::vector<ReportStat> out;
   for (const RowColumn& c : kRowColumns)
-    if (cycle || !c.cycle_only) out.push_back({c.name, c.unit, c.desc, c.value(f)});
+    if (in_rows(c, cycle, host_times)) out.push_back({c.name, c.unit, c.desc, c.value(f)});
   return out;
 }
 
-// The sequence's summary, declared once.
-std::vector<ReportStat> summary_stats(const SequenceResult& r) {
-  std::uint64_t bytes = 0, max_bytes = 0, top = 0, bottom = 0;
-  for (const SequenceFrame& f : r.frames) {
-    if (f.index == 0) continue;  // frame 0's upload is the initial load, its trees the first build
-    bytes += f.upload_bytes;
-    max_bytes = std::max(max_bytes, f.upload_bytes);
-    top += f.top_level_builds;
-    bottom += f.bottom_level_builds;
-  }
-  const std::size_t n = r.frames.size();
-  std::vector<ReportStat> s = {
-      {"upload_bytes_total", "bytes", "bytes uploaded after frame 0", bytes},
-      {"upload_bytes_mean", "bytes", "bytes uploaded per frame after frame 0",
-       n > 1 ? static_cast<double>(bytes) / (n - 1) : 0.0},
-      {"upload_bytes_max", "bytes", "largest upload after frame 0", max_bytes},
-      {"top_level_rebuilds", "trees", "top-level trees rebuilt after frame 0", top},
-      {"bottom_level_rebuilds", "trees", "bottom-level trees rebuilt after frame 0", bottom},
-      {"bottom_level_trees", "trees", "bottom-level trees built for frame 0",
-       r.frames.empty() ? 0 : r.frames.front().bottom_level_builds}};
-  if (!r.cycle) return s;
-  s.push_back({"cycles", "cycles", "the sequence from frame 0's start to the last frame's end",
-               r.total_cycles()});
-  s.push_back({"fps", "frames/s", "frames per second with the uploads", r.fps()});
-  s.push_back({"render_fps", "frames/s", "frames per second rendering alone", r.render_fps()});
-  s.push_back(
-      {"uploads_hidden", "uploads", "uploads done within the previous frame", r.hidden_uploads()});
-  s.push_back({"uploads_in_gaps", "uploads", "uploads that waited for a frame's end", r.gaps()});
-  s.push_back({"uploads", "uploads", "uploads after frame 0", n > 0 ? n - 1 : 0});
-  s.push_back({"break_even_mb_s", "MB/s", "the lowest bus bandwidth every upload fits behind",
-               r.break_even_mb_s()});
+// Frames 1..N-1: frame 0's upload is the initial load, its trees the first build.
+std::uint64_t sum_after_first(Run r, std::uint64_t SequenceFrame::*m) {
+  std::uint64_t s = 0;
+  for (std::size_t k = 1; k < r.frames.size(); ++k)
+    s += r.frames[k].*m;
   return s;
+}
+std::uint64_t max_after_first(Run r, std::uint64_t SequenceFrame::*m) {
+  std::uint64_t s = 0;
+  for (std::size_t k = 1; k < r.frames.size(); ++k)
+    s = std::max(s, r.frames[k].*m);
+  return s;
+}
+std::size_t uploads(Run r) {
+  return r.frames.empty() ? 0 : r.frames.size() - 1;
+}
+double mean_after_first(Run r, std::uint64_t SequenceFrame::*m) {
+  return r.frames.size() > 1
+             ? static_cast<double>(sum_after_first(r, m)) / static_cast<double>(r.frames.size() - 1)
+             : 0.0;
+}
+
+int frames_delayed(Run r) {
+  int n = 0;
+  for (std::size_t k = 1; k < r.frames.size(); ++k)
+    n += r.frames[k].stall_cycles > 0 ? 1 : 0;
+  return n;
+}
+
+// One statistic of a sequence's summary, declared once: its key, unit, description and value,
+// and its cell in the bus sweep's table (a sequence per row).
+struct SummaryColumn {
+  const char* name;
+  const char* unit;
+  const char* desc;
+  bool cycle_only;
+  nlohmann::json (*value)(const SequenceResult&);
+  const char* head = nullptr;  // the bus sweep table's header (nullptr: not printed)
+  const char* format = "%.0f";
+  std::string (*text)(const SequenceResult&) = nullptr;  // printed in place of the value
+};
+
+constexpr SummaryColumn kSummaryColumns[] = {
+    {"upload_bytes_total", "bytes", "bytes uploaded after frame 0", false,
+     [](Run r) { return nlohmann::json(sum_after_first(r, &SequenceFrame::upload_bytes)); }},
+    {"upload_bytes_mean", "bytes", "bytes uploaded per frame after frame 0", false,
+     [](Run r) { return nlohmann::json(mean_after_first(r, &SequenceFrame::upload_bytes)); }},
+    {"upload_bytes_max", "bytes", "largest upload after frame 0", false,
+     [](Run r) { return nlohmann::json(max_after_first(r, &SequenceFrame::upload_bytes)); }},
+    {"top_level_rebuilds", "trees", "top-level trees rebuilt after frame 0", false,
+     [](Run r) { return nlohmann::json(sum_after_first(r, &SequenceFrame::top_level_builds)); }},
+    {"bottom_level_rebuilds", "trees", "bottom-level trees rebuilt after frame 0", false,
+     [](Run r) { return nlohmann::json(sum_after_first(r, &SequenceFrame::bottom_level_builds)); }},
+    {"bottom_level_trees", "trees", "bottom-level trees built for frame 0", false,
+     [](Run r) {
+       return nlohmann::json(r.frames.empty() ? 0 : r.frames.front().bottom_level_builds);
+     }},
+    {"cycles", "cycles", "the sequence from frame 0's start to the last frame's end", true,
+     [](Run r) { return nlohmann::json(r.total_cycles()); }},
+    {"fps", "frames/s", "frames per second with the uploads", true,
+     [](Run r) { return nlohmann::json(r.fps()); }, "sequence fps", "%.2f"},
+    {"render_fps", "frames/s", "frames per second rendering alone", true,
+     [](Run r) { return nlohmann::json(r.render_fps()); }, "render fps", "%.2f"},
+    {"uploads_hidden", "uploads", "uploads done within the previous frame", true,
+     [](Run r) { return nlohmann::json(r.hidden_uploads()); }, "uploads hidden", "",
+     [](Run r) {
+       return std::to_string(r.hidden_uploads()) + " of " + std::to_string(uploads(r));
+     }},
+    {"uploads_in_gaps", "uploads", "uploads that waited for a frame's end", true,
+     [](Run r) { return nlohmann::json(r.gaps()); }},
+    {"uploads", "uploads", "uploads after frame 0", true,
+     [](Run r) { return nlohmann::json(uploads(r)); }},
+    {"break_even_mb_s", "MB/s", "the lowest bus bandwidth every upload fits behind", true,
+     [](Run r) { return nlohmann::json(r.break_even_mb_s()); }},
+    {"frames_delayed", "frames", "frames that started after the previous frame's end", true,
+     [](Run r) { return nlohmann::json(frames_delayed(r)); }, "frames delayed"},
+    {"stall_cycles_max", "cycles", "the longest wait of a frame for its upload", true,
+     [](Run r) { return nlohmann::json(max_after_first(r, &SequenceFrame::stall_cycles)); },
+     "max stall cyc"},
+    {"upload_cycles_mean", "cycles",
+     "the uploads' cycles from the previous frame's start, per frame after frame 0", true,
+     [](Run r) { return nlohmann::json(mean_after_first(r, &SequenceFrame::upload_cycles)); },
+     "mean upload cyc"},
+};
+
+std::vector<ReportStat> summary_stats(const SequenceResult& r) {
+  std::vector<ReportStat> out;
+  for (const SummaryColumn& c : kSummaryColumns)
+    if (r.cycle || !c.cycle_only) out.push_back({c.name, c.unit, c.desc, c.value(r)});
+  return out;
 }
 
 std::string csv_cell(const RowColumn& c, const nlohmann::json& v) {
@@ -511,6 +678,100 @@ std::string csv_cell(const RowColumn& c, const nlohmann::json& v) {
   else
     return v.dump();
   return buf;
+}
+
+std::string printf_cell(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// Rows of cells (the first: the headers) right-aligned in columns two spaces apart.
+std::string aligned(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> width;
+  for (const auto& row : rows)
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      if (width.size() <= i) width.push_back(0);
+      width[i] = std::max(width[i], row[i].size());
+    }
+  std::string s;
+  for (const auto& row : rows) {
+    for (std::size_t i = 0; i < row.size(); ++i)
+      s += (i == 0 ? "" : "  ") + std::string(width[i] - row[i].size(), ' ') + row[i];
+    s += "\n";
+  }
+  return s;
+}
+
+bool printed(const RowColumn& c, bool cycle) {
+  return c.cell.printed == Printed::kAlways || (cycle && c.cell.printed == Printed::kCycle) ||
+         (!cycle && c.cell.printed == Printed::kFunctional);
+}
+
+std::string row_cell(const RowColumn& c, Row f) {
+  if (c.upload && f.index == 0) return "-";
+  if (c.word != nullptr) return c.word(f);
+  return printf_cell(c.cell.format, num(c.value(f)));
+}
+
+// The sequence: scene, model, frames, the scene's instances and the initial load.
+std::string table_header(Run r) {
+  std::string s;
+  char buf[400];
+  std::snprintf(
+      buf, sizeof buf, "frames: %s, model %s, %dx%d, %zu frames %g s apart, %s\n", r.scene.c_str(),
+      r.model.c_str(), r.width, r.height, r.frames.size(), r.dt,
+      r.frame_gap ? "one top-level copy (uploads in frame gaps)" : "two top-level copies");
+  s += buf;
+  std::snprintf(buf, sizeof buf,
+                "  %" PRIu64 " objects, %" PRIu64 " instances (%" PRIu64
+                " dynamic); a top-level copy %.1f KB; initial load %.2f MB",
+                r.objects, r.instances, r.dynamic_instances,
+                static_cast<double>(r.top_copy_bytes) / 1024.0,
+                static_cast<double>(r.initial_load_bytes) / 1048576.0);
+  s += buf;
+  if (r.cycle) {
+    std::snprintf(buf, sizeof buf, ", %" PRIu64 " cycles = %.1f ms over the %g MB/s host bus",
+                  r.initial_load_cycles,
+                  static_cast<double>(r.initial_load_cycles) / (r.clock_mhz * 1e3), r.bus_mb_s);
+    s += buf;
+  }
+  return s + "\n";
+}
+
+std::string table_summary(Run r) {
+  std::string s;
+  char buf[400];
+  const nlohmann::json sum = nest(summary_stats(r));
+  std::snprintf(buf, sizeof buf,
+                "summary: uploads %.0f B per frame on average, at most %" PRIu64
+                " B; top-level rebuilds %" PRIu64 ", bottom-level rebuilds %" PRIu64 " (%" PRIu64
+                " bottom-level trees built for frame 0, reused since)\n",
+                sum["upload_bytes_mean"].get<double>(),
+                sum["upload_bytes_max"].get<std::uint64_t>(),
+                sum["top_level_rebuilds"].get<std::uint64_t>(),
+                sum["bottom_level_rebuilds"].get<std::uint64_t>(),
+                sum["bottom_level_trees"].get<std::uint64_t>());
+  s += buf;
+  if (r.cycle && !r.frames.empty()) {
+    std::snprintf(buf, sizeof buf,
+                  "  %" PRIu64
+                  " cycles = %.2f fps at %g MHz with the uploads (%.2f fps rendering "
+                  "alone); uploads hidden behind the previous frame: %d of %zu (%d in frame "
+                  "gaps); the others would fit down to %.3g MB/s\n",
+                  sum["cycles"].get<std::uint64_t>(), sum["fps"].get<double>(), r.clock_mhz,
+                  sum["render_fps"].get<double>(), sum["uploads_hidden"].get<int>(),
+                  sum["uploads"].get<std::size_t>(), sum["uploads_in_gaps"].get<int>(),
+                  sum["break_even_mb_s"].get<double>());
+    s += buf;
+  }
+  return s;
+}
+
+const SummaryColumn& summary_column(std::string_view name) {
+  for (const SummaryColumn& c : kSummaryColumns)
+    if (name == c.name) return c;
+  throw std::logic_error("no summary statistic " + std::string(name));
 }
 
 }  // namespace
@@ -534,11 +795,8 @@ nlohmann::json sequence_json(const SequenceResult& r, bool host_times) {
     j["initial_load"]["cycles"] = r.initial_load_cycles;
   }
   nlohmann::json rows = nlohmann::json::array();
-  for (const SequenceFrame& f : r.frames) {
-    nlohmann::json e = nest(row_stats(f, r.cycle));
-    if (host_times) e["host_rebuild_ms"] = f.host_rebuild_seconds * 1e3;
-    rows.push_back(e);
-  }
+  for (const SequenceFrame& f : r.frames)
+    rows.push_back(nest(row_stats(f, r.cycle, host_times)));
   j["per_frame"] = rows;
   j["summary"] = nest(summary_stats(r));
   return j;
@@ -561,6 +819,41 @@ std::string sequence_csv(const SequenceResult& r) {
     }
     s += line + "\n";
   }
+  return s;
+}
+
+std::string sequence_table(const SequenceResult& r) {
+  std::vector<std::vector<std::string>> cells(1);
+  for (const RowColumn& c : kRowColumns)
+    if (printed(c, r.cycle)) cells[0].push_back(c.cell.head);
+  for (const SequenceFrame& f : r.frames) {
+    cells.emplace_back();
+    for (const RowColumn& c : kRowColumns)
+      if (printed(c, r.cycle)) cells.back().push_back(row_cell(c, f));
+  }
+  return table_header(r) + aligned(cells) + table_summary(r);
+}
+
+std::string bus_sweep_table(const std::vector<SequenceResult>& points) {
+  // The bandwidth, then the summary statistics that tell where the uploads stop fitting.
+  constexpr const char* kColumns[] = {
+      "uploads_hidden", "frames_delayed", "stall_cycles_max", "upload_cycles_mean", "fps",
+      "render_fps"};
+  std::vector<std::vector<std::string>> cells = {{"bus MB/s"}};
+  for (const char* name : kColumns)
+    cells[0].push_back(summary_column(name).head);
+  for (const SequenceResult& p : points) {
+    cells.push_back({printf_cell("%.4g", p.bus_mb_s)});
+    for (const char* name : kColumns) {
+      const SummaryColumn& c = summary_column(name);
+      cells.back().push_back(c.text ? c.text(p) : printf_cell(c.format, num(c.value(p))));
+    }
+  }
+  std::string s = aligned(cells);
+  if (!points.empty())
+    s += "(uploads fit behind rendering down to about " +
+         std::to_string(points.front().break_even_mb_s()) +
+         " MB/s by bytes over render time, without bank contention)\n";
   return s;
 }
 
@@ -589,13 +882,14 @@ nlohmann::json sequence_host_json(const SequenceResult& r) {
 nlohmann::json sequence_configuration_json(double time, const RenderSettings& s, bool cycle) {
   nlohmann::json c = {
       {"time", time}, {"shadows", s.shadows}, {"depth", s.depth}, {"bank_mb", s.bank_mb}};
-  if (cycle)
-    for (const units::CycleParamInfo& p : units::describe(resolve_cycle_params(s.cycle)))
-      c["cycle"][p.name] = {{"value", p.value}, {"unit", p.unit}, {"help", p.help}};
+  if (cycle) {
+    const units::CycleParams p = resolve_cycle_params(s.cycle);
+    c["cycle"] = parameters_json(&p, nullptr);
+  }
   host::ImageParams trees;
   for (const std::string& kv : s.cycle.set)
     if (host::is_tree_setting(kv)) host::apply_tree_setting(trees, kv);
-  c["trees"] = tree_configuration_json(trees);
+  c["trees"] = parameters_json(nullptr, &trees);
   return c;
 }
 
@@ -902,7 +1196,8 @@ void write_precision_report(const std::string& json, const std::string& out_dir,
   config["reference"] = "float";
   config["shadows"] = settings.shadows;
   config["depth"] = settings.depth;
-  config["trees"] = tree_configuration_json(host::ImageParams{});
+  const host::ImageParams trees;
+  config["trees"] = parameters_json(nullptr, &trees);
   write_run_folder({out_dir, j, std::move(config), std::move(host), stats_text(stats), argv, {}});
 }
 
@@ -915,11 +1210,73 @@ double paper_ratio(const PaperFigure& f) {
   return f.paper == 0.0 ? 0.0 : f.model / f.paper;
 }
 
+double stat(const nlohmann::json& cycle, const char* name) {
+  return json_at(cycle, name).get<double>();
+}
+
+// The paper's cycles per 4-ray packet and Mrays/s at its fps and resolution (90 MHz).
+void add_rate_figures(std::vector<PaperFigure>& v, const nlohmann::json& cycle, double fps,
+                      int width, int height) {
+  const double rays = fps * width * height;
+  v.push_back({"cycles_per_packet", stat(cycle, "cycles_per_packet"),
+               rays > 0.0 ? 90e6 / (rays / 4.0) : 0.0});
+  v.push_back({"mrays_per_s", stat(cycle, "rays_per_s") / 1e6, rays / 1e6});
+}
+
+std::vector<PaperFigure> table4_figures(const nlohmann::json& cycle, double fps,
+                                        const std::string& paper) {
+  const Table4Row none{"", 0, {0, 0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  const auto row =
+      std::ranges::find_if(paper_table4(), [&](const Table4Row& r) { return paper == r.scene; });
+  const Table4Row& p = row != paper_table4().end() ? *row : none;
+  const nlohmann::json& fb = json_at(cycle, "bandwidth_mb_s.frame_buffer");
+  std::vector<PaperFigure> v = {
+      {"fps", fps, p.fps},
+      {"usage_traversal", stat(cycle, "usage.traversal"), p.usage[0]},
+      {"usage_list", stat(cycle, "usage.list"), p.usage[1]},
+      {"usage_transformation", stat(cycle, "usage.transformation"), p.usage[2]},
+      {"usage_intersection", stat(cycle, "usage.intersection"), p.usage[3]},
+      {"hit_traversal", stat(cycle, "cache_hit.traversal"), p.hit[0]},
+      {"hit_list", stat(cycle, "cache_hit.list"), p.hit[1]},
+      {"hit_transformation", stat(cycle, "cache_hit.transformation"), p.hit[2]},
+      {"mb_s_dynrtc", stat(cycle, "bandwidth_mb_s.dynrtc"), p.bw[0]},
+      // The paper's shading bandwidth includes the frame buffer (docs/fidelity.md).
+      {"mb_s_shading",
+       stat(cycle, "bandwidth_mb_s.shading") + (fb.is_number() ? fb.get<double>() : 0.0), p.bw[1]},
+      {"mb_s_total", stat(cycle, "bandwidth_mb_s.total"), p.bw[2]},
+  };
+  add_rate_figures(v, cycle, p.fps, 1024, 768);
+  // Shading and frame-buffer bytes per pixel: the paper's from its shading MB/s over its frame
+  // rate at 1024x768 (Scene6: 19.0).
+  const double paper_bpp = p.fps > 0 ? p.bw[1] * 1048576.0 / (p.fps * 1024.0 * 768.0) : 0.0;
+  const nlohmann::json& bpp = json_at(cycle, "rgs.shading_bytes_per_pixel");
+  v.push_back({"shading_bytes_per_pixel", bpp.is_number() ? bpp.get<double>() : 0.0, paper_bpp});
+  return v;
+}
+
+std::vector<PaperFigure> table3_figures(const nlohmann::json& cycle, double fps,
+                                        const std::string& paper) {
+  const Table3Row* r = paper_table3_row(paper);
+  const double paper_fps = r ? r->saarcor_fps : 0.0;
+  std::vector<PaperFigure> v = {{"fps", fps, paper_fps}};
+  add_rate_figures(v, cycle, paper_fps, 512, 384);
+  return v;
+}
+
 }  // namespace
 
+std::vector<PaperFigure> paper_figures(int table, const std::string& paper,
+                                       const nlohmann::json& cycle, int width, int height) {
+  // A frame at 1/scale of the table's resolution: its fps as the paper's frame would have it
+  // (cycles per packet and rays/s do not depend on the resolution but through the image's
+  // content).
+  const int pw = table == 3 ? 512 : 1024, ph = table == 3 ? 384 : 768;
+  const double fps = stat(cycle, "fps") * (width * height) / (pw * ph);
+  return table == 3 ? table3_figures(cycle, fps, paper) : table4_figures(cycle, fps, paper);
+}
+
 nlohmann::json paper_entry_json(int table, const std::string& paper, const std::string& scene,
-                                bool reference, const std::string& resolution,
-                                const std::vector<PaperFigure>& figures,
+                                bool reference, int width, int height,
                                 const std::vector<std::string>& settings,
                                 const nlohmann::json& cycle) {
   nlohmann::json e;
@@ -927,10 +1284,10 @@ nlohmann::json paper_entry_json(int table, const std::string& paper, const std::
   e["paper_scene"] = paper;
   e["scene"] = scene;
   e["kind"] = reference ? "reference" : "stand-in";
-  e["resolution"] = resolution;
+  e["resolution"] = std::to_string(width) + "x" + std::to_string(height);
   e["paper_resolution"] = table == 3 ? "512x384" : "1024x768";
   nlohmann::json fj = nlohmann::json::object();
-  for (const PaperFigure& g : figures)
+  for (const PaperFigure& g : paper_figures(table, paper, cycle, width, height))
     fj[g.key] = {{"model", g.model}, {"paper", g.paper}, {"ratio", paper_ratio(g)}};
   e["figures"] = fj;
   e["configuration"] = settings;
@@ -974,6 +1331,156 @@ nlohmann::json thread_curve_json(const std::vector<int>& counts,
     last = fps;
   }
   return {{"scene", "builtin:room"}, {"resolution", resolution}, {"rows", rows}};
+}
+
+// ---- scene and compare ------------------------------------------------------------------------
+
+namespace {
+
+nlohmann::json tree_json(const host::KdTreeStats& s) {
+  return {{"nodes", s.nodes},
+          {"leaves", s.leaves},
+          {"empty_leaves", s.empty_leaves},
+          {"empty_chain_links", s.empty_chain_links},
+          {"mergeable_chain_links", s.mergeable_chain_links},
+          {"depth", s.depth},
+          {"items_per_leaf", s.items_per_leaf},
+          {"sah_cost", s.sah_cost},
+          {"expected_traversal_steps", s.expected_traversal_steps},
+          {"expected_leaf_visits", s.expected_leaf_visits},
+          {"expected_item_tests", s.expected_item_tests},
+          {"build_seconds", s.build_seconds}};
+}
+
+// A bottom tree's entry adds the busiest-unit objective's record (the top level keeps the plain
+// SAH: host/tree_objective.h).
+nlohmann::json bottom_tree_json(const host::KdTreeStats& s) {
+  nlohmann::json j = tree_json(s);
+  j["traversal_cost"] = s.chosen_traversal_cost;
+  j["expected_unit_cycles"] = {{"traversal", s.expected_traversal_cycles},
+                               {"list", s.expected_list_cycles},
+                               {"transformation", s.expected_transformation_cycles},
+                               {"intersection", s.expected_intersection_cycles}};
+  return j;
+}
+
+// Every bottom tree (per object) and their sums.
+nlohmann::json bottom_json(const SceneTrees& t, const host::Scene& scene) {
+  host::KdTreeStats sum;
+  std::uint64_t triangles = 0;
+  double leaf_items = 0.0;
+  std::uint64_t nonempty = 0;
+  nlohmann::json per_object = nlohmann::json::array();
+  for (const auto& [o, s] : t.bottom) {
+    sum.nodes += s.nodes;
+    sum.leaves += s.leaves;
+    sum.empty_leaves += s.empty_leaves;
+    sum.empty_chain_links += s.empty_chain_links;
+    sum.mergeable_chain_links += s.mergeable_chain_links;
+    sum.depth = std::max(sum.depth, s.depth);
+    sum.build_seconds += s.build_seconds;
+    leaf_items += s.items_per_leaf * (s.leaves - s.empty_leaves);
+    nonempty += s.leaves - s.empty_leaves;
+    nlohmann::json j = bottom_tree_json(s);
+    j["object"] = o;
+    j["name"] = scene.objects[o].name;
+    j["triangles"] = scene.objects[o].triangles.size();
+    j["nodes_per_triangle"] =
+        static_cast<double>(s.nodes) / std::max<double>(1.0, scene.objects[o].triangles.size());
+    triangles += scene.objects[o].triangles.size();
+    per_object.push_back(j);
+  }
+  return {{"trees", t.bottom.size()},
+          {"nodes", sum.nodes},
+          {"leaves", sum.leaves},
+          {"empty_leaves", sum.empty_leaves},
+          {"empty_chain_links", sum.empty_chain_links},
+          {"mergeable_chain_links", sum.mergeable_chain_links},
+          {"max_depth", sum.depth},
+          {"nodes_per_triangle",
+           static_cast<double>(sum.nodes) / std::max<double>(1.0, static_cast<double>(triangles))},
+          {"items_per_leaf", nonempty ? leaf_items / static_cast<double>(nonempty) : 0.0},
+          {"build_seconds", sum.build_seconds},
+          {"objects", per_object}};
+}
+
+// What the scene holds: counts, cameras, animation, the loader's warnings.
+nlohmann::json scene_counts_json(const host::Scene& scene) {
+  nlohmann::json j;
+  j["time"] = scene.time;
+  j["triangles"] = scene.instanced_triangles();
+  j["unique_triangles"] = scene.unique_triangles();
+  j["objects"] = scene.objects.size();
+  j["instances"] = scene.instances.size();
+  j["dynamic_instances"] = dynamic_instances(scene);
+  j["materials"] = scene.materials.size();
+  j["textures"] = scene.textures.size();
+  j["lights"] = scene.lights.size();
+  j["light_defaulted"] = scene.light_defaulted;
+  j["cameras"] = scene.cameras.size();
+  j["camera_names"] = nlohmann::json::array();
+  for (const host::Camera& c : scene.cameras)
+    j["camera_names"].push_back(c.name);
+  j["animation_seconds"] = scene.animation_seconds;
+  j["dropped_triangles"] = scene.dropped_triangles();
+  j["dropped_triangles_instanced"] = scene.instanced_dropped_triangles();
+  j["skipped_primitives"] = scene.skipped_primitives;
+  j["warnings"] = scene.warnings;
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json scene_report_json(const SceneOptions& options, const host::Scene& scene,
+                                 double load_seconds, const SceneImage& img) {
+  nlohmann::json j = scene_counts_json(scene);
+  j["scene"] = options.scene;
+  j["load_seconds"] = load_seconds;
+  j["kdtree"] = {{"top", tree_json(img.trees.top)}, {"bottom", bottom_json(img.trees, scene)}};
+  if (img.built) {
+    j["bytes_per_bank"] = img.built->stats.bytes_per_bank;
+    j["bank_bytes"] = static_cast<std::uint64_t>(img.params.bank_words) * 4u;
+    j["image_seconds"] = img.seconds;
+    j["image_error"] = nullptr;
+  } else {
+    j["bytes_per_bank"] = nullptr;
+    j["image_error"] = img.error;
+  }
+  if (!options.export_path.empty()) j["exported"] = options.export_path;
+  return j;
+}
+
+nlohmann::json compare_report_json(const CompareResult& r) {
+  // JSON has no infinity: an infinite or absent figure is null (docs/compare.md).
+  auto finite = [](const std::optional<double>& v) -> nlohmann::json {
+    if (!v || !std::isfinite(*v)) return nullptr;
+    return *v;
+  };
+  nlohmann::json j;
+  j["kind"] = r.hit_records ? "hit_records" : "images";
+  j["width"] = r.width;
+  j["height"] = r.height;
+  j["pixels"] = r.pixels;
+  j["bit_identical"] = r.bit_identical;
+  if (r.hit_records) {
+    j["same_triangle_pct"] = r.same_triangle_pct;
+    j["t_compared_pixels"] = r.t_compared;
+    j["mismatches"] = {{"hit_vs_miss", r.mismatches.hit_vs_miss},
+                       {"hit_vs_miss_near_edge", r.mismatches.hit_vs_miss_near_edge},
+                       {"edge_tie", r.mismatches.edge_tie},
+                       {"grazing", r.mismatches.grazing},
+                       {"other", r.mismatches.other},
+                       {"total", r.mismatches.total()}};
+  } else {
+    j["same_triangle_pct"] = nullptr;
+    j["mismatches"] = {{"differing_pixels", r.differing_pixels}};
+  }
+  j["t_rel_err_max"] = finite(r.t_rel_err_max);
+  j["t_rel_err_median"] = finite(r.t_rel_err_median);
+  j["psnr_db"] = finite(r.psnr_db);
+  j["max_channel_diff"] = finite(r.max_channel_diff);
+  if (!r.hit_records) j["max_channel_diff_unit"] = r.eight_bit ? "8-bit levels" : "float";
+  return j;
 }
 
 // ---- the run folder ----------------------------------------------------------------------------
@@ -1044,10 +1551,20 @@ std::string describe_format(ff::Format f) {
          ff::format_name(f) + ")";
 }
 
-nlohmann::json tree_configuration_json(const host::ImageParams& trees) {
+nlohmann::json parameters_json(const units::CycleParams* cycle, const host::ImageParams* trees) {
   nlohmann::json j = nlohmann::json::object();
-  for (const host::TreeSettingInfo& t : host::describe_tree_settings(trees))
-    j[t.name] = {{"value", t.value}, {"unit", t.unit}, {"help", t.help}};
+  const auto add = [&j](const std::vector<hw::ParamInfo>& keys) {
+    for (const hw::ParamInfo& k : keys)
+      j[k.name] = {{"value", k.value}, {"unit", k.unit}, {"help", k.help}};
+  };
+  if (cycle != nullptr) {
+    add(units::describe(*cycle));
+    j["depth.traversal"] = cycle->traversal_depth();
+    j["depth.list"] = cycle->list_depth();
+    j["depth.transformation"] = cycle->transformation_depth();
+    j["depth.intersection"] = cycle->intersection_depth();
+  }
+  if (trees != nullptr) add(host::describe_tree_settings(*trees));
   return j;
 }
 
@@ -1093,7 +1610,7 @@ nlohmann::json render_report_json(const std::string& scene, const std::string& m
     c.erase("configuration");
     j.update(c);
   } else {  // the other models read the same trees: their keys are configuration too
-    j["configuration"]["trees"] = tree_configuration_json(prep.built.params);
+    j["configuration"]["trees"] = parameters_json(nullptr, &prep.built.params);
   }
   return j;
 }

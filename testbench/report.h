@@ -40,6 +40,9 @@ struct PrecisionRow;
 struct SweepOptions;
 struct SweepPoint;
 struct SweepResult;
+struct SceneOptions;
+struct SceneImage;
+struct CompareResult;
 
 // ---- statistics and their declarations ---------------------------------------------------------
 
@@ -91,9 +94,10 @@ std::vector<ReportStat> op_stats(const units::UnitStats& u);
 // The frame's statistics as the report writes them: cycles, fps, rays, rates, the Table 4 figures
 // (units/figures.h), the RGS's traffic, per-ray counters, per-unit and per-cache counts.
 std::vector<ReportStat> cycle_stats(const CycleFrame& frame);
-// The per-frame report: cycle_stats, host, pipelines, configuration, the hw/ registry (stats),
+// The per-frame report: cycle_stats, host, pipelines, configuration (the cycle keys and, given
+// `trees`, the kd-tree keys the image was built with: parameters_json), the hw/ registry (stats),
 // (time_series).
-nlohmann::json cycle_report_json(const CycleFrame& frame);
+nlohmann::json cycle_report_json(const CycleFrame& frame, const host::ImageParams* trees = nullptr);
 // stats.txt's lines of a cycle report (as cycle_report_json wrote it; a sweep's points travel as
 // JSON): each frame statistic as "frame.NAME" with its declaration's description and unit, then
 // every statistic of the hw/ registry with its own.
@@ -101,12 +105,19 @@ std::vector<StatLine> cycle_stat_lines(const nlohmann::json& cycle);
 
 // ---- frame sequences (render --frames N) -------------------------------------------------------
 
-// The report (host timing only with host_times: each frame's top-level rebuild on this host, which
-// a run folder keeps in host.json) and the CSV of the frames (no host timing), both from the
-// per-frame rows' one declaration; the bus sweep's report (one sequence report per bandwidth).
+// The per-frame rows' columns and the summary's statistics are each declared once (kRowColumns,
+// kSummaryColumns in report.cpp). The report (host timing only with host_times: each frame's
+// top-level rebuild on this host, which a run folder keeps in host.json) and the CSV of the frames
+// (no host timing), both from the per-frame rows' one declaration; the bus sweep's report (one
+// sequence report per bandwidth).
 nlohmann::json sequence_json(const SequenceResult& r, bool host_times = false);
 std::string sequence_csv(const SequenceResult& r);
 nlohmann::json bus_sweep_json(const std::vector<SequenceResult>& points);
+// The printed per-frame table (with the host's rebuild times) and summary, and the bus sweep's
+// table (a row per bandwidth: its summary statistics), from the same declarations as the JSON,
+// the CSV and stats.txt.
+std::string sequence_table(const SequenceResult& r);
+std::string bus_sweep_table(const std::vector<SequenceResult>& points);
 // host.json of a sequence: each frame's host seconds and top-level rebuild seconds, and the
 // largest rebuild after frame 0.
 nlohmann::json sequence_host_json(const SequenceResult& r);
@@ -147,11 +158,18 @@ void write_precision_report(const std::string& json, const std::string& out_dir,
 
 // ---- the paper's tables ---------------------------------------------------------------------
 
+// One table's figures for the paper's scene `paper` (Table 3: fps, cycles per packet, Mrays/s;
+// Table 4: fps, the four usages, three hit rates, DynRTC, shading and total MB/s, those two and
+// the shading bytes per pixel), each the model's, read from the frame's cycle report by its
+// declared name, beside the paper's. The frame ran at width x height (the table's resolution over
+// --scale): its fps is the one the table's frame would have, scaled by their pixels.
+std::vector<PaperFigure> paper_figures(int table, const std::string& paper,
+                                       const nlohmann::json& cycle, int width, int height);
 // One table's entry for one scene of `saarcor paper`: the scene, the frame's resolution, each
-// figure beside the paper's with their ratio, the settings and the model's whole cycle report.
+// figure beside the paper's with their ratio (paper_figures), the settings and the model's whole
+// cycle report.
 nlohmann::json paper_entry_json(int table, const std::string& paper, const std::string& scene,
-                                bool reference, const std::string& resolution,
-                                const std::vector<PaperFigure>& figures,
+                                bool reference, int width, int height,
                                 const std::vector<std::string>& settings,
                                 const nlohmann::json& cycle);
 // The tables' result: the entries, scene after scene (moved out of `per_scene`).
@@ -162,6 +180,16 @@ nlohmann::json paper_tables_json(int scale, const std::vector<std::string>& set,
 nlohmann::json thread_curve_json(const std::vector<int>& counts,
                                  const std::vector<nlohmann::json>& reports,
                                  const std::string& resolution);
+
+// ---- scene and compare ------------------------------------------------------------------------
+
+// `saarcor scene --json` (the printout reads it too): the scene's counts, both kd-tree levels'
+// statistics (per bottom tree and summed), the bytes per bank or why the image does not build.
+nlohmann::json scene_report_json(const SceneOptions& options, const host::Scene& scene,
+                                 double load_seconds, const SceneImage& image);
+// `saarcor compare --report`: keys pixels, same_triangle_pct, bit_identical, t_rel_err_max,
+// t_rel_err_median, psnr_db, max_channel_diff, mismatches (and a few more, docs/compare.md).
+nlohmann::json compare_report_json(const CompareResult& r);
 
 // ---- the run folder ----------------------------------------------------------------------------
 
@@ -200,8 +228,11 @@ void list_run_folder(const RunFolder& folder,
 
 // "Float<7,16> (e7m16)".
 std::string describe_format(ff::Format f);
-// The kd-tree builder's keys as configuration ({"kd.KEY": {value, unit, help}}).
-nlohmann::json tree_configuration_json(const host::ImageParams& trees);
+// The parameter tables' keys resolved (hw::ParamTable): the cycle keys with the unit depths they
+// give (`cycle`), the kd-tree builder's keys (`trees`), each {"KEY": {value, unit, help}} as its
+// table declares it. The one builder of the keys every config.json and every report's
+// configuration holds (the render, sequence, precision and sweep folders, the cycle report).
+nlohmann::json parameters_json(const units::CycleParams* cycle, const host::ImageParams* trees);
 // `saarcor render`'s report: the scene, model, resolution, host time, rays, the model's counters,
 // the configuration (frame, image, trees or cycle keys) and, with the cycle model, its frame
 // report's figures at the top.

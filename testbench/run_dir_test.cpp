@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "testbench/render_cmd.h"
 #include "testbench/testing.h"
 
 namespace saarcor {
@@ -78,6 +79,26 @@ void expect_every_line_declared(const std::string& stats) {
     ++checked;
   }
   EXPECT_GT(checked, 0u);
+}
+
+// Every configuration's keys come from the parameter tables through parameters_json: the cycle
+// keys with the unit depths they give, the kd-tree keys, each with its declared unit and help.
+TEST(RunDir, ConfigurationKeysComeFromTheParameterTables) {
+  const units::CycleParams cycle;
+  const host::ImageParams trees;
+  const nlohmann::json both = parameters_json(&cycle, &trees);
+  EXPECT_EQ(both["threads"]["value"], 64);  // the prototype's defaults
+  EXPECT_FALSE(both["threads"]["help"].get<std::string>().empty());
+  EXPECT_EQ(both["depth.traversal"], cycle.traversal_depth());
+  EXPECT_EQ(both["kd.traversal_cost"]["value"], 30);
+  EXPECT_EQ(parameters_json(nullptr, &trees).count("threads"), 0u);
+  EXPECT_EQ(parameters_json(nullptr, &trees)["kd.traversal_cost"], both["kd.traversal_cost"]);
+  EXPECT_TRUE(parameters_json(nullptr, nullptr).empty());
+  // A frame sequence's config.json holds the same keys (depth.* included) as the cycle report.
+  RenderSettings s = frame_settings("8x6", 0.0, false, 0, 4.0);
+  const nlohmann::json seq = sequence_configuration_json(0.0, s, true);
+  EXPECT_EQ(seq["cycle"], parameters_json(&cycle, nullptr));
+  EXPECT_EQ(seq["trees"], parameters_json(nullptr, &trees));
 }
 
 TEST(RunDir, CommandLineQuotesWhatAShellWouldSplit) {

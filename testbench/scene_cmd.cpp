@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <stdexcept>
 
 #include "host/gltf_export.h"
@@ -17,6 +16,7 @@
 #include "host/scene.h"
 #include "host/tree_objective.h"
 #include "host/tree_settings.h"
+#include "testbench/report.h"
 
 namespace saarcor {
 
@@ -29,41 +29,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-json tree_json(const KdTreeStats& s) {
-  return json{{"nodes", s.nodes},
-              {"leaves", s.leaves},
-              {"empty_leaves", s.empty_leaves},
-              {"empty_chain_links", s.empty_chain_links},
-              {"mergeable_chain_links", s.mergeable_chain_links},
-              {"depth", s.depth},
-              {"items_per_leaf", s.items_per_leaf},
-              {"sah_cost", s.sah_cost},
-              {"expected_traversal_steps", s.expected_traversal_steps},
-              {"expected_leaf_visits", s.expected_leaf_visits},
-              {"expected_item_tests", s.expected_item_tests},
-              {"build_seconds", s.build_seconds}};
-}
-// A bottom tree's entry adds the busiest-unit objective's record (the top level keeps the plain
-// SAH: host/tree_objective.h).
-json bottom_tree_json(const KdTreeStats& s) {
-  json j = tree_json(s);
-  j["traversal_cost"] = s.chosen_traversal_cost;
-  j["expected_unit_cycles"] = json{{"traversal", s.expected_traversal_cycles},
-                                   {"list", s.expected_list_cycles},
-                                   {"transformation", s.expected_transformation_cycles},
-                                   {"intersection", s.expected_intersection_cycles}};
-  return j;
-}
-
-struct Trees {
-  KdTreeStats top;
-  std::vector<std::pair<std::uint32_t, KdTreeStats>> bottom;  // (object, stats) of stored objects
-};
-
 // The trees without a memory image (used when the image does not fit its banks): the same
 // builder and parameters the image builder uses (its depth budget and top-level item cost).
-Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& params) {
-  Trees t;
+SceneTrees build_trees_directly(const host::Scene& scene, const host::ImageParams& params) {
+  SceneTrees t;
   std::vector<std::uint8_t> used(scene.objects.size(), 0);
   for (const host::Instance& i : scene.instances)
     used.at(i.object) = 1;
@@ -106,45 +75,6 @@ Trees build_trees_directly(const host::Scene& scene, const host::ImageParams& pa
   return t;
 }
 
-json bottom_json(const Trees& t, const host::Scene& scene) {
-  KdTreeStats sum;
-  std::uint64_t triangles = 0;
-  double leaf_items = 0.0;
-  std::uint64_t nonempty = 0;
-  json per_object = json::array();
-  for (const auto& [o, s] : t.bottom) {
-    sum.nodes += s.nodes;
-    sum.leaves += s.leaves;
-    sum.empty_leaves += s.empty_leaves;
-    sum.empty_chain_links += s.empty_chain_links;
-    sum.mergeable_chain_links += s.mergeable_chain_links;
-    sum.depth = std::max(sum.depth, s.depth);
-    sum.build_seconds += s.build_seconds;
-    leaf_items += s.items_per_leaf * (s.leaves - s.empty_leaves);
-    nonempty += s.leaves - s.empty_leaves;
-    json j = bottom_tree_json(s);
-    j["object"] = o;
-    j["name"] = scene.objects[o].name;
-    j["triangles"] = scene.objects[o].triangles.size();
-    j["nodes_per_triangle"] =
-        static_cast<double>(s.nodes) / std::max<double>(1.0, scene.objects[o].triangles.size());
-    triangles += scene.objects[o].triangles.size();
-    per_object.push_back(j);
-  }
-  return json{{"trees", t.bottom.size()},
-              {"nodes", sum.nodes},
-              {"leaves", sum.leaves},
-              {"empty_leaves", sum.empty_leaves},
-              {"empty_chain_links", sum.empty_chain_links},
-              {"mergeable_chain_links", sum.mergeable_chain_links},
-              {"max_depth", sum.depth},
-              {"nodes_per_triangle", static_cast<double>(sum.nodes) /
-                                         std::max<double>(1.0, static_cast<double>(triangles))},
-              {"items_per_leaf", nonempty ? leaf_items / static_cast<double>(nonempty) : 0.0},
-              {"build_seconds", sum.build_seconds},
-              {"objects", per_object}};
-}
-
 void check_scene_options(const SceneOptions& options) {
   if (!(options.bank_mb > 0.0) || options.bank_mb > 16384.0)
     throw std::runtime_error("--bank-mb must be in (0, 16384], got " +
@@ -153,15 +83,6 @@ void check_scene_options(const SceneOptions& options) {
     throw std::runtime_error("--time must be a finite number >= 0, got " +
                              std::to_string(options.time));
 }
-
-// The memory image, or when it does not fit its banks the reason and the trees built alone.
-struct SceneImage {
-  std::optional<host::BuiltImage> built;
-  std::string error;
-  host::ImageParams params;
-  Trees trees;
-  double seconds = 0.0;
-};
 
 SceneImage build_scene_image(const host::Scene& scene, const SceneOptions& options) {
   SceneImage img;
@@ -185,52 +106,6 @@ SceneImage build_scene_image(const host::Scene& scene, const SceneOptions& optio
   }
   img.seconds = seconds_since(t1);
   return img;
-}
-
-std::uint64_t dynamic_instances(const host::Scene& scene) {
-  std::uint64_t dynamic = 0;
-  for (const host::Instance& i : scene.instances)
-    dynamic += i.dynamic ? 1 : 0;
-  return dynamic;
-}
-
-json scene_json(const SceneOptions& options, const host::Scene& scene, double load_seconds,
-                const SceneImage& img) {
-  json j;
-  j["scene"] = options.scene;
-  j["time"] = scene.time;
-  j["triangles"] = scene.instanced_triangles();
-  j["unique_triangles"] = scene.unique_triangles();
-  j["objects"] = scene.objects.size();
-  j["instances"] = scene.instances.size();
-  j["dynamic_instances"] = dynamic_instances(scene);
-  j["materials"] = scene.materials.size();
-  j["textures"] = scene.textures.size();
-  j["lights"] = scene.lights.size();
-  j["light_defaulted"] = scene.light_defaulted;
-  j["cameras"] = scene.cameras.size();
-  j["camera_names"] = json::array();
-  for (const host::Camera& c : scene.cameras) {
-    j["camera_names"].push_back(c.name);
-  }
-  j["animation_seconds"] = scene.animation_seconds;
-  j["dropped_triangles"] = scene.dropped_triangles();
-  j["dropped_triangles_instanced"] = scene.instanced_dropped_triangles();
-  j["skipped_primitives"] = scene.skipped_primitives;
-  j["warnings"] = scene.warnings;
-  j["load_seconds"] = load_seconds;
-  j["kdtree"] = json{{"top", tree_json(img.trees.top)}, {"bottom", bottom_json(img.trees, scene)}};
-  if (img.built) {
-    j["bytes_per_bank"] = img.built->stats.bytes_per_bank;
-    j["bank_bytes"] = static_cast<std::uint64_t>(img.params.bank_words) * 4u;
-    j["image_seconds"] = img.seconds;
-    j["image_error"] = nullptr;
-  } else {
-    j["bytes_per_bank"] = nullptr;
-    j["image_error"] = img.error;
-  }
-  if (!options.export_path.empty()) j["exported"] = options.export_path;
-  return j;
 }
 
 void print_scene_counts(const SceneOptions& options, const host::Scene& scene,
@@ -300,7 +175,7 @@ void print_object_trees(const json& b) {
     std::printf("  (%zu smaller trees: --json lists every tree)\n", objs.size() - kShown);
 }
 
-void print_trees(const Trees& trees, const json& j) {
+void print_trees(const SceneTrees& trees, const json& j) {
   print_tree_line("kd-tree top", trees.top);
   const json b = j["kdtree"]["bottom"];
   std::printf(
@@ -329,6 +204,13 @@ void print_image(const SceneImage& img) {
 
 }  // namespace
 
+std::uint64_t dynamic_instances(const host::Scene& scene) {
+  std::uint64_t dynamic = 0;
+  for (const host::Instance& i : scene.instances)
+    dynamic += i.dynamic ? 1 : 0;
+  return dynamic;
+}
+
 int run_scene(const SceneOptions& options) {
   check_scene_options(options);
   const auto t0 = std::chrono::steady_clock::now();
@@ -338,7 +220,7 @@ int run_scene(const SceneOptions& options) {
   if (!options.export_path.empty()) host::export_gltf(scene, options.export_path);
 
   const SceneImage img = build_scene_image(scene, options);
-  const json j = scene_json(options, scene, load_seconds, img);
+  const json j = scene_report_json(options, scene, load_seconds, img);
   if (options.json) {
     std::printf("%s\n", j.dump(2).c_str());
     return 0;

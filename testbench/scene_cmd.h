@@ -3,8 +3,14 @@
 // times, bytes per SRAM bank; docs/memory-image.md).
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "host/image_builder.h"
+#include "host/kdtree.h"
 
 namespace saarcor {
 
@@ -17,7 +23,27 @@ struct SceneOptions {
   std::vector<std::string> set;  // kd.KEY=VALUE: the tree builder's keys (host/tree_settings.h)
 };
 
-// Prints the report on stdout; returns the exit status. Bad input throws std::runtime_error.
+// The scene's trees: the top level and each stored object's (built with the memory image, or alone
+// when the image does not fit its banks).
+struct SceneTrees {
+  host::KdTreeStats top;
+  std::vector<std::pair<std::uint32_t, host::KdTreeStats>> bottom;  // (object, stats)
+};
+
+// The memory image, or when it does not fit its banks the reason and the trees built alone.
+struct SceneImage {
+  std::optional<host::BuiltImage> built;
+  std::string error;
+  host::ImageParams params;
+  SceneTrees trees;
+  double seconds = 0.0;
+};
+
+// Instances whose transform is animated.
+std::uint64_t dynamic_instances(const host::Scene& scene);
+
+// Prints the report on stdout (testbench/report.h scene_report_json; --json prints it as JSON);
+// returns the exit status. Bad input throws std::runtime_error.
 int run_scene(const SceneOptions& options);
 
 }  // namespace saarcor

@@ -121,6 +121,9 @@ class CycleUnit : public hw::Module {
   int depth() const { return depth_; }
   std::uint64_t issue_cycles() const { return issued_->value; }
   std::uint64_t requests_served() const { return served_->value; }
+  // The same counts as the registry's counters (<name>.issue_cycles, <name>.requests).
+  const hw::Counter& issue_counter() const { return *issued_; }
+  const hw::Counter& served_counter() const { return *served_; }
   // Threads inside the unit (fetching, waiting for data, ready, issuing, in the pipeline).
   int occupancy() const { return inside_; }
 

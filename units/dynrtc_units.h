@@ -141,6 +141,7 @@ class RaySource : public CycleUnit {
   bool idle() const { return free_ == count_; }
   std::uint64_t packets_retired() const { return retired_->value; }
   std::uint64_t packets_admitted() const { return admitted_->value; }
+  const hw::Counter& admitted_counter() const { return *admitted_; }
 
  protected:
   Fetch fetch(const Request& r) const override;

@@ -11,6 +11,7 @@
 #include <iterator>
 #include <string_view>
 
+#include "hw/stats.h"
 #include "units/cycle_params.h"
 
 namespace saarcor::units {
@@ -49,21 +50,18 @@ inline FigureCounts span(const FigureCounts& a, const FigureCounts& b) {
 
 namespace figure {
 
-inline double percent(std::uint64_t a, std::uint64_t b) {
-  return b == 0 ? 0.0 : 100.0 * static_cast<double>(a) / static_cast<double>(b);
-}
-// MB = 2^20 bytes, per second at the modelled clock (D39).
+// The formulas are the registry's (hw/stats.h): a figure over the chip's sums of the counters is
+// computed as a cache's or a memory client's own statistic is. MB/s at the modelled clock (D39).
 inline double mb_per_s(std::uint64_t bytes, std::uint64_t cycles, double clock_mhz) {
-  if (cycles == 0) return 0.0;
-  return static_cast<double>(bytes) * clock_mhz * 1e6 / static_cast<double>(cycles) / 1048576.0;
+  return hw::mb_per_s(bytes, cycles, clock_mhz * 1e6);
 }
 template <int kUnit>
 double usage(const FigureCounts& s, double) {
-  return percent(s.issued[kUnit], s.cycle * static_cast<std::uint64_t>(s.pipelines));
+  return hw::percent(s.issued[kUnit], s.cycle * static_cast<std::uint64_t>(s.pipelines));
 }
 template <int kCache>
 double cache_hit(const FigureCounts& s, double) {
-  return s.requests[kCache] == 0 ? 100.0 : percent(s.hits[kCache], s.requests[kCache]);
+  return s.requests[kCache] == 0 ? 100.0 : hw::percent(s.hits[kCache], s.requests[kCache]);
 }
 inline double dynrtc(const FigureCounts& s, double clock_mhz) {
   std::uint64_t bytes = 0;
