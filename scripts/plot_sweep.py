@@ -44,6 +44,8 @@ PANELS = [
 COST_COLUMNS = {"fp_units": "FP units", "memory_kb": "internal memory (KB)",
                 "luts": "Virtex-II LUT estimate (FP operators)",
                 "block_rams": "Virtex-II 18-Kbit block RAMs (at least)"}
+# What the prototype's XC2V6000 holds (units/cost.h), drawn as a line on those costs' panels.
+DEVICE = {"luts": 67584, "block_rams": 144}
 # Written with a fixed Software entry and no date, so the same input gives the same bytes.
 PNG_METADATA = {"Software": "saarcor plot_sweep.py"}
 
@@ -220,9 +222,15 @@ def plot_pareto(keys, records, costs, out_path, title):
                     key=lambda p: (p[0][1], p[0][0]))
         ax.plot([c for (_, c), _ in on], [f for (f, _), _ in on], color="black", linewidth=1,
                 zorder=2, label="Pareto front (%d of %d)" % (len(on), len(records)))
-        for (fps, c), r in on:
+        # Labels to the right and the left in turn: neighbours on the front (points that differ
+        # in a key that changes little) do not write over each other.
+        for i, ((fps, c), r) in enumerate(on):
             ax.annotate("/".join(r[k] for k in keys), (c, fps), textcoords="offset points",
-                        xytext=(5, -3), fontsize=7)
+                        xytext=(6 if i % 2 == 0 else -6, -3), ha="left" if i % 2 == 0 else "right",
+                        fontsize=7)
+        if cost in DEVICE:
+            ax.axvline(DEVICE[cost], color="grey", linestyle="--", linewidth=1,
+                       label="XC2V6000 (%d)" % DEVICE[cost])
         ax.set_xlabel(COST_COLUMNS[cost])
         ax.set_ylabel("frame rate (fps)")
         ax.grid(True, alpha=0.3)
