@@ -4,11 +4,18 @@
 # lacks matplotlib.
 #
 #   plot_sweep.py SWEEP.csv [--out-dir DIR]     one PNG per varied key: sweep_<key>.png
+#   plot_sweep.py SWEEP.csv --pareto [--cost C,...]  and frame rate against cost with the Pareto
+#                                               front: sweep_pareto.png, one panel per cost column
 #   plot_sweep.py PRECISION.json [--out-dir DIR]  the precision study's curve: precision_curve.png
 #   plot_sweep.py RUN_FOLDER [--out-dir DIR]    a --out-dir folder (its sweep.csv or report.json)
 #
 # A sweep figure has four panels against the key's values: frame rate, unit usage, cache hit
 # rates and memory bandwidth. With several keys varied, each other combination is one line.
+# The Pareto figure (--pareto, or a CSV of `saarcor sweep --pareto`, which has a column
+# pareto_<cost>) draws every point's frame rate against a cost column (fp_units, memory_kb, luts,
+# block_rams; by default the CSV's pareto cost, else luts) and joins the front: the points no
+# other point beats in both (at least as fast and at most as dear, better in one). The front of
+# the CSV's own pareto column is the binary's; another cost's is computed here by the same rule.
 # Figures go beside the input unless --out-dir says where. Prints the files written.
 import argparse
 import csv
@@ -34,6 +41,11 @@ PANELS = [
       ("cache_hit_transformation", "transformation")]),
     ("memory bandwidth (MB/s)", [("bandwidth_mb_s_total", "total")]),
 ]
+COST_COLUMNS = {"fp_units": "FP units", "memory_kb": "internal memory (KB)",
+                "luts": "Virtex-II LUT estimate (FP operators)",
+                "block_rams": "Virtex-II 18-Kbit block RAMs (at least)"}
+# What the prototype's XC2V6000 holds (units/cost.h), drawn as a line on those costs' panels.
+DEVICE = {"luts": 67584, "block_rams": 144}
 # Written with a fixed Software entry and no date, so the same input gives the same bytes.
 PNG_METADATA = {"Software": "saarcor plot_sweep.py"}
 
@@ -170,6 +182,73 @@ def plot_precision(report, out_path, title):
     plt.close(fig)
 
 
+def pareto_front(pairs):
+    """For each (fps, cost): no other pair at least as fast and at most as dear, better in one."""
+    return [not any(f >= fps and c <= cost and (f > fps or c < cost) for f, c in pairs)
+            for fps, cost in pairs]
+
+
+def pareto_costs(header, requested):
+    """The cost columns of the Pareto figure: the requested ones, else the CSV's pareto cost."""
+    marked = [h[len("pareto_"):] for h in header if h.startswith("pareto_")]
+    costs = [c for c in requested.split(",") if c] if requested else (marked or ["luts"])
+    for c in costs:
+        if c not in COST_COLUMNS:
+            fail("bad --cost '%s': expected cost columns among %s" % (
+                c, ", ".join(COST_COLUMNS)))
+        if c not in header:
+            fail("the CSV has no '%s' column (a sweep CSV from before the cost columns?)" % c)
+    return costs
+
+
+def plot_pareto(keys, records, costs, out_path, title):
+    # A colour per value of the first key, a marker per value of the second; the front joined by
+    # a line, cheapest first, each of its points labelled with the keys' values.
+    firsts, _ = axis_values(records, keys[0])
+    seconds, _ = axis_values(records, keys[1]) if len(keys) > 1 else ([""], False)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    markers = ["o", "s", "^", "v", "D", "P", "X", "*"]
+    fig, axes = plt.subplots(1, len(costs), figsize=(6.5 * len(costs), 5.5), squeeze=False)
+    for ax, cost in zip(axes.flat, costs):
+        pairs = [(float(r["fps"]), float(r[cost])) for r in records]
+        column = "pareto_" + cost
+        front = ([r[column] == "1" for r in records] if column in records[0]
+                 else pareto_front(pairs))
+        for r, (fps, c) in zip(records, pairs):
+            second = r[keys[1]] if len(keys) > 1 else ""
+            ax.scatter(c, fps, color=colours[firsts.index(r[keys[0]]) % len(colours)],
+                       marker=markers[seconds.index(second) % len(markers)], s=36, zorder=3)
+        on = sorted((p for p, f in zip(zip(pairs, records), front) if f),
+                    key=lambda p: (p[0][1], p[0][0]))
+        ax.plot([c for (_, c), _ in on], [f for (f, _), _ in on], color="black", linewidth=1,
+                zorder=2, label="Pareto front (%d of %d)" % (len(on), len(records)))
+        # Labels to the right and the left in turn: neighbours on the front (points that differ
+        # in a key that changes little) do not write over each other.
+        for i, ((fps, c), r) in enumerate(on):
+            ax.annotate("/".join(r[k] for k in keys), (c, fps), textcoords="offset points",
+                        xytext=(6 if i % 2 == 0 else -6, -3), ha="left" if i % 2 == 0 else "right",
+                        fontsize=7)
+        if cost in DEVICE:
+            ax.axvline(DEVICE[cost], color="grey", linestyle="--", linewidth=1,
+                       label="XC2V6000 (%d)" % DEVICE[cost])
+        ax.set_xlabel(COST_COLUMNS[cost])
+        ax.set_ylabel("frame rate (fps)")
+        ax.grid(True, alpha=0.3)
+        handles = [Line2D([], [], color=colours[i % len(colours)], marker="o", linestyle="",
+                          label=keys[0] + "=" + v) for i, v in enumerate(firsts)]
+        if len(keys) > 1:
+            handles += [Line2D([], [], color="grey", marker=markers[i % len(markers)],
+                               linestyle="", label=keys[1] + "=" + v)
+                        for i, v in enumerate(seconds)]
+        handles += ax.get_legend_handles_labels()[0]
+        ax.legend(handles=handles, fontsize=7, title="labels: " + "/".join(keys),
+                  title_fontsize=7)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=100, metadata=PNG_METADATA)
+    plt.close(fig)
+
+
 def slug(text):
     return "".join(c if c.isalnum() or c in "._-" else "_" for c in text)
 
@@ -178,6 +257,12 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("input", help="sweep CSV, precision JSON, or a saarcor --out-dir folder")
     parser.add_argument("--out-dir", help="where the PNGs go (default: beside the input)")
+    parser.add_argument("--pareto", action="store_true",
+                        help="also draw frame rate against cost with the Pareto front "
+                             "(sweep_pareto.png)")
+    parser.add_argument("--cost", metavar="COST,...",
+                        help="the Pareto figure's cost columns, one panel each (implies "
+                             "--pareto; default: the CSV's pareto cost, else luts)")
     args = parser.parse_args()
     path = args.input
     if os.path.isdir(path):
@@ -204,11 +289,21 @@ def main():
         written.append(out)
     else:
         keys, records = read_sweep(path)
+        header = list(records[0].keys())
+        pareto = (args.pareto or args.cost is not None or
+                  any(h.startswith("pareto_") for h in header))
+        costs = pareto_costs(header, args.cost) if pareto else []
         for key in keys:
             out = os.path.join(out_dir, "sweep_" + slug(key) + ".png")
             plot_key(keys, records, key, out,
                      "%s: %d points, varied %s" % (os.path.basename(path), len(records),
                                                    ", ".join(keys)))
+            written.append(out)
+        if pareto:
+            out = os.path.join(out_dir, "sweep_pareto.png")
+            plot_pareto(keys, records, costs, out,
+                        "%s: %d points, frame rate against %s" % (
+                            os.path.basename(path), len(records), " and ".join(costs)))
             written.append(out)
     for w in written:
         print(w)

@@ -24,18 +24,21 @@ const units::PaperTable2Row& paper_row(const std::string& key) {
   throw std::logic_error("no Table 2 row " + key);
 }
 
-nlohmann::json fp_json(const FpUnits& f, std::int64_t bits) {
+nlohmann::json fp_json(const FpUnits& f, std::int64_t bits, const units::AreaEstimate& a) {
   return {{"add", f.add},
           {"mul", f.mul},
           {"div", f.div},
           {"cmp", f.cmp},
           {"sqrt", f.sqrt},
           {"memory_bits", bits},
-          {"memory_kb", static_cast<double>(bits) / 8192.0}};
+          {"memory_kb", static_cast<double>(bits) / 8192.0},
+          {"luts", a.luts},
+          {"mult18x18", a.mult18x18},
+          {"block_rams", a.block_rams}};
 }
 
 nlohmann::json unit_json(const UnitCost& u) {
-  nlohmann::json j = fp_json(u.fp, u.memory_bits());
+  nlohmann::json j = fp_json(u.fp, u.memory_bits(), u.area);
   j["name"] = u.name;
   j["memory"] = nlohmann::json::array();
   j["memory_by_kind"] = nlohmann::json::object();
@@ -73,12 +76,20 @@ std::string fp_cell(int v) {
   return v == 0 ? "-" : std::to_string(v);
 }
 
-std::string unit_line(const std::string& label, const FpUnits& f, double kb) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10.2f\n", label.c_str(),
+// A model line has its area estimate (LUTs, block RAMs); the paper's line has none.
+std::string unit_line(const std::string& label, const FpUnits& f, double kb,
+                      const units::AreaEstimate* area = nullptr) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10.2f", label.c_str(),
                 fp_cell(f.add).c_str(), fp_cell(f.mul).c_str(), fp_cell(f.div).c_str(),
                 fp_cell(f.cmp).c_str(), fp_cell(f.sqrt).c_str(), kb);
-  return buf;
+  std::string s = buf;
+  if (area != nullptr) {
+    std::snprintf(buf, sizeof buf, " %8s %5s", fp_cell(static_cast<int>(area->luts)).c_str(),
+                  fp_cell(area->block_rams).c_str());
+    s += buf;
+  }
+  return s + "\n";
 }
 
 std::string ratio_cell(double model, double paper) {
@@ -116,8 +127,8 @@ std::string heading(const CostParams& p) {
 
 std::string column_heads(const char* first) {
   char buf[160];
-  std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10s\n", first, "add", "mul", "div",
-                "cmp", "sqrt", "memory KB");
+  std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10s %8s %5s\n", first, "add", "mul",
+                "div", "cmp", "sqrt", "memory KB", "LUTs", "BRAM");
   return buf;
 }
 
@@ -136,14 +147,24 @@ std::string memory_lines(const UnitCost& u) {
 
 std::string total_lines(const ConfigurationCost& c, bool table2) {
   const double kb1 = static_cast<double>(c.memory_bits_per_pipeline) / 8192.0;
-  std::string s = unit_line("Total (one DynRTP)", c.fp_per_pipeline, kb1);
+  std::string s = unit_line("Total (one DynRTP)", c.fp_per_pipeline, kb1, &c.area_per_pipeline);
   if (table2) s += paper_lines("total", c.fp_per_pipeline, kb1);
   if (c.pipelines > 1)
     s += unit_line("Total (" + std::to_string(c.pipelines) + " DynRTPs)", c.fp_total,
-                   c.memory_kb_total());
-  char buf[200];
+                   c.memory_kb_total(), &c.area_total);
+  char buf[400];
   std::snprintf(buf, sizeof buf, "FLOPs: %.3g (%d FP units x %.0f MHz; paper: 4 billion)\n",
                 c.flops, c.fp_total.total(), c.clock_mhz);
+  s += buf;
+  const auto pct = [](double v, double of) { return 100.0 * v / of; };
+  std::snprintf(
+      buf, sizeof buf,
+      "XC2V6000 (Virtex-II, the prototype's): %lld LUTs (%.1f %%), %d MULT18X18 (%.1f %%), "
+      "at least %d block RAMs (%.1f %%); LUTs of the FP operators only (docs/cost.md)\n",
+      static_cast<long long>(c.area_total.luts),
+      pct(static_cast<double>(c.area_total.luts), units::kXc2v6000Luts), c.area_total.mult18x18,
+      pct(c.area_total.mult18x18, units::kXc2v6000Mult18x18), c.area_total.block_rams,
+      pct(c.area_total.block_rams, units::kXc2v6000BlockRams));
   return s + buf;
 }
 
@@ -162,8 +183,11 @@ nlohmann::json cost_json(const CostParams& params, bool table2) {
   nlohmann::json j;
   for (const UnitCost& u : c.units)
     j["units"][u.key] = unit_json(u);
-  j["total"] = fp_json(c.fp_total, c.memory_bits_total);
-  j["total"]["per_pipeline"] = fp_json(c.fp_per_pipeline, c.memory_bits_per_pipeline);
+  j["total"] = fp_json(c.fp_total, c.memory_bits_total, c.area_total);
+  j["total"]["per_pipeline"] =
+      fp_json(c.fp_per_pipeline, c.memory_bits_per_pipeline, c.area_per_pipeline);
+  for (const units::OperatorArea& o : units::operator_areas())
+    j["operator_area"][o.op] = {{"luts", o.luts}, {"mult18x18", o.mult18x18}, {"source", o.source}};
   j["pipelines"] = c.pipelines;
   j["flops"] = c.flops;
   j["lights"] = params.lights;
@@ -188,7 +212,7 @@ std::string cost_text(const CostParams& params, bool table2) {
   const ConfigurationCost c = units::configuration_cost(params);
   std::string s = heading(params) + column_heads("unit (one DynRTP)");
   for (const UnitCost& u : c.units) {
-    s += unit_line(u.name, u.fp, u.memory_kb());
+    s += unit_line(u.name, u.fp, u.memory_kb(), &u.area);
     if (table2) s += paper_lines(u.key, u.fp, u.memory_kb());
     s += memory_lines(u);
   }
@@ -201,7 +225,7 @@ std::string table2_text(const CostParams& params) {
                   heading(params).substr(0, heading(params).size() - 1) + ")\n" +
                   column_heads("unit");
   for (const UnitCost& u : c.units)
-    s += unit_line(u.name, u.fp, u.memory_kb()) + paper_lines(u.key, u.fp, u.memory_kb());
+    s += unit_line(u.name, u.fp, u.memory_kb(), &u.area) + paper_lines(u.key, u.fp, u.memory_kb());
   return s + total_lines(c, true) + "the memory items and each difference: saarcor cost --preset " +
          "table2, docs/cost.md\n";
 }

@@ -130,6 +130,18 @@ TEST(CostCmd, Table2PresetJsonAndText) {
   EXPECT_DOUBLE_EQ(j["table1"]["dyn1_over_dyn3"]["full"].get<double>(), 44.0 / 109);
   EXPECT_DOUBLE_EQ(j["table2"]["traversal"]["memory_kb"]["paper"].get<double>(), 44.5);
   EXPECT_EQ(j["configuration"]["threads"].get<double>(), 32);
+  // The area estimate (units/cost_test.cpp Cost.Table2AreaByHand has the sums).
+  EXPECT_EQ(j["units"]["traversal"]["luts"].get<std::int64_t>(), 10'080);
+  EXPECT_EQ(j["units"]["transformation"]["mult18x18"].get<int>(), 9);
+  EXPECT_EQ(j["units"]["caches"]["block_rams"].get<int>(), 7);
+  EXPECT_EQ(j["total"]["luts"].get<std::int64_t>(), 33'164);
+  EXPECT_EQ(j["total"]["block_rams"].get<int>(), 41);
+  EXPECT_EQ(j["total"]["per_pipeline"]["luts"].get<std::int64_t>(), 33'164);
+  EXPECT_EQ(j["operator_area"]["div"]["luts"].get<int>(), 1504);
+  EXPECT_NE(r.out.find("LUTs  BRAM"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("33164 LUTs (49.1 %), 12 MULT18X18 (8.3 %), at least 41 block RAMs"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST(CostCmd, PrototypeHasNoPaperLinesAndSetsApply) {

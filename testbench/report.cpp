@@ -903,10 +903,68 @@ std::vector<StatLine> sequence_stat_lines(const SequenceResult& r) {
 
 // ---- sweeps -----------------------------------------------------------------------------------
 
+namespace {
+
+// A sweep point's cost, declared once: its name (JSON key under "cost", CSV column, stats.txt
+// "cost.NAME"), unit, description and value, from the cost model of the point's configuration
+// (units/cost.h, docs/cost.md); the table's header and cell format.
+struct CostStatDecl {
+  const char* name;
+  const char* unit;
+  const char* desc;
+  const char* head;
+  const char* format;
+  double (*value)(const units::ConfigurationCost&);
+};
+
+using Cost = const units::ConfigurationCost&;
+constexpr CostStatDecl kCostStats[] = {
+    {"fp_units", "units", "floating-point units of the chip (add, mul, div, cmp, sqrt)", "FP",
+     "%5.0f", [](Cost c) { return double(c.fp_total.total()); }},
+    {"memory_kb", "KB", "internal memory of the chip, dual-ported bits counted twice", "mem KB",
+     "%8.2f", [](Cost c) { return c.memory_kb_total(); }},
+    {"luts", "LUTs",
+     "Virtex-II LUT estimate: the FP operators' LUTs (measured per operator, docs/cost.md)", "LUTs",
+     "%7.0f", [](Cost c) { return double(c.area_total.luts); }},
+    {"block_rams", "block RAMs",
+     "18-Kbit Virtex-II block RAMs the memories need at least (registers excluded)", "BRAM",
+     "%5.0f", [](Cost c) { return double(c.area_total.block_rams); }},
+};
+
+}  // namespace
+
+std::vector<std::string> sweep_cost_names() {
+  std::vector<std::string> names;
+  for (const CostStatDecl& d : kCostStats)
+    names.emplace_back(d.name);
+  return names;
+}
+
+nlohmann::json sweep_cost_json(const units::CostParams& params) {
+  const units::ConfigurationCost c = units::configuration_cost(params);
+  nlohmann::json j = nlohmann::json::object();
+  for (const CostStatDecl& d : kCostStats)
+    j[d.name] = d.value(c);
+  return j;
+}
+
+std::vector<StatLine> sweep_point_stat_lines(const SweepPoint& p, bool pareto) {
+  std::vector<StatLine> lines = cycle_stat_lines(p.cycle);
+  for (const CostStatDecl& d : kCostStats)
+    lines.push_back({std::string("cost.") + d.name, num(json_at(p.cost, d.name)), d.desc, d.unit});
+  if (pareto)
+    lines.push_back({"cost.pareto", p.pareto ? 1.0 : 0.0,
+                     "on the Pareto front: no other point has a higher frame rate at no more "
+                     "cost, or a lower cost at no less frame rate",
+                     "flag"});
+  return lines;
+}
+
 nlohmann::json sweep_points_json(const SweepResult& sweep) {
   nlohmann::json a = nlohmann::json::array();
   for (const SweepPoint& p : sweep.points)
-    a.push_back({{"index", p.index}, {"settings", p.settings}, {"cycle", p.cycle}});
+    a.push_back(
+        {{"index", p.index}, {"settings", p.settings}, {"cycle", p.cycle}, {"cost", p.cost}});
   return a;
 }
 
@@ -917,6 +975,7 @@ std::vector<SweepPoint> sweep_points_from_json(const nlohmann::json& j) {
     p.index = e.at("index").get<std::size_t>();
     p.settings = e.at("settings").get<std::vector<std::string>>();
     p.cycle = e.at("cycle");
+    p.cost = e.at("cost");
     points.push_back(std::move(p));
   }
   return points;
@@ -934,16 +993,26 @@ std::vector<std::string> point_values(const SweepPoint& p) {
 }
 
 // A column of the sweep's table and CSV: a statistic of the point's frame report (by its name in
-// cycle_stats' declarations) over a divisor, or the point's speed-up over the first (no stat).
+// cycle_stats' declarations) over a divisor, the point's speed-up over the first (no stat), one of
+// the point's cost statistics (kCostStats) or, with --pareto, whether it is on the front.
+enum class ColumnSource { kCycle, kSpeedup, kCost, kPareto };
 struct SweepColumn {
-  const char* name;    // CSV header
-  const char* head;    // table header
+  std::string name;    // CSV header
+  std::string head;    // table header
   const char* format;  // printf format of the table cell
+  ColumnSource source;
   const char* stat;
   double divisor;
 };
 
-constexpr SweepColumn kSweepColumns[] = {
+struct CycleColumn {
+  const char* name;
+  const char* head;
+  const char* format;
+  const char* stat;  // nullptr: the speed-up
+  double divisor;
+};
+constexpr CycleColumn kCycleColumns[] = {
     {"cycles", "cycles", "%10.0f", "cycles", 1.0},
     {"fps", "fps", "%8.1f", "fps", 1.0},
     {"mrays_per_s", "Mrays/s", "%8.2f", "rays_per_s", 1e6},
@@ -960,14 +1029,51 @@ constexpr SweepColumn kSweepColumns[] = {
     {"simd_efficiency", "SIMD", "%6.2f", "simd_efficiency", 1.0},
 };
 
+std::vector<SweepColumn> sweep_columns(const SweepResult& sweep) {
+  std::vector<SweepColumn> cols;
+  for (const CycleColumn& c : kCycleColumns)
+    cols.push_back({c.name, c.head, c.format,
+                    c.stat == nullptr ? ColumnSource::kSpeedup : ColumnSource::kCycle, c.stat,
+                    c.divisor});
+  for (const CostStatDecl& d : kCostStats)
+    cols.push_back({d.name, d.head, d.format, ColumnSource::kCost, d.name, 1.0});
+  if (!sweep.pareto_cost.empty())
+    cols.push_back(
+        {"pareto_" + sweep.pareto_cost, "front", "%5.0f", ColumnSource::kPareto, nullptr, 1.0});
+  return cols;
+}
+
 double column_value(const SweepColumn& c, const SweepPoint& p) {
-  if (c.stat == nullptr) return p.speedup;
+  switch (c.source) {
+    case ColumnSource::kSpeedup:
+      return p.speedup;
+    case ColumnSource::kPareto:
+      return p.pareto ? 1.0 : 0.0;
+    case ColumnSource::kCost:
+      return json_at(p.cost, c.stat).get<double>();
+    case ColumnSource::kCycle:
+      break;
+  }
   return json_at(p.cycle, c.stat).get<double>() / c.divisor;
+}
+
+// A table cell: the column's format, the front's members as '*'.
+std::string table_cell(const SweepColumn& c, const SweepPoint& p) {
+  char buf[64];
+  if (c.source == ColumnSource::kPareto) {
+    char probe[64];
+    const int width = std::snprintf(probe, sizeof probe, c.format, 0.0);
+    std::snprintf(buf, sizeof buf, "%*s", width, p.pareto ? "*" : "");
+  } else {
+    std::snprintf(buf, sizeof buf, c.format, column_value(c, p));
+  }
+  return buf;
 }
 
 }  // namespace
 
 std::string sweep_table(const SweepResult& sweep) {
+  const std::vector<SweepColumn> columns = sweep_columns(sweep);
   std::string s;
   char buf[64];
   for (const SweepAxis& a : sweep.axes) {
@@ -975,10 +1081,10 @@ std::string sweep_table(const SweepResult& sweep) {
                   a.key.c_str());
     s += buf;
   }
-  for (const SweepColumn& c : kSweepColumns) {
+  for (const SweepColumn& c : columns) {
     char probe[64];
     const int width = std::snprintf(probe, sizeof probe, c.format, 0.0);
-    std::snprintf(buf, sizeof buf, " %*s", width, c.head);
+    std::snprintf(buf, sizeof buf, " %*s", width, c.head.c_str());
     s += buf;
   }
   s += "\n";
@@ -989,24 +1095,22 @@ std::string sweep_table(const SweepResult& sweep) {
       std::snprintf(buf, sizeof buf, "%*s ", width, v[a].c_str());
       s += buf;
     }
-    for (const SweepColumn& c : kSweepColumns) {
-      s += ' ';
-      std::snprintf(buf, sizeof buf, c.format, column_value(c, p));
-      s += buf;
-    }
+    for (const SweepColumn& c : columns)
+      s += ' ' + table_cell(c, p);
     s += "\n";
   }
   return s;
 }
 
 std::string sweep_csv(const SweepResult& sweep) {
+  const std::vector<SweepColumn> columns = sweep_columns(sweep);
   const bool shard = sweep.shards > 1;
   std::string s = shard ? "point,points," : "";
   for (const SweepAxis& a : sweep.axes) {
     s += a.key + ",";
   }
-  for (const SweepColumn& c : kSweepColumns) {
-    s += std::string(c.name) + (&c == &kSweepColumns[std::size(kSweepColumns) - 1] ? "\n" : ",");
+  for (const SweepColumn& c : columns) {
+    s += c.name + (&c == &columns.back() ? "\n" : ",");
   }
   char buf[64];
   for (const SweepPoint& p : sweep.points) {
@@ -1014,10 +1118,37 @@ std::string sweep_csv(const SweepResult& sweep) {
     for (const std::string& v : point_values(p)) {
       s += v + ",";
     }
-    for (const SweepColumn& c : kSweepColumns) {
+    for (const SweepColumn& c : columns) {
       std::snprintf(buf, sizeof buf, "%.17g", column_value(c, p));
-      s += std::string(buf) + (&c == &kSweepColumns[std::size(kSweepColumns) - 1] ? "\n" : ",");
+      s += std::string(buf) + (&c == &columns.back() ? "\n" : ",");
     }
+  }
+  return s;
+}
+
+std::string sweep_pareto_text(const SweepResult& sweep) {
+  if (sweep.pareto_cost.empty()) return "";
+  std::vector<const SweepPoint*> front;
+  for (const SweepPoint& p : sweep.points)
+    if (p.pareto) front.push_back(&p);
+  // Cheapest first; at equal cost (a tie in both) in sweep order.
+  std::ranges::stable_sort(front, {}, [&](const SweepPoint* p) {
+    return json_at(p->cost, sweep.pareto_cost).get<double>();
+  });
+  const CostStatDecl* decl = nullptr;
+  for (const CostStatDecl& d : kCostStats)
+    if (sweep.pareto_cost == d.name) decl = &d;
+  std::string s = "Pareto front (frame rate against " + sweep.pareto_cost + ", " + decl->unit +
+                  "): " + std::to_string(front.size()) + " of " +
+                  std::to_string(sweep.points.size()) +
+                  " points; no other point has a higher frame rate at no more cost, or a lower "
+                  "cost at no less frame rate\n";
+  char buf[96];
+  for (const SweepPoint* p : front) {
+    std::snprintf(buf, sizeof buf, "  %12.2f %s  %10.1f fps  ",
+                  json_at(p->cost, sweep.pareto_cost).get<double>(), sweep.pareto_cost.c_str(),
+                  json_at(p->cycle, "fps").get<double>());
+    s += buf + join_words(p->settings) + "\n";
   }
   return s;
 }
@@ -1041,7 +1172,10 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
     j["shard"] = std::to_string(sweep.shard + 1) + "/" + std::to_string(sweep.shards);
     j["total_points"] = sweep.total_points;
   }
+  for (const CostStatDecl& d : kCostStats)
+    j["cost_stats"][d.name] = {{"unit", d.unit}, {"desc", d.desc}};
   nlohmann::json points = nlohmann::json::array();
+  nlohmann::json front = nlohmann::json::array();
   for (const SweepPoint& p : sweep.points) {
     nlohmann::json e;
     if (sweep.shards > 1) e["index"] = p.index;
@@ -1050,10 +1184,15 @@ nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts) {
       e["values"][sweep.axes[a].key] = v[a];
     }
     e["speedup"] = p.speedup;
+    e["cost"] = p.cost;
+    if (!sweep.pareto_cost.empty()) e["pareto"] = p.pareto;
+    if (p.pareto) front.push_back(p.index);
     e["report"] = p.cycle;
     points.push_back(std::move(e));
   }
   j["points"] = points;
+  if (!sweep.pareto_cost.empty())
+    j["pareto"] = {{"cost", sweep.pareto_cost}, {"performance", "fps"}, {"points", front}};
   return j;
 }
 
@@ -1099,7 +1238,7 @@ void write_sweep_folder(const SweepOptions& opts, const SweepResult& sweep,
     blocks.push_back({"point " + std::to_string(sweep.points[i].index + 1) + " of " +
                           std::to_string(sweep.total_points) + ": " +
                           join_words(sweep.points[i].settings),
-                      cycle_stat_lines(sweep.points[i].cycle)});
+                      sweep_point_stat_lines(sweep.points[i], !sweep.pareto_cost.empty())});
   }
   write_run_folder({opts.out_dir,
                     std::move(report),

@@ -25,6 +25,7 @@
 #include "host/float_reference.h"
 #include "host/image_builder.h"
 #include "testbench/chip.h"
+#include "units/cost.h"
 #include "units/figures.h"
 #include "units/functional_model.h"
 
@@ -135,12 +136,23 @@ std::vector<StatLine> sequence_stat_lines(const SequenceResult& r);
 nlohmann::json sweep_points_json(const SweepResult& sweep);
 std::vector<SweepPoint> sweep_points_from_json(const nlohmann::json& j);
 nlohmann::json sweep_rank_message(const std::string& error, const SweepResult& sweep);
+// A sweep point's cost (units/cost.h, docs/cost.md), its statistics declared once in report.cpp
+// with name, unit and description: {"fp_units", "memory_kb", "luts", "block_rams"} of the chip.
+nlohmann::json sweep_cost_json(const units::CostParams& params);
+// Those statistics' names, in column order (what --pareto-cost takes).
+std::vector<std::string> sweep_cost_names();
+// stats.txt's lines of one point: cycle_stat_lines, then "cost.NAME" for each cost statistic and,
+// with `pareto`, "cost.pareto" (1 on the front).
+std::vector<StatLine> sweep_point_stat_lines(const SweepPoint& p, bool pareto);
 // The printed table, the CSV text (a shard's with the columns point and points first) and the
 // JSON report of a sweep; the table's and the CSV's columns are statistics of the points' frame
-// reports, named as cycle_stats declares them.
+// reports, named as cycle_stats declares them, then the cost statistics and, when the sweep marked
+// its Pareto front, the column pareto_<cost> (1 on the front; '*' in the table).
 std::string sweep_table(const SweepResult& sweep);
 std::string sweep_csv(const SweepResult& sweep);
 nlohmann::json sweep_json(const SweepResult& sweep, const SweepOptions& opts);
+// The front's points, cheapest first, one line each (cost, fps, settings); empty without --pareto.
+std::string sweep_pareto_text(const SweepResult& sweep);
 // --out-dir for a sweep: the CSV, the report without host timing (host.json has it), each point's
 // resolved configuration (config.json), each point's statistics as one block (stats.txt) and the
 // command line.

@@ -235,6 +235,12 @@ void add_sweep(CLI::App& app, saarcor::SweepOptions& sweep_opts, int& status,
   sub->add_option("--out-dir", sweep_opts.out_dir,
                   "write sweep.csv, report.json, stats.txt, config.json, command.txt, host.json "
                   "into DIR");
+  sub->add_flag("--pareto", sweep_opts.pareto,
+                "mark the points no other point beats in both frame rate and cost (the LUT "
+                "estimate unless --pareto-cost says)");
+  sub->add_option("--pareto-cost", sweep_opts.pareto_cost,
+                  "the cost of --pareto: luts, block_rams, memory_kb or fp_units (implies "
+                  "--pareto)");
   sub->callback([&] {
     sweep_opts.argv = command;
     status = saarcor::run_sweep(sweep_opts);

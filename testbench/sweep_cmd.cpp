@@ -23,6 +23,7 @@
 #include "testbench/mpi_ranks.h"
 #include "testbench/report.h"
 #include "testbench/task_pool.h"
+#include "units/cost.h"
 #include "units/cycle_params.h"
 
 namespace saarcor {
@@ -226,6 +227,9 @@ std::vector<SweepPoint> run_group(const Group& g, const SweepContext& cx, SweepR
     p.index = i;
     p.settings = points[i];
     p.cycle = f.cycle;
+    // The configuration's cost, the light table at the preset's capacity (units/cost.h).
+    p.cost =
+        sweep_cost_json({resolve_cycle_params(s.cycle), units::cost_preset(s.cycle.preset).lights});
     cx.beat.beat("points " + std::to_string(++cx.done) + " / " + std::to_string(cx.selected) +
                  (cx.jobs > 1 ? ", " + std::to_string(cx.jobs) + " at once" : ""));
   });
@@ -276,6 +280,41 @@ void set_speedups(SweepResult& sweep) {
     p.speedup = first / p.cycle["cycles"].get<double>();
 }
 
+std::vector<bool> pareto_front(const std::vector<std::pair<double, double>>& performance_cost) {
+  std::vector<bool> front(performance_cost.size(), true);
+  for (std::size_t i = 0; i < performance_cost.size(); ++i) {
+    const auto [perf, cost] = performance_cost[i];
+    for (const auto& [p, c] : performance_cost) {
+      if (p >= perf && c <= cost && (p > perf || c < cost)) {
+        front[i] = false;
+        break;
+      }
+    }
+  }
+  return front;
+}
+
+std::string pareto_cost_name(const std::string& name) {
+  if (name.empty()) return "luts";
+  const std::vector<std::string> names = sweep_cost_names();
+  if (std::ranges::find(names, name) != names.end()) return name;
+  std::string known;
+  for (const std::string& n : names)
+    known += (known.empty() ? "" : ", ") + n;
+  throw std::runtime_error("bad --pareto-cost '" + name + "': expected a cost column (" + known +
+                           ")");
+}
+
+void mark_pareto(SweepResult& sweep, const std::string& cost) {
+  std::vector<std::pair<double, double>> pc;
+  for (const SweepPoint& p : sweep.points)
+    pc.emplace_back(p.cycle.at("fps").get<double>(), p.cost.at(cost).get<double>());
+  const std::vector<bool> front = pareto_front(pc);
+  for (std::size_t i = 0; i < sweep.points.size(); ++i)
+    sweep.points[i].pareto = front[i];
+  sweep.pareto_cost = cost;
+}
+
 namespace {
 
 // A CSV's lines and cells (the sweep's own CSVs: no quoting, one row a line).
@@ -300,6 +339,40 @@ std::vector<std::vector<std::string>> csv_cells(const std::string& text) {
     from = eol + 1;
   }
   return rows;
+}
+
+// The columns that depend on the whole sweep, recomputed over the merged rows: the speed-up over
+// point 0 from the exact cycles and, when the shards marked a front (a column pareto_<cost>), the
+// Pareto front of all points (each shard marked its own).
+void recompute_whole_sweep(const std::vector<std::string>& header,
+                           std::vector<std::optional<std::vector<std::string>>>& rows,
+                           const std::string& first_file) {
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::ranges::find(header, name) - header.begin());
+  };
+  const auto number = [](const std::string& cell) { return std::strtod(cell.c_str(), nullptr); };
+  const std::size_t cycles = col("cycles"), speedup = col("speedup"), fps = col("fps");
+  if (cycles == header.size() || speedup == header.size() || fps == header.size())
+    throw std::runtime_error(first_file + ": no cycles, fps or speedup column");
+  const double first = number((*rows[0])[cycles]);
+  char buf[64];
+  for (auto& row : rows) {
+    std::snprintf(buf, sizeof buf, "%.17g", first / number((*row)[cycles]));
+    (*row)[speedup] = buf;
+  }
+  const auto pareto =
+      std::ranges::find_if(header, [](const std::string& h) { return h.starts_with("pareto_"); });
+  if (pareto == header.end()) return;
+  const std::size_t flag = static_cast<std::size_t>(pareto - header.begin());
+  const std::size_t cost = col(pareto->substr(7));
+  if (cost == header.size())
+    throw std::runtime_error(first_file + ": a column " + *pareto + " without its cost column");
+  std::vector<std::pair<double, double>> pc;
+  for (const auto& row : rows)
+    pc.emplace_back(number((*row)[fps]), number((*row)[cost]));
+  const std::vector<bool> front = pareto_front(pc);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    (*rows[i])[flag] = front[i] ? "1" : "0";
 }
 
 std::string csv_line(const std::vector<std::string>& cells, std::size_t from) {
@@ -353,21 +426,10 @@ std::string merge_sweep_csv(const std::vector<std::pair<std::string, std::string
                                std::to_string(total) +
                                " is in none of the files (a shard missing)");
   if (rows.empty()) throw std::runtime_error("sweep-merge: the shard files hold no rows");
-  // The speed-up column is over point 0 of the whole sweep: recomputed from the exact cycles.
-  const auto col = [&](const char* name) {
-    return static_cast<std::size_t>(std::ranges::find(header, name) - header.begin());
-  };
-  const std::size_t cycles = col("cycles"), speedup = col("speedup");
-  if (cycles == header.size() || speedup == header.size())
-    throw std::runtime_error(parts.front().first + ": no cycles or speedup column");
-  const double first = std::strtod((*rows[0])[cycles].c_str(), nullptr);
+  recompute_whole_sweep(header, rows, parts.front().first);
   std::string out = csv_line(header, 2);
-  char buf[64];
-  for (auto& row : rows) {
-    std::snprintf(buf, sizeof buf, "%.17g", first / std::strtod((*row)[cycles].c_str(), nullptr));
-    (*row)[speedup] = buf;
+  for (const auto& row : rows)
     out += csv_line(*row, 2);
-  }
   return out;
 }
 
@@ -434,7 +496,19 @@ void check_sweep_outputs(const SweepOptions& opts) {
   }
 }
 
-// The sweep's summary line, where its files went and its table.
+// --out-dir, --report and --csv, from the whole sweep (rank 0's) with its front marked.
+void write_sweep_outputs(const SweepOptions& opts, const SweepResult& sweep,
+                         const RenderSettings& settings, int jobs, int ranks) {
+  if (!opts.out_dir.empty()) write_sweep_folder(opts, sweep, settings, jobs, ranks);
+  if (!opts.report.empty()) {
+    write_text_file(opts.report, sweep_json(sweep, opts).dump(2) + "\n");
+  }
+  if (!opts.csv.empty()) {
+    write_text_file(opts.csv, sweep_csv(sweep));
+  }
+}
+
+// The sweep's summary line, where its files went, its table and its Pareto front.
 void print_sweep(const SweepOptions& opts, const SweepResult& sweep, const RenderSettings& settings,
                  std::size_t count) {
   const std::string shard =
@@ -456,6 +530,7 @@ void print_sweep(const SweepOptions& opts, const SweepResult& sweep, const Rende
   if (!opts.csv.empty()) {
     std::printf("  csv:       %s\n", opts.csv.c_str());
   }
+  std::printf("%s%s", sweep_table(sweep).c_str(), sweep_pareto_text(sweep).c_str());
 }
 
 }  // namespace
@@ -486,6 +561,7 @@ int run_sweep(const SweepOptions& opts) {
     // Every bad input fails here, before the scene loads and before any frame runs.
     count = sweep_points(axes, settings.cycle).size();
     check_sweep_outputs(opts);
+    pareto_cost_name(opts.pareto_cost);
     const bool per_core = jobs == 0;
     jobs = resolve_jobs(jobs);
     SweepRun run;
@@ -508,16 +584,10 @@ int run_sweep(const SweepOptions& opts) {
   }
   if (ranks.size() > 1 && !gather_ranks(ranks, error, sweep)) return error.empty() ? 0 : 1;
   if (!error.empty()) throw std::runtime_error(error);
-
-  if (!opts.out_dir.empty()) write_sweep_folder(opts, sweep, settings, jobs, ranks.size());
-  if (!opts.report.empty()) {
-    write_text_file(opts.report, sweep_json(sweep, opts).dump(2) + "\n");
-  }
-  if (!opts.csv.empty()) {
-    write_text_file(opts.csv, sweep_csv(sweep));
-  }
+  if (opts.pareto || !opts.pareto_cost.empty())
+    mark_pareto(sweep, pareto_cost_name(opts.pareto_cost));
+  write_sweep_outputs(opts, sweep, settings, jobs, ranks.size());
   print_sweep(opts, sweep, settings, count);
-  std::printf("%s", sweep_table(sweep).c_str());
   return 0;
 }
 

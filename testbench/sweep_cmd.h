@@ -55,6 +55,11 @@ struct SweepOptions {
   // config.json, command.txt, host.json; --csv and --report are refused with it.
   std::string out_dir;
   std::vector<std::string> argv;  // the command line, for command.txt
+  // --pareto: mark the points no other point beats in both frame rate (higher is better) and
+  // cost (lower is better); --pareto-cost names the cost (a cost column: luts, the default,
+  // block_rams, memory_kb, fp_units) and implies --pareto.
+  bool pareto = false;
+  std::string pareto_cost;
 };
 
 // (bugprone-exception-escape: nlohmann::json's default constructor is not declared noexcept; a
@@ -63,7 +68,9 @@ struct SweepPoint {                   // NOLINT(bugprone-exception-escape)
   std::size_t index = 0;              // the point's place in the whole sweep (0-based)
   std::vector<std::string> settings;  // the KEY=VALUE the point adds
   nlohmann::json cycle;               // the frame's cycle report (cycle_report_json)
+  nlohmann::json cost;                // the configuration's cost (sweep_cost_json)
   double speedup = 1.0;               // the first point's cycles over this point's
+  bool pareto = false;                // on the Pareto front (mark_pareto)
 };
 struct SweepResult {
   std::vector<SweepAxis> axes;
@@ -76,6 +83,7 @@ struct SweepResult {
   std::size_t shard = 0;
   std::size_t shards = 1;
   std::size_t total_points = 0;
+  std::string pareto_cost;  // the cost the front was marked against (mark_pareto); empty: none
 };
 
 // How run_sweep_points runs: `jobs` frames at once, the points of one shard.
@@ -103,6 +111,16 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
                              const RenderSettings& settings, const SweepRun& run = {});
 // Every point's speed-up over the first point held (the sweep's first point in a whole sweep).
 void set_speedups(SweepResult& sweep);
+
+// The Pareto front of (performance, cost) pairs, higher performance and lower cost better: true
+// for each pair no other pair dominates (at least as fast and at most as costly, and strictly
+// better in one of the two). Equal pairs do not dominate each other: both are on the front.
+std::vector<bool> pareto_front(const std::vector<std::pair<double, double>>& performance_cost);
+// "luts" when empty; throws "bad --pareto-cost 'NAME': ..." for a name that is no cost column.
+std::string pareto_cost_name(const std::string& name);
+// Marks each held point's `pareto` against the frame rate and the named cost (the points held:
+// a shard's front is its own; sweep-merge marks the whole sweep's).
+void mark_pareto(SweepResult& sweep, const std::string& cost);
 
 // The points as JSON and back (MPI ranks), the printed table, the CSV and the JSON report are
 // testbench/report.h's (sweep_points_json, sweep_table, sweep_csv, sweep_json).

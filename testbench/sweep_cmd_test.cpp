@@ -319,7 +319,7 @@ TEST(SweepParallel, ShardsMergeIntoTheWholeSweepsCsv) {
             "point,points,threads,packet,cycles,fps,mrays_per_s,speedup,usage_traversal,"
             "usage_list,usage_transformation,usage_intersection,cache_hit_traversal,"
             "cache_hit_list,cache_hit_transformation,bandwidth_mb_s_total,cycles_per_packet,"
-            "simd_efficiency");
+            "simd_efficiency,fp_units,memory_kb,luts,block_rams");
   EXPECT_EQ(parts[1].second.substr(parts[1].second.find('\n') + 1, 6), "1,6,2,");
   // In any order of the files: the bytes of the one-process CSV (speed-ups over point 0 again).
   std::swap(parts[0], parts[3]);
@@ -337,6 +337,27 @@ TEST(SweepParallel, ShardsMergeIntoTheWholeSweepsCsv) {
             }),
             "whole.csv: not a shard CSV (saarcor sweep --shard K/N): its header does not start "
             "with point,points");
+}
+
+// --pareto on shards: each shard marks its own front; sweep-merge marks the whole sweep's, so
+// the merged CSV is the one-process CSV with --pareto.
+TEST(SweepParallel, MergeMarksTheWholeSweepsParetoFront) {
+  RenderSettings s;
+  s.res = {32, 24};
+  const std::vector<SweepAxis> axes = {parse_sweep_axis("threads=2,8,32"),
+                                       parse_sweep_axis("packet=4,16")};
+  SweepResult whole = run_sweep_points(axes, room(), s);
+  mark_pareto(whole, "luts");
+  std::vector<std::pair<std::string, std::string>> parts;
+  for (std::size_t k = 0; k < 3; ++k) {
+    SweepRun run;
+    run.shard = k;
+    run.shards = 3;
+    SweepResult shard = run_sweep_points(axes, room(), s, run);
+    mark_pareto(shard, "luts");
+    parts.push_back({"part" + std::to_string(k) + ".csv", sweep_csv(shard)});
+  }
+  EXPECT_EQ(merge_sweep_csv(parts), sweep_csv(whole));
 }
 
 TEST(SweepParallel, ShardGrammar) {

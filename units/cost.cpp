@@ -51,7 +51,7 @@ MemoryItem per_thread(const Shape& s, std::string what, std::string kind, std::i
 
 UnitCost traversal_cost(const CycleParams& p, const Shape& s) {
   const int f = s.w.fp, n = s.lanes;
-  UnitCost u{"traversal", "Traversal", {}, {}};
+  UnitCost u{"traversal", "Traversal", {}, {}, {}};
   const int faces = p.clip_faces_per_step;
   // Node step: per lane 1 add and 1 div (d = (split - O) / D) and 3 cmp (d < tn, tf < d,
   // t_best < tn; D33); a clip step divides for `faces` box faces per lane (D29).
@@ -97,7 +97,7 @@ UnitCost traversal_cost(const CycleParams& p, const Shape& s) {
 }
 
 UnitCost list_cost(const CycleParams& p, const Shape& s) {
-  UnitCost u{"list", "Mailboxed List", {}, {}};
+  UnitCost u{"list", "Mailboxed List", {}, {}, {}};
   // Ids are integers: the mailbox compares no floats.
   const int n = s.lanes;
   u.memory.push_back(per_thread(
@@ -124,7 +124,7 @@ UnitCost list_cost(const CycleParams& p, const Shape& s) {
 UnitCost transformation_cost(const Shape& s) {
   const int f = s.w.fp, n = s.lanes;
   // One 3x3 matrix-vector product plus vector add per cycle (paper 2.3, D5).
-  UnitCost u{"transformation", "Transformation", transformation_algorithm().units(), {}};
+  UnitCost u{"transformation", "Transformation", transformation_algorithm().units(), {}, {}};
   // Rows arrive from the row cache (or T from the RGS) while the unit reads another thread's.
   u.memory.push_back(
       per_thread(s, "matrix applied (3 rows of 4)", "matrices", std::int64_t{12} * f, 2));
@@ -140,7 +140,7 @@ UnitCost transformation_cost(const Shape& s) {
 UnitCost intersection_cost() {
   // One ray per cycle on the transformation unit's unit-triangle rays; hits go on path f. Its
   // only storage is its pipeline.
-  return {"intersection", "Intersection", unit_triangle_algorithm().units(), {}};
+  return {"intersection", "Intersection", unit_triangle_algorithm().units(), {}, {}};
 }
 
 void add_cache(UnitCost& u, const CycleParams& p, const Shape& s, CacheUnit c, int index,
@@ -166,7 +166,7 @@ void add_cache(UnitCost& u, const CycleParams& p, const Shape& s, CacheUnit c, i
 
 UnitCost caches_cost(const CycleParams& p, const Shape& s) {
   // The cache serves one lookup or one fill per cycle (fills first, memif/cache.h): one port.
-  UnitCost u{"caches", "DynRTC-Cache", {}, {}};
+  UnitCost u{"caches", "DynRTC-Cache", {}, {}, {}};
   const int row_bits = 32 * ff::row_words(ff::kFp24);
   add_cache(u, p, s, CacheUnit::kTraversal, s.w.node, 64);
   add_cache(u, p, s, CacheUnit::kList, s.w.list, 32);
@@ -176,7 +176,7 @@ UnitCost caches_cost(const CycleParams& p, const Shape& s) {
 
 UnitCost shader_cost(const CostParams& cp, const Shape& s) {
   const int f = s.w.fp, n = s.lanes;
-  UnitCost u{"shader", "Shader", {}, {}};
+  UnitCost u{"shader", "Shader", {}, {}, {}};
   // The RGS FP helper (D10): the cosines' mul, sqrt, div and k + k; one operator of each kind,
   // sequenced by the RGS's phases.
   u.fp = {1, 1, 1, 0, 1};
@@ -215,6 +215,54 @@ FpUnits operator+(FpUnits a, const FpUnits& b) {
 }
 FpUnits operator*(FpUnits a, int k) {
   return {a.add * k, a.mul * k, a.div * k, a.cmp * k, a.sqrt * k};
+}
+
+// Virtex-II figures of one fp24 operator (rtl/fp_*.sv at their defaults: nearest even, flush, the
+// cycle model's latencies), measured with yosys 0.23 by
+//   RTL_SYNTH=xc2v rtl/synth.sh fp_add fp_mul fp_div fp_cmp
+// (synth_xilinx -family xc2v -flatten; LUT1-LUT4 counted, carry and MUXF cells not; docs/rtl.md
+// "Synthesis"). rtl/ has no square root: the RGS helper's one is counted at the divider's figure,
+// the digit recurrence of a square root having the divider's shape (one root bit per step).
+const std::vector<OperatorArea>& operator_areas() {
+  static const std::vector<OperatorArea> table = {
+      {"add", 728, 0, "rtl/fp_add.sv, 3 stages"},
+      {"mul", 759, 1, "rtl/fp_mul.sv, 3 stages"},
+      {"div", 1504, 0, "rtl/fp_div.sv, 8 stages"},
+      {"cmp", 96, 0, "rtl/fp_cmp.sv (lt, le, eq), 1 stage"},
+      {"sqrt", 1504, 0, "no RTL: the divider's figure"},
+  };
+  return table;
+}
+
+AreaEstimate& AreaEstimate::operator+=(const AreaEstimate& o) {
+  luts += o.luts;
+  mult18x18 += o.mult18x18;
+  block_rams += o.block_rams;
+  return *this;
+}
+AreaEstimate operator*(AreaEstimate a, int k) {
+  return {a.luts * k, a.mult18x18 * k, a.block_rams * k};
+}
+
+AreaEstimate fp_area(const FpUnits& f) {
+  const int counts[] = {f.add, f.mul, f.div, f.cmp, f.sqrt};
+  AreaEstimate a;
+  for (std::size_t i = 0; i < std::size(counts); ++i) {
+    a.luts += std::int64_t{counts[i]} * operator_areas()[i].luts;
+    a.mult18x18 += counts[i] * operator_areas()[i].mult18x18;
+  }
+  return a;
+}
+
+std::int64_t UnitCost::block_ram_bits() const {
+  std::int64_t b = 0;
+  for (const MemoryItem& m : memory)
+    if (m.kind != "global state" && m.kind != "cache misses") b += m.bits_each * m.count;
+  return b;
+}
+
+int block_rams(const UnitCost& u) {
+  return static_cast<int>((u.block_ram_bits() + kBlockRamBits - 1) / kBlockRamBits);
 }
 
 std::int64_t UnitCost::memory_bits() const {
@@ -282,11 +330,15 @@ ConfigurationCost configuration_cost(const CostParams& params) {
   c.clock_mhz = p.clock_mhz;
   c.units = {traversal_cost(p, s), list_cost(p, s),   transformation_cost(s),
              intersection_cost(),  caches_cost(p, s), shader_cost(params, s)};
-  for (const UnitCost& u : c.units) {
+  for (UnitCost& u : c.units) {
+    u.area = fp_area(u.fp);
+    u.area.block_rams = block_rams(u);
     c.fp_per_pipeline += u.fp;
     c.memory_bits_per_pipeline += u.memory_bits();
+    c.area_per_pipeline += u.area;
   }
   c.fp_total = c.fp_per_pipeline * p.pipelines;
+  c.area_total = c.area_per_pipeline * p.pipelines;
   c.memory_bits_total = c.memory_bits_per_pipeline * p.pipelines;
   c.flops = static_cast<double>(c.fp_total.total()) * p.clock_mhz * 1e6;
   return c;

@@ -61,14 +61,54 @@ struct MemoryItem {
   std::int64_t bits() const { return bits_each * count * ports; }
 };
 
+// ---- area on the prototype's FPGA (a Virtex-II XC2V6000, paper 4.1) ---------------------------
+inline constexpr int kXc2v6000Luts = 67584;
+inline constexpr int kXc2v6000Mult18x18 = 144;
+inline constexpr int kXc2v6000BlockRams = 144;
+// A Virtex-II block RAM holds 18 Kbit in every shape that carries the parity bits as data (512 x
+// 36, 1K x 18, 2K x 9; Xilinx UG002); it has two ports of its own, so a memory the paper counts
+// twice (dual-ported) needs its bits once.
+inline constexpr std::int64_t kBlockRamBits = 18 * 1024;
+
+// What one fp24 operator of the FP unit count takes on the Virtex-II: LUTs (LUT1-LUT4) and
+// MULT18X18 blocks, the synthesis figures of rtl/ (docs/rtl.md "Synthesis").
+struct OperatorArea {
+  const char* op;  // add, mul, div, cmp, sqrt
+  int luts = 0;
+  int mult18x18 = 0;
+  const char* source;  // where the figure comes from
+};
+const std::vector<OperatorArea>& operator_areas();
+
+// A unit's (or the chip's) area estimate: the LUTs and multipliers of its FP operators (the
+// per-operator table times the FP unit counts) and the block RAMs its memories need at least.
+struct AreaEstimate {
+  std::int64_t luts = 0;
+  int mult18x18 = 0;
+  int block_rams = 0;
+  AreaEstimate& operator+=(const AreaEstimate& o);
+  friend bool operator==(const AreaEstimate&, const AreaEstimate&) = default;
+};
+AreaEstimate operator*(AreaEstimate a, int k);
+// The operators' LUTs and multipliers for these FP unit counts.
+AreaEstimate fp_area(const FpUnits& f);
+
 struct UnitCost {
   std::string key;   // JSON key: traversal, list, transformation, intersection, caches, shader
   std::string name;  // the paper's row name
   FpUnits fp;
   std::vector<MemoryItem> memory;
+  AreaEstimate area;  // set by configuration_cost
   std::int64_t memory_bits() const;
   double memory_kb() const { return static_cast<double>(memory_bits()) / 8192.0; }  // KB = 2^10 B
+  // The bits that go into block RAM, each once: every memory but the registers (kinds "global
+  // state", the frame registers, and "cache misses", the outstanding misses every lookup
+  // searches at once and the short request FIFO).
+  std::int64_t block_ram_bits() const;
 };
+// At least this many block RAMs hold the unit's RAM bits: ceil(block_ram_bits / 18 Kbit), the
+// unit's memories packed densely (a lower bound; a memory's shape can waste part of a block).
+int block_rams(const UnitCost& u);
 
 struct ConfigurationCost {
   int pipelines = 1;
@@ -79,6 +119,8 @@ struct ConfigurationCost {
   std::int64_t memory_bits_per_pipeline = 0;
   std::int64_t memory_bits_total = 0;  // all DynRTPs
   double flops = 0.0;                  // every FP unit of the chip once per cycle at the clock
+  AreaEstimate area_per_pipeline;      // the units' areas added
+  AreaEstimate area_total;             // all DynRTPs
   double memory_kb_total() const { return static_cast<double>(memory_bits_total) / 8192.0; }
 };
 

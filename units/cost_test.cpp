@@ -192,6 +192,71 @@ TEST(Cost, Table1DesignsFromTheirOperations) {
   EXPECT_GT(std::abs(t.ratios[2].full - t.ratios[2].paper_full), 0.05);
 }
 
+TEST(Cost, OperatorAreasAreTheMeasuredSynthesisFigures) {
+  // docs/rtl.md "Synthesis", Virtex-II columns: add 728 LUTs, mul 759 + 1 MULT18X18, div 1,504,
+  // cmp 96; the square root (no RTL) at the divider's figure.
+  const auto& t = operator_areas();
+  ASSERT_EQ(t.size(), 5u);
+  const char* ops[] = {"add", "mul", "div", "cmp", "sqrt"};
+  const int luts[] = {728, 759, 1504, 96, 1504}, mults[] = {0, 1, 0, 0, 0};
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_STREQ(t[i].op, ops[i]);
+    EXPECT_EQ(t[i].luts, luts[i]) << ops[i];
+    EXPECT_EQ(t[i].mult18x18, mults[i]) << ops[i];
+  }
+}
+
+TEST(Cost, Table2AreaByHand) {
+  const ConfigurationCost c = configuration_cost(cost_preset("table2"));
+  // LUTs: traversal 4 x 728 + 4 x 1,504 + 12 x 96 = 10,080; transformation 9 x 728 + 9 x 759 =
+  // 13,383 (9 multipliers); intersection 3 x 728 + 2 x 759 + 1,504 = 5,206 (2); shader 728 + 759
+  // + 1,504 + 1,504 (the sqrt) = 4,495 (1); list and caches none.
+  EXPECT_EQ(unit(c, "traversal").area.luts, 10'080);
+  EXPECT_EQ(unit(c, "transformation").area.luts, 13'383);
+  EXPECT_EQ(unit(c, "transformation").area.mult18x18, 9);
+  EXPECT_EQ(unit(c, "intersection").area.luts, 5'206);
+  EXPECT_EQ(unit(c, "intersection").area.mult18x18, 2);
+  EXPECT_EQ(unit(c, "shader").area.luts, 4'495);
+  EXPECT_EQ(unit(c, "list").area.luts, 0);
+  EXPECT_EQ(unit(c, "caches").area.luts, 0);
+  // Block RAMs: each unit's RAM bits once (two ports per block RAM) over 18,432, rounded up.
+  // Traversal: Table2MemoryByHand's items without the second port and the frame registers:
+  // 2 x 18,432 + 2 x 6,144 + 3,072 + 4,608 + 444,416 + 448 + 1,280 = 502,976 -> 27.3 -> 28.
+  EXPECT_EQ(unit(c, "traversal").block_ram_bits(), 502'976);
+  EXPECT_EQ(unit(c, "traversal").area.block_rams, 28);
+  // List: 17,952 bits, all single-ported -> 1.
+  EXPECT_EQ(unit(c, "list").area.block_rams, 1);
+  // Transformation: 9,216 + 2 x 18,432 + 160 = 46,240 -> 2.5 -> 3.
+  EXPECT_EQ(unit(c, "transformation").block_ram_bits(), 46'240);
+  EXPECT_EQ(unit(c, "transformation").area.block_rams, 3);
+  EXPECT_EQ(unit(c, "intersection").area.block_rams, 0);
+  // Caches: data 98,304 + tags 19,968 = 118,272 (the misses' registers excluded) -> 6.4 -> 7.
+  EXPECT_EQ(unit(c, "caches").block_ram_bits(), 118'272);
+  EXPECT_EQ(unit(c, "caches").area.block_rams, 7);
+  // Shader: hit records 13,952 + 7,168 + 8,704 + 768 + lights 768 = 31,360 -> 1.7 -> 2.
+  EXPECT_EQ(unit(c, "shader").block_ram_bits(), 31'360);
+  EXPECT_EQ(unit(c, "shader").area.block_rams, 2);
+  // One DynRTP: 33,164 LUTs (49 % of the XC2V6000's 67,584), 12 multipliers, 41 block RAMs.
+  EXPECT_EQ(c.area_per_pipeline, (AreaEstimate{33'164, 12, 41}));
+  EXPECT_EQ(c.area_total, c.area_per_pipeline);
+}
+
+TEST(Cost, AreaOfWidePacketsAndFourPipelinesByHand) {
+  // P = 16, two clip faces: traversal 32 add, 32 div, 64 cmp = 23,296 + 48,128 + 6,144 = 77,568
+  // LUTs; with the transformation, intersection and shader of Table2AreaByHand: 100,652, more
+  // than one XC2V6000 holds.
+  const ConfigurationCost wide = configuration_cost(
+      with("prototype", {"packet=16", "threads=64", "stack=32", "clip.faces_per_step=2"}));
+  EXPECT_EQ(unit(wide, "traversal").area.luts, 77'568);
+  EXPECT_EQ(wide.area_total.luts, 100'652);
+  EXPECT_GT(wide.area_total.luts, kXc2v6000Luts);
+  // Four prototype DynRTPs: four times one's LUTs, multipliers and block RAMs.
+  const ConfigurationCost four = configuration_cost(with("prototype", {"pipelines=4"}));
+  EXPECT_EQ(four.area_per_pipeline.luts, 33'164);
+  EXPECT_EQ(four.area_total, four.area_per_pipeline * 4);
+  EXPECT_EQ(four.area_total.mult18x18, 48);
+}
+
 TEST(Cost, LightsAndBadInput) {
   EXPECT_EQ(cost_preset("table2").lights, 8);
   EXPECT_EQ(cost_preset("prototype").lights, 256);
