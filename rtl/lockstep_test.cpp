@@ -44,7 +44,10 @@ void expect_agreement(const LockstepResult& r) {
   const auto ev = [&](BoundaryPort p) { return r.events[static_cast<std::size_t>(p)]; };
   EXPECT_GT(ev(BoundaryPort::kCacheRequest), 0u);
   EXPECT_EQ(ev(BoundaryPort::kCacheRequest), ev(BoundaryPort::kCacheResponse));
-  EXPECT_EQ(ev(BoundaryPort::kCacheRequest), ev(BoundaryPort::kOutput));
+  // Every list step fetches its entry but a return to a list that is done (D49: a thread back
+  // from an object whose top-level list has ended), which every scene here has (each packet that
+  // enters the last object of its list comes back to it).
+  EXPECT_GT(ev(BoundaryPort::kOutput), ev(BoundaryPort::kCacheRequest));
   std::printf("  %s: %llu cycles, %llu requests, %llu outputs compared\n", r.build.c_str(),
               static_cast<unsigned long long>(r.cycles),
               static_cast<unsigned long long>(ev(BoundaryPort::kCacheRequest)),

@@ -91,6 +91,8 @@ class TravHarness {
         if (!clip(s)) return false;
       } else if (ph == units::Phase::kTraverse) {
         if (!step(s)) return false;
+      } else if (ph == units::Phase::kPop) {
+        if (!pop_request(s)) return false;
       } else if (ph == units::Phase::kList || ph == units::Phase::kIntersect ||
                  ph == units::Phase::kTransformObject || ph == units::Phase::kTransformTriangle) {
         if (!neighbour(s)) return false;
@@ -313,7 +315,16 @@ class TravHarness {
     return outcome(s, o, issue + static_cast<std::uint64_t>(lat_.depth));
   }
 
-  // A pop the model ran in the list or intersection unit: the thread passes through the RTL.
+  // The pop request a list's end sends (D49): the model's pop and the RTL's, side by side.
+  bool pop_request(S& s) {
+    const std::uint64_t drops0 = s.u.stack_drops;
+    s.traversal.pop(s);
+    drops_left_ = s.u.stack_drops - drops0;
+    run_.drops += drops_left_;
+    return pop(s);
+  }
+
+  // Issues a pop to the RTL (the model's has run) and compares its outcome.
   bool pop(S& s) {
     top_->dbg_thread = thread_;
     settle();
@@ -329,8 +340,7 @@ class TravHarness {
 
   // The RTL's outcome against the model's state after the request. The thread leaves `due` =
   // issue + depth, one cycle later per stack entry dropped. A bottom level that ended inside the
-  // request goes back to the top level's list (dest 2); when the model popped the top level as
-  // well (that list was over), the RTL pops on, and the request's drops are split over the two.
+  // request goes back to the top level's list (dest 2), as the model's (D49).
   bool outcome(S& s, const Out& o, std::uint64_t due) {
     ++run_.requests;
     top_->dbg_thread = thread_;
@@ -340,24 +350,21 @@ class TravHarness {
     if (!o.valid)
       return fail("missing", top_->overflow ? "RTL stack overflow" : "the thread never left");
     const Phase ph = s.phase;
-    const bool more = o.dest == 2 && !(ph == Phase::kList || ph == Phase::kTransformObject);
     const std::uint64_t extra = o.cycle >= due ? o.cycle - due : ~std::uint64_t{0};
     // Shadow packets also drop entries whose rays are all done, which the model does not count:
     // there the RTL may leave later than the counted drops say, never earlier.
     const bool shadow = s.kind == units::RayKind::kShadow;
-    if (shadow ? (extra == ~std::uint64_t{0} || (!more && extra < drops_left_))
-               : (more ? extra > drops_left_ : extra != drops_left_))
+    if (shadow ? (extra == ~std::uint64_t{0} || extra < drops_left_) : extra != drops_left_)
       return fail("timing", "thread left in cycle " + std::to_string(o.cycle) + ", model " +
                                 std::to_string(due + drops_left_) + " (depth " +
                                 std::to_string(lat_.depth) + " + " + std::to_string(drops_left_) +
                                 " drops after the issue)");
     drops_left_ = drops_left_ > extra ? drops_left_ - extra : 0;
     if (o.dest == 2) {
-      // Back at the top level's list: the model continued there or popped the top level too.
-      if (s.traversal.level() != units::Level::kTop)
+      // Back at the top level's list: the model's thread goes there too.
+      if (s.traversal.level() != units::Level::kTop || ph != Phase::kList)
         return fail("payload", "RTL ended the object, the model is still in it");
-      if (!more) return true;
-      return pop(s);
+      return true;
     }
     switch (ph) {
       case Phase::kTraverse:
@@ -424,10 +431,7 @@ class TravHarness {
 
   // The model's list, transformation and intersection steps; their hand-overs to the RTL.
   bool neighbour(S& s) {
-    const Phase ph = s.phase;
-    const units::Level level = s.traversal.level();
-    const std::uint64_t drops0 = s.u.stack_drops;
-    switch (ph) {
+    switch (s.phase) {
       case Phase::kList:
         s.list.step(s);
         break;
@@ -453,14 +457,9 @@ class TravHarness {
       default:
         return true;
     }
-    // Did the list end (ListStep::resume popped)? Then the RTL pops.
-    const Phase now = s.phase;
-    const bool popped = now == Phase::kTraverse || now == Phase::kShadeSurface ||
-                        now == Phase::kShadeShadow || s.traversal.level() != level;
-    if (!popped) return true;
-    drops_left_ = s.u.stack_drops - drops0;
-    run_.drops += drops_left_;
-    return pop(s);
+    // A list that ends sends the thread on with a pop request (Phase::kPop, D49): the loop
+    // in packet() issues it.
+    return true;
   }
 
   const memif::MemoryImage& image_;
