@@ -28,17 +28,19 @@ module list_unit #(
     input  logic                 clk,
     input  logic                 rst,
     // Input paths in the model's priority (units/dynrtp.cpp): 0 the unit's loop, 1 from the
-    // intersection unit, 2 from the traversal unit (path c).
+    // intersection unit, 2 from the traversal unit (path c). Path i's fields are the i-th slices
+    // of the flat vectors (in_thread[i*TW +: TW], in_next[i*32 +: 32], ...): yosys 0.23 reads no
+    // packed arrays.
     input  logic [2:0]           in_valid,
-    input  logic [2:0][TW-1:0]   in_thread,
+    input  logic [3*TW-1:0]      in_thread,
     input  logic [2:0]           in_start,
     input  logic [2:0]           in_level,
-    input  logic [2:0][31:0]     in_next,
-    input  logic [2:0][31:0]     in_end,
-    input  logic [2:0][P-1:0]    in_mask,
+    input  logic [3*32-1:0]      in_next,
+    input  logic [3*32-1:0]      in_end,
+    input  logic [3*P-1:0]       in_mask,
     // Side band: packet starts (two per cycle: the RGS admits one and hands on another).
     input  logic [1:0]           clr_valid,
-    input  logic [1:0][TW-1:0]   clr_thread,
+    input  logic [2*TW-1:0]      clr_thread,
     // List cache.
     output logic                 req_valid,
     output logic [31:0]          req_item,
@@ -116,6 +118,21 @@ module list_unit #(
   assign m = cur_mask[iss_thread][lv];
   assign entry = word[iss_thread];
 
+  // The issuing thread's mailboxes, slot k at [k*32 +: 32] and [k*P +: P].
+  logic [MBN*32-1:0] ob_ids;
+  logic [MBN*P-1:0] ob_masks;
+  logic [TMBN*32-1:0] tr_ids;
+  logic [TMBN*P-1:0] tr_masks;
+  always_comb begin
+    for (int k = 0; k < MBN; k++) begin
+      ob_ids[k*32+:32] = ob_id[iss_thread][k];
+      ob_masks[k*P+:P] = ob_mask[iss_thread][k];
+    end
+    for (int k = 0; k < TMBN; k++) begin
+      tr_ids[k*32+:32] = tr_id[iss_thread][k];
+      tr_masks[k*P+:P] = tr_mask[iss_thread][k];
+    end
+  end
   logic [P-1:0] ob_todo, ob_slot_mask, tr_todo, tr_slot_mask;
   logic [MSB-1:0] ob_slot, ob_next_head;
   logic [MBB-1:0] ob_next_size;
@@ -123,12 +140,12 @@ module list_unit #(
   logic [TMBB-1:0] tr_next_size;
   logic ob_write, tr_write;
   list_mailbox #(.N(MB), .P(P), .FAULT_NEVER_HITS(FAULT_MAILBOX_NEVER_HITS)) objects (
-      .ids(ob_id[iss_thread]), .masks(ob_mask[iss_thread]), .head(ob_head[iss_thread]),
+      .ids(ob_ids), .masks(ob_masks), .head(ob_head[iss_thread]),
       .size(ob_size[iss_thread]), .id(entry), .mask(m), .todo(ob_todo), .slot(ob_slot),
       .slot_mask(ob_slot_mask), .next_head(ob_next_head), .next_size(ob_next_size),
       .write(ob_write));
   list_mailbox #(.N(TMB), .P(P), .FAULT_NEVER_HITS(FAULT_MAILBOX_NEVER_HITS)) triangles (
-      .ids(tr_id[iss_thread]), .masks(tr_mask[iss_thread]), .head(tr_head[iss_thread]),
+      .ids(tr_ids), .masks(tr_masks), .head(tr_head[iss_thread]),
       .size(tr_size[iss_thread]), .id(entry), .mask(m), .todo(tr_todo), .slot(tr_slot),
       .slot_mask(tr_slot_mask), .next_head(tr_next_head), .next_size(tr_next_size),
       .write(tr_write));
@@ -146,7 +163,7 @@ module list_unit #(
 
   always_ff @(posedge clk) begin
     if (rst) begin
-      for (int t = 0; t < THREADS; ++t) begin
+      for (int t = 0; t < THREADS; t++) begin
         level[t] <= 1'b0;
         ob_head[t] <= '0;
         ob_size[t] <= '0;
@@ -175,18 +192,18 @@ module list_unit #(
           tr_size[iss_thread] <= '0;
         end
       end
-      for (int c = 0; c < 2; ++c)
+      for (int c = 0; c < 2; c++)
         if (clr_valid[c]) begin
-          ob_head[clr_thread[c]] <= '0;
-          ob_size[clr_thread[c]] <= '0;
+          ob_head[clr_thread[c*TW+:TW]] <= '0;
+          ob_size[clr_thread[c*TW+:TW]] <= '0;
         end
-      for (int i = 0; i < 3; ++i)
+      for (int i = 0; i < 3; i++)
         if (in_valid[i]) begin
-          level[in_thread[i]] <= in_level[i];
-          cur_mask[in_thread[i]][in_level[i]] <= in_mask[i];
+          level[in_thread[i*TW+:TW]] <= in_level[i];
+          cur_mask[in_thread[i*TW+:TW]][in_level[i]] <= in_mask[i*P+:P];
           if (in_start[i]) begin
-            cur_next[in_thread[i]][in_level[i]] <= in_next[i];
-            cur_end[in_thread[i]][in_level[i]] <= in_end[i];
+            cur_next[in_thread[i*TW+:TW]][in_level[i]] <= in_next[i*32+:32];
+            cur_end[in_thread[i*TW+:TW]][in_level[i]] <= in_end[i*32+:32];
           end
         end
     end

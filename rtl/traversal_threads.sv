@@ -159,20 +159,21 @@ module traversal_threads #(
 
   // ---- the thread machinery --------------------------------------------------------------------
   logic [Inputs-1:0] in_valid;
-  logic [Inputs-1:0][TW-1:0] in_thread;
+  logic [Inputs*TW-1:0] in_thread;  // path i's thread at [i*TW +: TW]
+  localparam int PathF = FAULT_PRIO_SWAP ? 5 : 2, PathB = FAULT_PRIO_SWAP ? 2 : 5;
   always_comb begin
     in_valid[0] = c_out_valid && c_out_dest == 2'd0;
-    in_thread[0] = c_out_thread;
+    in_thread[0+:TW] = c_out_thread;
     in_valid[1] = c_out2_valid && c_out2_dest == 2'd0;
-    in_thread[1] = c_out2_thread;
-    in_valid[FAULT_PRIO_SWAP ? 5 : 2] = f_valid;
-    in_thread[FAULT_PRIO_SWAP ? 5 : 2] = f_thread;
+    in_thread[TW+:TW] = c_out2_thread;
+    in_valid[PathF] = f_valid;
+    in_thread[PathF*TW+:TW] = f_thread;
     in_valid[3] = l_valid;
-    in_thread[3] = l_thread;
+    in_thread[3*TW+:TW] = l_thread;
     in_valid[4] = r_valid;
-    in_thread[4] = r_thread;
-    in_valid[FAULT_PRIO_SWAP ? 2 : 5] = b_valid;
-    in_thread[FAULT_PRIO_SWAP ? 2 : 5] = b_thread;
+    in_thread[4*TW+:TW] = r_thread;
+    in_valid[PathB] = b_valid;
+    in_thread[PathB*TW+:TW] = b_thread;
   end
 
   logic acc_node;

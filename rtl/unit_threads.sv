@@ -27,9 +27,10 @@ module unit_threads #(
 ) (
     input  logic                     clk,
     input  logic                     rst,
-    // Input paths in priority order (0 first): a thread pushed this cycle.
+    // Input paths in priority order (0 first): a thread pushed this cycle. Path i's thread is
+    // in_thread[i*TW +: TW] (flat vectors, not packed arrays: yosys 0.23 reads no packed arrays).
     input  logic [INPUTS-1:0]        in_valid,
-    input  logic [INPUTS-1:0][TW-1:0] in_thread,
+    input  logic [INPUTS*TW-1:0]     in_thread,
     // Accept: the thread taken from a path this cycle and the items it needs.
     output logic                     acc_valid,
     output logic [TW-1:0]            acc_thread,
@@ -66,16 +67,16 @@ module unit_threads #(
   logic [TW-1:0] path_q[INPUTS][QS];
   logic [QB:0] path_head[INPUTS], path_tail[INPUTS];
   logic [INPUTS-1:0] path_any;
-  logic [$clog2(INPUTS+1)-1:0] sel;
+  localparam int SelW = $clog2(INPUTS + 1);
+  logic [SelW-1:0] sel;
   always_comb begin
     sel = '0;
-    for (int i = 0; i < INPUTS; ++i) path_any[i] = path_head[i] != path_tail[i];
-    for (int k = INPUTS - 1; k >= 0; --k) begin
+    for (int i = 0; i < INPUTS; i++) path_any[i] = path_head[i] != path_tail[i];
+    for (int k = INPUTS - 1; k >= 0; k--) begin
       // The injected fault (tests only): the first two paths' priorities swapped.
-      /* verilator lint_off UNUSEDSIGNAL */
-      automatic int i = FAULT_PRIORITY_SWAP && INPUTS > 1 && k < 2 ? 1 - k : k;
-      /* verilator lint_on UNUSEDSIGNAL */
-      if (path_any[i]) sel = i[$clog2(INPUTS+1)-1:0];
+      logic [SelW-1:0] path;
+      path = FAULT_PRIORITY_SWAP && INPUTS > 1 && k < 2 ? SelW'(1 - k) : SelW'(k);
+      if (path_any[path]) sel = path;
     end
   end
 
@@ -123,12 +124,12 @@ module unit_threads #(
   always_ff @(posedge clk) begin
     if (rst) begin
       now <= '0;
-      for (int i = 0; i < INPUTS; ++i) begin
+      for (int i = 0; i < INPUTS; i++) begin
         path_head[i] <= '0;
         path_tail[i] <= '0;
       end
       fetching <= 1'b0;
-      for (int t = 0; t < THREADS; ++t) waiting[t] <= '0;
+      for (int t = 0; t < THREADS; t++) waiting[t] <= '0;
       ready_head <= '0;
       ready_tail <= '0;
       steps_left <= '0;
@@ -181,9 +182,9 @@ module unit_threads #(
         fetch_left <= fetch_left - CW'(1);
       end
       // Threads arriving on the paths (taken from the next cycle on).
-      for (int i = 0; i < INPUTS; ++i)
+      for (int i = 0; i < INPUTS; i++)
         if (in_valid[i]) begin
-          path_q[i][path_tail[i][QB-1:0]] <= in_thread[i];
+          path_q[i][path_tail[i][QB-1:0]] <= in_thread[i*TW+:TW];
           path_tail[i] <= path_tail[i] + 1;
         end
     end
