@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "testbench/image_io.h"
+#include "testbench/report.h"
 
 namespace saarcor {
 namespace {
@@ -16,60 +17,6 @@ using units::UnitCost;
 
 double ratio(double model, double paper) {
   return paper == 0.0 ? 0.0 : model / paper;
-}
-
-const units::PaperTable2Row& paper_row(const std::string& key) {
-  for (const auto& r : units::paper_table2())
-    if (key == r.key) return r;
-  throw std::logic_error("no Table 2 row " + key);
-}
-
-nlohmann::json fp_json(const FpUnits& f, std::int64_t bits, const units::AreaEstimate& a) {
-  return {{"add", f.add},
-          {"mul", f.mul},
-          {"div", f.div},
-          {"cmp", f.cmp},
-          {"sqrt", f.sqrt},
-          {"memory_bits", bits},
-          {"memory_kb", static_cast<double>(bits) / 8192.0},
-          {"luts", a.luts},
-          {"mult18x18", a.mult18x18},
-          {"block_rams", a.block_rams}};
-}
-
-nlohmann::json unit_json(const UnitCost& u) {
-  nlohmann::json j = fp_json(u.fp, u.memory_bits(), u.area);
-  j["name"] = u.name;
-  j["memory"] = nlohmann::json::array();
-  j["memory_by_kind"] = nlohmann::json::object();
-  for (const auto& m : u.memory)
-    j["memory_by_kind"][m.kind] = j["memory_by_kind"].value(m.kind, std::int64_t{0}) + m.bits();
-  for (const auto& m : u.memory)
-    j["memory"].push_back({{"what", m.what},
-                           {"kind", m.kind},
-                           {"bits_each", m.bits_each},
-                           {"count", m.count},
-                           {"ports", m.ports},
-                           {"bits", m.bits()}});
-  return j;
-}
-
-nlohmann::json table2_json(const ConfigurationCost& c) {
-  nlohmann::json j;
-  auto row = [&](const std::string& key, const FpUnits& f, double kb) {
-    const auto& p = paper_row(key);
-    const double model[] = {double(f.add), double(f.mul), double(f.div), double(f.cmp), kb};
-    const double paper[] = {double(p.add), double(p.mul), double(p.div), double(p.cmp),
-                            p.memory_kb};
-    const char* keys[] = {"add", "mul", "div", "cmp", "memory_kb"};
-    for (int i = 0; i < 5; ++i)
-      j[key][keys[i]] = {
-          {"model", model[i]}, {"paper", paper[i]}, {"ratio", ratio(model[i], paper[i])}};
-  };
-  for (const UnitCost& u : c.units)
-    row(u.key, u.fp, u.memory_kb());
-  row("total", c.fp_per_pipeline, static_cast<double>(c.memory_bits_per_pipeline) / 8192.0);
-  return j;
 }
 
 std::string fp_cell(int v) {
@@ -103,7 +50,7 @@ std::string ratio_cell(double model, double paper) {
 
 // Table 2's paper line and the ratio line under a model line.
 std::string paper_lines(const std::string& key, const FpUnits& f, double kb) {
-  const auto& p = paper_row(key);
+  const auto& p = units::paper_table2_row(key);
   std::string s = unit_line("  paper", {p.add, p.mul, p.div, p.cmp, 0}, p.memory_kb);
   char buf[200];
   std::snprintf(buf, sizeof buf, "%-34s %5s %5s %5s %5s %5s %10s\n", "  ratio model/paper",
@@ -178,36 +125,6 @@ CostParams cost_params(const std::string& preset, const std::vector<std::string>
   return p;
 }
 
-nlohmann::json cost_json(const CostParams& params, bool table2) {
-  const ConfigurationCost c = units::configuration_cost(params);
-  nlohmann::json j;
-  for (const UnitCost& u : c.units)
-    j["units"][u.key] = unit_json(u);
-  j["total"] = fp_json(c.fp_total, c.memory_bits_total, c.area_total);
-  j["total"]["per_pipeline"] =
-      fp_json(c.fp_per_pipeline, c.memory_bits_per_pipeline, c.area_per_pipeline);
-  for (const units::OperatorArea& o : units::operator_areas())
-    j["operator_area"][o.op] = {{"luts", o.luts}, {"mult18x18", o.mult18x18}, {"source", o.source}};
-  j["pipelines"] = c.pipelines;
-  j["flops"] = c.flops;
-  j["lights"] = params.lights;
-  for (const auto& i : units::describe(params.cycle))
-    j["configuration"][i.name] = i.value;
-  const units::Table1 t1 = units::table1(params);
-  for (const auto& r : t1.ratios)
-    j["table1"][r.key] = {{"without_traversal", r.without_traversal},
-                          {"full", r.full},
-                          {"paper_without_traversal", r.paper_without_traversal},
-                          {"paper_full", r.paper_full}};
-  for (const auto& d : t1.designs)
-    j["table1"]["designs"][d.key] = {{"name", d.name},
-                                     {"parts", d.parts},
-                                     {"without_traversal", d.without_traversal.total()},
-                                     {"full", d.full.total()}};
-  if (table2) j["table2"] = table2_json(c);
-  return j;
-}
-
 std::string cost_text(const CostParams& params, bool table2) {
   const ConfigurationCost c = units::configuration_cost(params);
   std::string s = heading(params) + column_heads("unit (one DynRTP)");
@@ -269,7 +186,7 @@ int run_cost(const CostOptions& opts) {
   const CostParams p = cost_params(opts.preset, opts.set);
   const bool table2 = opts.preset == "table2";
   const std::string text = cost_text(p, table2);  // computed before any file is written
-  if (!opts.json.empty()) write_text_file(opts.json, cost_json(p, table2).dump(2) + "\n");
+  if (!opts.json.empty()) write_text_file(opts.json, cost_report_json(p, table2).dump(2) + "\n");
   std::printf("%s", text.c_str());
   if (!opts.json.empty()) std::printf("  json: %s\n", opts.json.c_str());
   return 0;
@@ -284,7 +201,7 @@ int run_paper_cost_table(int table, const std::vector<std::string>& set, const s
     throw std::runtime_error("bad --json '" + json + "': expected a .json file name");
   const CostParams p = cost_params(table == 2 ? "table2" : "prototype", set);
   const std::string text = table == 1 ? table1_text(p) : table2_text(p);
-  if (!json.empty()) write_text_file(json, cost_json(p, table == 2).dump(2) + "\n");
+  if (!json.empty()) write_text_file(json, cost_report_json(p, table == 2).dump(2) + "\n");
   std::printf("%s", text.c_str());
   if (!json.empty()) std::printf("  json: %s\n", json.c_str());
   return 0;

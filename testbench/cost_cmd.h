@@ -21,11 +21,6 @@ struct CostOptions {
 // The configuration: the preset's, then every --set in order; throws naming the key.
 units::CostParams cost_params(const std::string& preset, const std::vector<std::string>& set);
 
-// The figures as JSON: units.<unit>.{add,mul,div,cmp,sqrt,memory_bits,memory_kb,memory[],
-// memory_by_kind},
-// total.{...}, flops, table1.<ratio>.{without_traversal,full,paper_*}; with `table2` also
-// table2.<unit>.{model,paper,ratio}.
-nlohmann::json cost_json(const units::CostParams& params, bool table2);
 // The per-unit listing with every memory item; with `table2` each unit's paper and ratio lines.
 std::string cost_text(const units::CostParams& params, bool table2);
 // Tables 1 and 2 printed as `saarcor paper` prints Tables 3 and 4: paper, model, ratio lines.

@@ -1801,4 +1801,89 @@ void write_render_folder(const std::string& dir, nlohmann::json report, const Fr
   write_run_folder(f);
 }
 
+// ---- cost ------------------------------------------------------------------------------------
+
+namespace {
+
+nlohmann::json fp_json(const units::FpUnits& f, std::int64_t bits, const units::AreaEstimate& a) {
+  return {{"add", f.add},
+          {"mul", f.mul},
+          {"div", f.div},
+          {"cmp", f.cmp},
+          {"sqrt", f.sqrt},
+          {"memory_bits", bits},
+          {"memory_kb", static_cast<double>(bits) / 8192.0},
+          {"luts", a.luts},
+          {"mult18x18", a.mult18x18},
+          {"block_rams", a.block_rams}};
+}
+
+nlohmann::json unit_json(const units::UnitCost& u) {
+  nlohmann::json j = fp_json(u.fp, u.memory_bits(), u.area);
+  j["name"] = u.name;
+  j["memory"] = nlohmann::json::array();
+  j["memory_by_kind"] = nlohmann::json::object();
+  for (const auto& m : u.memory)
+    j["memory_by_kind"][m.kind] = j["memory_by_kind"].value(m.kind, std::int64_t{0}) + m.bits();
+  for (const auto& m : u.memory)
+    j["memory"].push_back({{"what", m.what},
+                           {"kind", m.kind},
+                           {"bits_each", m.bits_each},
+                           {"count", m.count},
+                           {"ports", m.ports},
+                           {"bits", m.bits()}});
+  return j;
+}
+
+nlohmann::json table2_json(const units::ConfigurationCost& c) {
+  nlohmann::json j;
+  auto row = [&](const std::string& key, const units::FpUnits& f, double kb) {
+    const auto& p = units::paper_table2_row(key);
+    const double model[] = {double(f.add), double(f.mul), double(f.div), double(f.cmp), kb};
+    const double paper[] = {double(p.add), double(p.mul), double(p.div), double(p.cmp),
+                            p.memory_kb};
+    const char* keys[] = {"add", "mul", "div", "cmp", "memory_kb"};
+    for (int i = 0; i < 5; ++i)
+      j[key][keys[i]] = {{"model", model[i]},
+                         {"paper", paper[i]},
+                         {"ratio", paper[i] == 0.0 ? 0.0 : model[i] / paper[i]}};
+  };
+  for (const units::UnitCost& u : c.units)
+    row(u.key, u.fp, u.memory_kb());
+  row("total", c.fp_per_pipeline, static_cast<double>(c.memory_bits_per_pipeline) / 8192.0);
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json cost_report_json(const units::CostParams& params, bool table2) {
+  const units::ConfigurationCost c = units::configuration_cost(params);
+  nlohmann::json j;
+  for (const units::UnitCost& u : c.units)
+    j["units"][u.key] = unit_json(u);
+  j["total"] = fp_json(c.fp_total, c.memory_bits_total, c.area_total);
+  j["total"]["per_pipeline"] =
+      fp_json(c.fp_per_pipeline, c.memory_bits_per_pipeline, c.area_per_pipeline);
+  for (const units::OperatorArea& o : units::operator_areas())
+    j["operator_area"][o.op] = {{"luts", o.luts}, {"mult18x18", o.mult18x18}, {"source", o.source}};
+  j["pipelines"] = c.pipelines;
+  j["flops"] = c.flops;
+  j["lights"] = params.lights;
+  for (const auto& i : units::describe(params.cycle))
+    j["configuration"][i.name] = i.value;
+  const units::Table1 t1 = units::table1(params);
+  for (const auto& r : t1.ratios)
+    j["table1"][r.key] = {{"without_traversal", r.without_traversal},
+                          {"full", r.full},
+                          {"paper_without_traversal", r.paper_without_traversal},
+                          {"paper_full", r.paper_full}};
+  for (const auto& d : t1.designs)
+    j["table1"]["designs"][d.key] = {{"name", d.name},
+                                     {"parts", d.parts},
+                                     {"without_traversal", d.without_traversal.total()},
+                                     {"full", d.full.total()}};
+  if (table2) j["table2"] = table2_json(c);
+  return j;
+}
+
 }  // namespace saarcor

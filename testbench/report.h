@@ -139,6 +139,13 @@ nlohmann::json sweep_rank_message(const std::string& error, const SweepResult& s
 // A sweep point's cost (units/cost.h, docs/cost.md), its statistics declared once in report.cpp
 // with name, unit and description: {"fp_units", "memory_kb", "luts", "block_rams"} of the chip.
 nlohmann::json sweep_cost_json(const units::CostParams& params);
+
+// ---- cost (saarcor cost, saarcor paper --table 1|2) -------------------------------------------
+
+// `saarcor cost --json`'s report: units.<unit>.{add,mul,div,cmp,sqrt,memory_bits,memory_kb,luts,
+// mult18x18,block_rams,memory[],memory_by_kind}, total.{...}, flops, table1.<ratio>.{without_
+// traversal,full,paper_*}; with `table2` also table2.<unit>.{model,paper,ratio}.
+nlohmann::json cost_report_json(const units::CostParams& params, bool table2);
 // Those statistics' names, in column order (what --pareto-cost takes).
 std::vector<std::string> sweep_cost_names();
 // stats.txt's lines of one point: cycle_stat_lines, then "cost.NAME" for each cost statistic and,

@@ -467,4 +467,10 @@ const std::vector<PaperTable2Row>& paper_table2() {
   return rows;
 }
 
+const PaperTable2Row& paper_table2_row(const std::string& key) {
+  for (const PaperTable2Row& r : paper_table2())
+    if (key == r.key) return r;
+  throw std::logic_error("no Table 2 row " + key);
+}
+
 }  // namespace saarcor::units

@@ -188,6 +188,8 @@ struct PaperTable2Row {
   double memory_kb;
 };
 const std::vector<PaperTable2Row>& paper_table2();
+// The row with `key` (a UnitCost::key or "total"); throws std::logic_error for another key.
+const PaperTable2Row& paper_table2_row(const std::string& key);
 inline constexpr double kPaperFlops = 4e9;  // section 4.3: "a total of 4 billion FLOPs"
 
 }  // namespace saarcor::units
