@@ -10,7 +10,9 @@
 //   Step (one cycle, at issue): the entry goes through the level's mailbox; if a ray still needs
 //   it, it goes to the transformation unit (kind 0, path d) with those rays, and a top-level
 //   entry (an object the thread enters) clears the triangle mailbox; otherwise the list goes on
-//   through the unit's own loop (kind 1) or, at its end, the traversal unit pops (kind 2).
+//   through the unit's own loop (kind 1) or, at its end, the traversal unit pops (kind 2). A
+//   thread back from an object (op 0 on path c) whose top-level list is done fetches nothing and
+//   passes on to the pop (kind 2, the cursor unchanged).
 //   Side band (path a): a new packet clears the thread's object mailbox (D28).
 // The output leaves DEPTH cycles after the issue (the mailbox compare, lat_cmp).
 module list_unit #(
@@ -87,7 +89,7 @@ module list_unit #(
   ) threads (
       .clk, .rst, .in_valid, .in_thread,
       .acc_valid, .acc_thread,
-      .acc_first(cur_next[acc_thread][level[acc_thread]]), .acc_count(1'b1),
+      .acc_first(cur_next[acc_thread][level[acc_thread]]), .acc_count(acc_fetch),
       .req_valid, .req_item, .req_thread, .req_ready, .resp_valid, .resp_thread,
       .iss_valid, .iss_thread, .iss_steps(1'b1), .iss_chain(1'b0), .iss_payload,
       .out_valid, .out_thread, .out_payload, .out_ready(1'b1));
@@ -95,6 +97,13 @@ module list_unit #(
   logic unused_acc;
   assign unused_acc = acc_valid;
   /* verilator lint_on UNUSEDSIGNAL */
+  // A thread back from an object whose top-level list is done reads nothing (list_step.h).
+  logic acc_fetch;
+  always_comb begin
+    logic la;
+    la = level[acc_thread];
+    acc_fetch = cur_next[acc_thread][la] < cur_end[acc_thread][la] && cur_mask[acc_thread][la] != '0;
+  end
   assign {out_kind, out_level, out_next, out_entry, out_mask} = out_payload;
 
   // ---- the list step of the issuing thread -----------------------------------------------------
@@ -124,12 +133,15 @@ module list_unit #(
       .slot_mask(tr_slot_mask), .next_head(tr_next_head), .next_size(tr_next_size),
       .write(tr_write));
 
+  // over: the list was done at accept (nothing read): the thread passes on to the pop.
   logic [P-1:0] todo;
   logic [31:0] nx1;
   logic [1:0] kind;
-  assign todo = lv ? tr_todo : ob_todo;
-  assign nx1 = nx + 32'd1;
-  assign kind = todo != '0 ? 2'd0 : (nx1 < en && m != '0) ? 2'd1 : 2'd2;
+  logic over;
+  assign over = !(nx < en && m != '0);
+  assign todo = over ? '0 : (lv ? tr_todo : ob_todo);
+  assign nx1 = over ? nx : nx + 32'd1;
+  assign kind = todo != '0 ? 2'd0 : (!over && nx1 < en && m != '0) ? 2'd1 : 2'd2;
   assign iss_payload = {kind, lv, nx1, kind == 2'd0 ? entry : 32'd0, kind == 2'd0 ? todo : m};
 
   always_ff @(posedge clk) begin
@@ -145,13 +157,13 @@ module list_unit #(
       if (resp_valid) word[resp_thread] <= resp_word;
       if (iss_valid) begin
         cur_next[iss_thread][lv] <= nx1;
-        if (!lv && ob_write) begin
+        if (!over && !lv && ob_write) begin
           ob_id[iss_thread][ob_slot] <= entry;
           ob_mask[iss_thread][ob_slot] <= ob_slot_mask;
           ob_head[iss_thread] <= ob_next_head;
           ob_size[iss_thread] <= ob_next_size;
         end
-        if (lv && tr_write) begin
+        if (!over && lv && tr_write) begin
           tr_id[iss_thread][tr_slot] <= entry;
           tr_mask[iss_thread][tr_slot] <= tr_slot_mask;
           tr_head[iss_thread] <= tr_next_head;
