@@ -11,12 +11,13 @@ namespace {
 
 void expect_agreement(const std::string& scene, int w, int h) {
   LockstepOptions o;
+  o.units = {"list"};
   o.scene = scene;
   o.width = w;
   o.height = h;
   const LockstepResult r = run_lockstep(o);
   EXPECT_FALSE(r.diverged) << r.screen;
-  EXPECT_GT(r.events[static_cast<std::size_t>(units::BoundaryPort::kOutput)], 0u);
+  EXPECT_GT(r.unit("list").event(units::BoundaryPort::kOutput), 0u);
 }
 
 TEST(ListLockstepDeep, Room512x384) {

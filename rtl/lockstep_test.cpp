@@ -1,6 +1,6 @@
-// The list unit's RTL (rtl/list_unit.sv) in lockstep with the cycle model (rtl/lockstep.h): 0
-// divergences on the CI scenes and configurations, the injected fault caught at its first wrong
-// event, bad input refused.
+// The RTL units (rtl/traversal_threads.sv, rtl/list_unit.sv) in lockstep with the cycle model
+// (rtl/lockstep.h): 0 divergences on the CI scenes and configurations, the injected faults caught
+// at their first wrong event, bad input refused.
 #include "rtl/lockstep.h"
 
 #include <gtest/gtest.h>
@@ -9,12 +9,16 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "rtl/list_rtl.h"
+#include "rtl/traversal_rtl.h"
 #include "units/boundary_list.h"
+#include "units/cycle_params.h"
 
 namespace saarcor::rtl {
 namespace {
@@ -30,6 +34,7 @@ std::string shared(const std::string& rel) {
 LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, int w = 24,
                    int h = 18, bool shadows = false, int depth = 0) {
   LockstepOptions o;
+  o.units = {"list"};
   o.scene = scene;
   o.set = std::move(set);
   o.width = w;
@@ -41,11 +46,12 @@ LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, 
 
 void expect_agreement(const LockstepResult& r) {
   EXPECT_FALSE(r.diverged) << r.screen;
-  const auto ev = [&](BoundaryPort p) { return r.events[static_cast<std::size_t>(p)]; };
+  const LockstepUnit& list = r.unit("list");
+  const auto ev = [&](BoundaryPort p) { return list.event(p); };
   EXPECT_GT(ev(BoundaryPort::kCacheRequest), 0u);
   EXPECT_EQ(ev(BoundaryPort::kCacheRequest), ev(BoundaryPort::kCacheResponse));
   EXPECT_EQ(ev(BoundaryPort::kCacheRequest), ev(BoundaryPort::kOutput));
-  std::printf("  %s: %llu cycles, %llu requests, %llu outputs compared\n", r.build.c_str(),
+  std::printf("  %s: %llu cycles, %llu requests, %llu outputs compared\n", list.build.c_str(),
               static_cast<unsigned long long>(r.cycles),
               static_cast<unsigned long long>(ev(BoundaryPort::kCacheRequest)),
               static_cast<unsigned long long>(ev(BoundaryPort::kOutput)));
@@ -85,6 +91,7 @@ TEST(ListLockstep, TwoCylinderEngineGltfP16) {
 // reduced (a skip, or an entry for fewer rays than the list holds).
 TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
   LockstepOptions o;
+  o.units = {"list"};
   o.scene = "builtin:room";
   o.width = 24;
   o.height = 18;
@@ -121,6 +128,7 @@ TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
 // the model's cache request for the loop's thread, the RTL's for the other (class order).
 TEST(ListLockstep, SwappedPrioritiesAreCaughtAtTheirFirstWrongEvent) {
   LockstepOptions o;
+  o.units = {"list"};
   o.scene = "builtin:dynamic";
   o.width = 24;
   o.height = 18;
@@ -220,6 +228,7 @@ TEST(ListLockstep, DivergencesAreClassified) {
   for (const auto& [fault, kind] : cases) {
     SCOPED_TRACE(kind);
     LockstepOptions o;
+    o.units = {"list"};
     o.scene = "builtin:room";
     o.width = 16;
     o.height = 12;
@@ -239,23 +248,155 @@ TEST(ListLockstep, DivergencesAreClassified) {
   }
 }
 
-TEST(ListLockstep, BadInputIsRefusedWithOneLine) {
+TEST(Lockstep, BadInputIsRefusedWithOneLine) {
   LockstepOptions o;
   o.scene = "builtin:room";
+  const auto error = [&]() -> std::string {
+    try {
+      run_lockstep(o);
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+      return e.what();
+    }
+    ADD_FAILURE() << "accepted";
+    return "";
+  };
   o.units = {"shading"};
-  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  EXPECT_NE(error().find("unknown unit 'shading'"), std::string::npos);
+  o.units = {"list", "list"};
+  EXPECT_NE(error().find("given twice"), std::string::npos);
   o.units = {"list"};
   o.set = {"threads=7"};
-  try {
-    run_lockstep(o);
-    ADD_FAILURE() << "threads=7 has no Verilated build";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("no Verilated list unit"), std::string::npos);
-    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
-  }
+  EXPECT_NE(error().find("no Verilated list unit"), std::string::npos);
+  o.units = {"traversal", "list"};
+  EXPECT_NE(error().find("no Verilated traversal unit"), std::string::npos);
+  o.set = {"stack=32"};
+  EXPECT_NE(error().find("stack=32"), std::string::npos);
   o.set = {};
   o.fault = "stack-off-by-one";
-  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  EXPECT_NE(error().find("no unit of the run has the fault"), std::string::npos);
+  o.units = {"list"};
+  o.fault = "pop-off";  // the traversal unit's
+  EXPECT_NE(error().find("no unit of the run has the fault"), std::string::npos);
+}
+
+// The first build of each unit is the prototype's (units/cycle_params.cpp defaults).
+TEST(Lockstep, PrototypeBuildsAreTheModelsDefaults) {
+  const units::CycleParams p = units::prototype_params();
+  const TraversalBuild& t = traversal_builds().front();
+  EXPECT_EQ(t.name, "proto");
+  EXPECT_EQ(t.threads, p.threads);
+  EXPECT_EQ(t.packet, p.packet);
+  EXPECT_EQ(t.stack, p.stack);
+  EXPECT_EQ(t.lat_add, p.lat_add);
+  EXPECT_EQ(t.lat_div, p.lat_div);
+  EXPECT_EQ(t.lat_cmp, p.lat_cmp);
+  EXPECT_EQ(t.fault, 0);
+  // Every traversal parameter set without a fault has the list unit's build beside it.
+  for (const TraversalBuild& b : traversal_builds()) {
+    if (b.fault != 0) continue;
+    bool list = false;
+    for (const ListBuild& l : list_builds())
+      list = list || (l.fault == 0 && l.threads == b.threads && l.packet == b.packet);
+    EXPECT_TRUE(list) << b.name;
+  }
+}
+
+// ---- the traversal unit ------------------------------------------------------------------------
+// Wraps the Verilated traversal unit and finds the first cycle in which a thread's stack shrank
+// from two or more entries: the first pop (or drop) that reads an entry with another below it,
+// where a pop one entry off first reads the wrong entry (the model's events do not show the
+// stack, the healthy RTL's dbg port does: it agrees with the model up to there, the lockstep
+// says so). `popped`: the thread left in that cycle (the entry decided: it was popped).
+class DeepPopProbe final : public UnitRtl {
+ public:
+  DeepPopProbe(std::unique_ptr<UnitRtl> rtl, int threads, std::uint64_t& cycle, bool& popped)
+      : cycle_(cycle),
+        popped_(popped),
+        rtl_(std::move(rtl)),
+        probe_(dynamic_cast<TraversalStackProbe*>(rtl_.get())),
+        size_(static_cast<std::size_t>(threads), 0) {}
+  units::UnitId unit() const override { return rtl_->unit(); }
+  void reset() override { rtl_->reset(); }
+  void start_trace(const std::string& p) override { rtl_->start_trace(p); }
+  void stop_trace() override { rtl_->stop_trace(); }
+  void cycle(std::uint64_t c, const std::vector<BoundaryEvent>& in,
+             std::vector<BoundaryEvent>& out) override {
+    rtl_->cycle(c, in, out);
+    if (cycle_ != 0 || probe_ == nullptr) return;
+    for (std::uint32_t t = 0; t < size_.size(); ++t) {
+      const int s = probe_->stack_size(t);
+      if (s < size_[t] && size_[t] >= 2 && cycle_ == 0) {
+        cycle_ = c;
+        for (const BoundaryEvent& e : out)
+          popped_ = popped_ || (e.port == BoundaryPort::kOutput && e.thread == t);
+      }
+      size_[t] = s;
+    }
+  }
+
+ private:
+  std::uint64_t& cycle_;
+  bool& popped_;
+  std::unique_ptr<UnitRtl> rtl_;
+  TraversalStackProbe* probe_;
+  std::vector<int> size_;
+};
+
+// The stack pop one entry off (traversal_ctrl.sv FAULT_POP_OFF: the entry below the top) is
+// caught at the first pop from a stack of two or more entries, which the healthy run names. The
+// room's first such pop decides (it pops, no drop): the faulty unit lets the thread go in the
+// same cycle with the entry below, whose node is another: class payload.
+TEST(TraversalLockstep, StackPopOneEntryOffIsCaughtAtTheFirstDeepPop) {
+  LockstepOptions o;
+  o.units = {"traversal"};
+  o.scene = "builtin:room";
+  o.width = 24;
+  o.height = 18;
+  std::uint64_t deep = 0;
+  bool popped = false;
+  o.wrap_rtl = [&](std::unique_ptr<UnitRtl> rtl) {
+    return std::unique_ptr<UnitRtl>(std::make_unique<DeepPopProbe>(
+        std::move(rtl), units::prototype_params().threads, deep, popped));
+  };
+  const LockstepResult healthy = run_lockstep(o);
+  ASSERT_FALSE(healthy.diverged) << healthy.screen;
+  ASSERT_NE(deep, 0u) << "no pop from a stack of two entries";
+  ASSERT_TRUE(popped) << "the room's first deep pop drops its entry";
+
+  o.wrap_rtl = nullptr;
+  o.fault = "pop-off";
+  const LockstepResult r = run_lockstep(o);
+  ASSERT_TRUE(r.diverged);
+  EXPECT_EQ(r.divergence.cycle, deep) << r.screen;
+  EXPECT_EQ(r.divergence.unit, "traversal");
+  EXPECT_EQ(r.divergence.port, "output");
+  EXPECT_EQ(r.divergence.kind, "payload") << r.screen;
+}
+
+// The traversal pipeline one cycle short (FAULT_SHORT: the lanes' compare stage a wire) is
+// caught at the unit's first output, the first clip chain's end: the RTL has it one cycle before
+// the model (class timing, the model's cycle beside it).
+TEST(TraversalLockstep, PipelineOneCycleShortIsCaughtAtTheFirstOutput) {
+  LockstepOptions o;
+  o.units = {"traversal"};
+  o.scene = "builtin:room";
+  o.width = 24;
+  o.height = 18;
+  o.fault = "short-pipeline";
+  std::uint64_t first = 0;
+  o.model_events = [&](const BoundaryEvent& e) {
+    if (first == 0 && e.unit == units::UnitId::kTraversal && e.port == BoundaryPort::kOutput)
+      first = e.cycle;
+  };
+  const LockstepResult r = run_lockstep(o);
+  ASSERT_TRUE(r.diverged);
+  ASSERT_NE(first, 0u);
+  EXPECT_EQ(r.divergence.cycle, first - 1) << r.screen;
+  EXPECT_EQ(r.divergence.other_cycle, first) << r.screen;
+  EXPECT_EQ(r.divergence.unit, "traversal");
+  EXPECT_EQ(r.divergence.port, "output");
+  EXPECT_EQ(r.divergence.kind, "timing");
 }
 
 }  // namespace
