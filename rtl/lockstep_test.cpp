@@ -303,6 +303,35 @@ TEST(Lockstep, PrototypeBuildsAreTheModelsDefaults) {
 }
 
 // ---- the traversal unit ------------------------------------------------------------------------
+// Both units on the room: the traversal unit agrees with the model on every port event at least
+// up to the first thread that comes back from a list to pop (the first input on f or
+// list -> traversal). Where the model still pops inside the list and intersection units
+// (docs/hw-interface.md "Where the model cannot be built as written"), that is where the two part;
+// where it pops in the traversal unit, the run agrees to the end.
+TEST(TraversalLockstep, RoomAgreesAtLeastUpToTheFirstPop) {
+  LockstepOptions o;
+  o.scene = "builtin:room";
+  o.width = 24;
+  o.height = 18;
+  std::uint64_t first_pop = 0;
+  o.model_events = [&](const BoundaryEvent& e) {
+    if (first_pop == 0 && e.unit == units::UnitId::kTraversal && e.port == BoundaryPort::kInput &&
+        e.field[0] == 1)
+      first_pop = e.cycle;
+  };
+  const LockstepResult r = run_lockstep(o);
+  ASSERT_NE(first_pop, 0u);
+  EXPECT_TRUE(!r.diverged || r.divergence.cycle > first_pop) << r.screen;
+  const LockstepUnit& t = r.unit("traversal");
+  EXPECT_GT(t.event(BoundaryPort::kOutput), 100u);
+  EXPECT_GT(t.event(BoundaryPort::kCacheRequest), 100u);
+  std::printf(
+      "  first pop at cycle %llu; %s\n", static_cast<unsigned long long>(first_pop),
+      r.diverged ? ("then " + r.divergence.kind + " at cycle " + std::to_string(r.divergence.cycle))
+                       .c_str()
+                 : "no divergence");
+}
+
 // Wraps the Verilated traversal unit and finds the first cycle in which a thread's stack shrank
 // from two or more entries: the first pop (or drop) that reads an entry with another below it,
 // where a pop one entry off first reads the wrong entry (the model's events do not show the
@@ -360,8 +389,8 @@ TEST(TraversalLockstep, StackPopOneEntryOffIsCaughtAtTheFirstDeepPop) {
         std::move(rtl), units::prototype_params().threads, deep, popped));
   };
   const LockstepResult healthy = run_lockstep(o);
-  ASSERT_FALSE(healthy.diverged) << healthy.screen;
   ASSERT_NE(deep, 0u) << "no pop from a stack of two entries";
+  ASSERT_TRUE(!healthy.diverged || healthy.divergence.cycle > deep) << healthy.screen;
   ASSERT_TRUE(popped) << "the room's first deep pop drops its entry";
 
   o.wrap_rtl = nullptr;
