@@ -6,13 +6,13 @@
 //   (MB entries, top-level lists) and the triangle mailbox (TMB entries, bottom-level lists).
 //   Arrival (units/boundary_list.h): a leaf's list starts (op 1: next, end, mask), or the level's
 //   list resumes with the rays still in it (op 0: the intersection unit's any-hit terminations
-//   removed some). The entry at `next` is fetched through the list cache at accept.
+//   removed some). The entry at `next` is fetched through the list cache at accept; a resume
+//   whose list is done (an object's bottom level ended after the top-level list's last entry)
+//   fetches nothing and leaves with kind 2 (D49).
 //   Step (one cycle, at issue): the entry goes through the level's mailbox; if a ray still needs
 //   it, it goes to the transformation unit (kind 0, path d) with those rays, and a top-level
 //   entry (an object the thread enters) clears the triangle mailbox; otherwise the list goes on
-//   through the unit's own loop (kind 1) or, at its end, the traversal unit pops (kind 2). A
-//   thread back from an object (op 0 on path c) whose top-level list is done fetches nothing and
-//   passes on to the pop (kind 2, the cursor unchanged).
+//   through the unit's own loop (kind 1) or, at its end, the traversal unit pops (kind 2).
 //   Side band (path a): a new packet clears the thread's object mailbox (D28).
 // The output leaves DEPTH cycles after the issue (the mailbox compare, lat_cmp).
 module list_unit #(
@@ -83,13 +83,20 @@ module list_unit #(
   logic acc_valid, iss_valid;
   logic [TW-1:0] acc_thread, iss_thread;
   logic [PW-1:0] iss_payload, out_payload;
+  // A thread back from an object whose top-level list is done (or whose rays are) reads nothing:
+  // it passes through the issue slot on to the traversal unit's pop (D49).
+  logic acc_done;
+  logic acc_lv;
+  assign acc_lv = level[acc_thread];
+  assign acc_done = cur_next[acc_thread][acc_lv] >= cur_end[acc_thread][acc_lv] ||
+                    cur_mask[acc_thread][acc_lv] == '0;
   unit_threads #(
       .THREADS(THREADS), .INPUTS(3), .DEPTH(DEPTH), .PW(PW), .IW(32), .CW(1), .SW(1),
       .FAULT_PRIORITY_SWAP(FAULT_PRIORITY_SWAP)
   ) threads (
       .clk, .rst, .in_valid, .in_thread,
       .acc_valid, .acc_thread,
-      .acc_first(cur_next[acc_thread][level[acc_thread]]), .acc_count(acc_fetch),
+      .acc_first(cur_next[acc_thread][level[acc_thread]]), .acc_count(~acc_done),
       .req_valid, .req_item, .req_thread, .req_ready, .resp_valid, .resp_thread,
       .iss_valid, .iss_thread, .iss_steps(1'b1), .iss_chain(1'b0), .iss_payload,
       .out_valid, .out_thread, .out_payload, .out_ready(1'b1));
@@ -97,13 +104,6 @@ module list_unit #(
   logic unused_acc;
   assign unused_acc = acc_valid;
   /* verilator lint_on UNUSEDSIGNAL */
-  // A thread back from an object whose top-level list is done reads nothing (list_step.h).
-  logic acc_fetch;
-  always_comb begin
-    logic la;
-    la = level[acc_thread];
-    acc_fetch = cur_next[acc_thread][la] < cur_end[acc_thread][la] && cur_mask[acc_thread][la] != '0;
-  end
   assign {out_kind, out_level, out_next, out_entry, out_mask} = out_payload;
 
   // ---- the list step of the issuing thread -----------------------------------------------------
@@ -133,16 +133,16 @@ module list_unit #(
       .slot_mask(tr_slot_mask), .next_head(tr_next_head), .next_size(tr_next_size),
       .write(tr_write));
 
-  // over: the list was done at accept (nothing read): the thread passes on to the pop.
   logic [P-1:0] todo;
   logic [31:0] nx1;
   logic [1:0] kind;
-  logic over;
-  assign over = !(nx < en && m != '0);
-  assign todo = over ? '0 : (lv ? tr_todo : ob_todo);
-  assign nx1 = over ? nx : nx + 32'd1;
-  assign kind = todo != '0 ? 2'd0 : (!over && nx1 < en && m != '0) ? 2'd1 : 2'd2;
-  assign iss_payload = {kind, lv, nx1, kind == 2'd0 ? entry : 32'd0, kind == 2'd0 ? todo : m};
+  assign todo = lv ? tr_todo : ob_todo;
+  assign nx1 = nx + 32'd1;
+  logic fin;  // the list was done on arrival: no entry was read (D49)
+  assign fin = nx >= en || m == '0;
+  assign kind = fin ? 2'd2 : todo != '0 ? 2'd0 : (nx1 < en && m != '0) ? 2'd1 : 2'd2;
+  assign iss_payload = {kind, lv, fin ? nx : nx1, kind == 2'd0 ? entry : 32'd0,
+                        kind == 2'd0 ? todo : m};
 
   always_ff @(posedge clk) begin
     if (rst) begin
@@ -155,15 +155,15 @@ module list_unit #(
       end
     end else begin
       if (resp_valid) word[resp_thread] <= resp_word;
-      if (iss_valid) begin
+      if (iss_valid && !fin) begin
         cur_next[iss_thread][lv] <= nx1;
-        if (!over && !lv && ob_write) begin
+        if (!lv && ob_write) begin
           ob_id[iss_thread][ob_slot] <= entry;
           ob_mask[iss_thread][ob_slot] <= ob_slot_mask;
           ob_head[iss_thread] <= ob_next_head;
           ob_size[iss_thread] <= ob_next_size;
         end
-        if (!over && lv && tr_write) begin
+        if (lv && tr_write) begin
           tr_id[iss_thread][tr_slot] <= entry;
           tr_mask[iss_thread][tr_slot] <= tr_slot_mask;
           tr_head[iss_thread] <= tr_next_head;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <string>
 
 #include "hw/cycle_marks.h"
@@ -22,6 +23,19 @@ class TraversalUnit : public CycleUnit {
  protected:
   Fetch fetch(const Request& r) const override;
   bool chains(const Request& done, const Request& next) const override;
+  // A request that ends in a pop leaves through the pop engine (units/traversal.cpp).
+  bool hold(ThreadToken t) override;
+  int extra() override;
+  std::uint64_t extra_wakeup(std::uint64_t now) const override;
+
+ private:
+  struct Popping {
+    std::uint64_t at;  // the cycle its request reaches the pipeline's last stage
+    ThreadToken thread;
+    int entries;  // stack entries still to read (the pop engine reads one per cycle)
+  };
+  std::deque<Popping> stage_;  // pops in the pipeline, in issue order
+  std::deque<Popping> queue_;  // the pop engine's queue
 };
 
 // Mailboxed list unit (path c in, d out): one list entry per cycle through the list cache; the

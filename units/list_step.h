@@ -34,6 +34,11 @@ class ListStep {
   std::uint64_t mask(Level level) const { return cursor(level).mask; }
   // The end of the level's list (the boundary record's payload on path c, units/boundary_list.h).
   std::uint32_t end(Level level) const { return cursor(level).end; }
+  // The level's list has no entry left for its rays.
+  bool done(Level level) const {
+    const Cursor& c = cursor(level);
+    return c.next >= c.end || c.mask == 0;
+  }
 
   // A packet leaves its mailbox behind (D28: a mailbox belongs to one packet's rays).
   void clear() { mailbox_.clear(); }
@@ -54,9 +59,17 @@ class ListStep {
 
   // One list entry (a request): mailboxed, then to the transformation unit or on to the next.
   void step(State& t) {
-    ++t.u.list_steps;
     const Level level = t.traversal.level();
     Cursor& c = cursor(level);
+    // Back from an object whose top-level list is done: the thread passes on to the traversal
+    // unit's pop without reading an entry (the unit holds the cursor; the traversal unit cannot
+    // know the list is done).
+    if (c.next >= c.end || c.mask == 0) {
+      ++t.u.list_returns;
+      t.phase = Phase::kPop;
+      return;
+    }
+    ++t.u.list_steps;
     const std::uint32_t entry = t.scene.list_entry(c.next++);
     // The matrix rows of this entry and of the next (its list entry was prefetched at the leaf).
     prefetch_entry_rows(t, entry);
@@ -79,20 +92,29 @@ class ListStep {
     }
   }
 
-  // Back at the current level's list (path f): its next entry, or the traversal unit's pop once
-  // the list is done or (any-hit) its rays are.
+  // Back at the current level's list (from the intersection unit, or the list unit's own skip):
+  // its next entry, or the traversal unit's pop once the list is done or (any-hit) its rays are.
+  // The stack is the traversal unit's: the thread goes there to pop (path f, list -> traversal).
   void resume(State& t) {
-    Cursor& c = cursor(t.traversal.level());
-    const std::uint64_t live = t.kind == RayKind::kShadow ? c.mask & ~t.done_mask() : c.mask;
-    c.mask = live;
-    if (c.next < c.end && live != 0) {
-      t.phase = Phase::kList;
-      return;
-    }
-    t.traversal.pop(t);
+    drop_done(t);
+    t.phase = done(t.traversal.level()) ? Phase::kPop : Phase::kList;
+  }
+
+  // An object's bottom level ended: the thread goes back to the list unit (path c), which reads
+  // the top-level list's next entry or, when it is done, sends the thread on to the pop.
+  void return_to_list(State& t) {
+    drop_done(t);
+    t.phase = Phase::kList;
   }
 
  private:
+  // Any-hit rays that are done leave the level's list (the mask travels with the thread).
+  void drop_done(State& t) {
+    if (t.kind != RayKind::kShadow) return;
+    Cursor& c = cursor(t.traversal.level());
+    c.mask &= ~t.done_mask();
+  }
+
   struct Cursor {
     std::uint32_t next = 0, end = 0;
     std::uint64_t mask = 0;

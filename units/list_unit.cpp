@@ -8,8 +8,10 @@ ListUnit::ListUnit(hw::Kernel& k, std::string name, ThreadTable& t, int depth, m
     : CycleUnit(k, std::move(name), UnitId::kList, t, depth, &cache) {}
 
 // One list entry per request through the list cache; a skipped (mailboxed) entry still costs its
-// fetch and its cycle.
+// fetch and its cycle. A thread back from an object whose list is done reads nothing: it passes
+// through the issue slot on to the traversal unit's pop.
 CycleUnit::Fetch ListUnit::fetch(const Request& r) const {
+  if (r.item == memif::kNone) return {};
   return {r.item, 1};
 }
 

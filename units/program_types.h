@@ -125,6 +125,7 @@ enum class Phase : std::uint8_t {
   kClipBottom,         // traversal: one face of the object box (6 steps)
   kTransformTriangle,  // transformation (path d): object -> unit-triangle space with T_delta
   kIntersect,          // intersection (path e): the packet's rays one per cycle
+  kPop,                // traversal (f, list -> traversal): the stack's pop after a list ended
   kShadeSurface,       // RGS (path g): the surface hits of a primary/secondary packet
   kShadeLight,         // RGS: cosines of one light from its generated shadow rays
   kShadeShadow,        // RGS: shadow-ray results of one light
@@ -156,9 +157,9 @@ inline const char* unit_name(UnitId u) {
 }
 inline const char* phase_name(Phase p) {
   constexpr const char* kNames[] = {
-      "generate",         "clip_top",    "traverse",           "list",
-      "transform_object", "clip_bottom", "transform_triangle", "intersect",
-      "shade_surface",    "shade_light", "shade_shadow",       "done"};
+      "generate",    "clip_top",           "traverse",  "list", "transform_object",
+      "clip_bottom", "transform_triangle", "intersect", "pop",  "shade_surface",
+      "shade_light", "shade_shadow",       "done"};
   return p <= Phase::kDone ? kNames[static_cast<int>(p)] : added_phase_name(p);
 }
 inline UnitId phase_unit(Phase p) {
@@ -170,6 +171,7 @@ inline UnitId phase_unit(Phase p) {
     case Phase::kClipTop:
     case Phase::kTraverse:
     case Phase::kClipBottom:
+    case Phase::kPop:
       return UnitId::kTraversal;
     case Phase::kList:
       return UnitId::kList;
@@ -190,10 +192,14 @@ inline UnitId phase_unit(Phase p) {
 struct Request {
   UnitId unit = UnitId::kNone;
   Phase phase = Phase::kDone;
-  std::uint32_t item = memif::kNone;  // kTraverse: node; kList: list entry; kTransform*: first
-                                      // matrix row; kClip*: face 0..5; otherwise kNone
+  std::uint32_t item = memif::kNone;  // kTraverse: node; kList: list entry (kNone: the list is
+                                      // done, nothing to read); kTransform*: first matrix row;
+                                      // kClip*: face 0..5; otherwise kNone
   int steps = 0;           // transformation steps (n+1 or 2n), intersection cycles (P), else 1
   std::uint64_t mask = 0;  // the rays concerned
+  // The pop engine's cycles of the request executed last (the traversal unit's stack, read one
+  // entry per cycle): 1 + the entries it dropped when that request ended in a pop, else 0.
+  std::uint16_t pop_cycles = 0;
 };
 
 // One memory access of the RGS (docs/memory-image.md, docs/memif.md and docs/shading.md;
@@ -260,6 +266,8 @@ struct UnitCounts {
   std::uint64_t sub_packets = 0;       // masked sub-packets from mixed direction signs (D27)
   std::uint64_t stack_drops = 0;       // stack entries dropped at the pop: every ray terminated
   std::uint64_t empty_leaf_steps = 0;  // of traversal_steps, on leaves without items
+  std::uint64_t pop_steps = 0;         // pop requests of the traversal unit after a list (D49)
+  std::uint64_t list_returns = 0;      // list unit steps without an entry: the list was done (D49)
 };
 
 inline constexpr CounterDecl<UnitCounts> kUnitCounterDecls[] = {
@@ -279,6 +287,10 @@ inline constexpr CounterDecl<UnitCounts> kUnitCounterDecls[] = {
     {"sub_packets", "packets", "packets split by the traversal", &UnitCounts::sub_packets},
     {"stack_drops", "entries", "traversal stack entries dropped", &UnitCounts::stack_drops},
     {"empty_leaf_steps", "steps", "steps into empty leaves", &UnitCounts::empty_leaf_steps},
+    {"pop_steps", "steps", "pop requests of the traversal unit after a list ended",
+     &UnitCounts::pop_steps},
+    {"list_returns", "steps", "list unit steps that found the list done (no entry read)",
+     &UnitCounts::list_returns},
 };
 
 // The float units of one DynRTP, each with its own counters (paper Table 2). The RGS FP helper is

@@ -97,7 +97,10 @@ class RecordedThreads final : public ThreadTable {
         rgs_mem_[t].assign(s.mem.begin() + begin, s.mem.begin() + s.mem_end[c.rgs]);
         ++c.rgs;
       }
+      // The pop engine's cycles, read before the replay of a final step releases the slot.
+      const std::uint16_t pops = s.pops[c.next + 1];
       replay(t, s.trace[++c.next]);
+      requests_[t].pop_cycles = pops;
       return;
     }
     if (tracing_) [[unlikely]]
@@ -175,6 +178,8 @@ class RecordedThreads final : public ThreadTable {
   struct Slot {
     std::vector<Step> trace;
     std::vector<std::uint64_t> masks;
+    // Beside each request: the pop engine's cycles of the request before it (Request::pop_cycles).
+    std::vector<std::uint16_t> pops;
     int packet = -1;
     // A traced run: per executed request, the packet's kind and (with the request trace) the
     // transactions.
@@ -197,6 +202,7 @@ class RecordedThreads final : public ThreadTable {
     s.packet = packet;
     s.trace.clear();
     s.masks.clear();
+    s.pops.clear();
     s.mem.clear();
     s.mem_end.clear();
     p.start_primary(packet_pixels(tiling_, w_, h_, packet));
@@ -206,6 +212,7 @@ class RecordedThreads final : public ThreadTable {
       const Request& r = p.request();
       s.trace.push_back(step_of(r));
       s.masks.push_back(r.mask);
+      s.pops.push_back(r.pop_cycles);
       if (p.done()) break;
       p.execute();
       if (r.unit == UnitId::kRgs) [[unlikely]]
@@ -231,6 +238,7 @@ class RecordedThreads final : public ThreadTable {
       const Request& r = p.request();
       s.trace.push_back(step_of(r));
       s.masks.push_back(r.mask);
+      s.pops.push_back(r.pop_cycles);
       if (p.done()) break;
       s.kinds.push_back(p.kind());
       tap_.begin();
@@ -275,6 +283,7 @@ class RecordedThreads final : public ThreadTable {
     r.phase = s.phase;
     r.item = s.item;
     r.steps = s.steps;
+    r.pop_cycles = 0;
     if (s.unit == UnitId::kNone) release(cursor_[t].slot);
   }
   struct Cursor {

@@ -15,6 +15,7 @@
 //   transform_object     transformation  TransformationStep::object    d
 //   transform_triangle   transformation  TransformationStep::triangle  d
 //   intersect            intersection    IntersectionStep::step        e
+//   pop                  traversal       TraversalStep::pop            f, list -> traversal
 //   shade_*              RGS             RgsStep::shade_*              g
 #pragma once
 
@@ -58,6 +59,7 @@ class ThreadProgram {
     r.phase = s_.phase;
     r.unit = phase_unit(s_.phase);
     r.steps = 1;
+    r.pop_cycles = s_.traversal.pop_cycles();
     switch (s_.phase) {
       case Phase::kGenerate:
         r.mask = s_.valid_mask();
@@ -73,8 +75,13 @@ class ThreadProgram {
         r.mask = s_.traversal.mask();
         break;
       case Phase::kList:
-        r.item = s_.list.next(s_.traversal.level());
+        // A list the thread comes back to after an object may be done: nothing to read.
+        r.item =
+            s_.list.done(s_.traversal.level()) ? memif::kNone : s_.list.next(s_.traversal.level());
         r.mask = s_.list.mask(s_.traversal.level());
+        break;
+      case Phase::kPop:
+        r.mask = s_.traversal.mask();
         break;
       case Phase::kTransformObject:
         r.item = s_.list.instance_row();
@@ -104,6 +111,7 @@ class ThreadProgram {
 
   // Performs the requested unit's work and advances the program.
   void execute() {
+    s_.traversal.clear_pop_cycles();
     switch (s_.phase) {
       case Phase::kGenerate:
         return s_.transformation.generate(s_);
@@ -120,6 +128,9 @@ class ThreadProgram {
         return s_.transformation.triangle(s_);
       case Phase::kIntersect:
         return s_.intersection.step(s_);
+      case Phase::kPop:
+        ++s_.u.pop_steps;
+        return s_.traversal.pop(s_);
       case Phase::kShadeSurface:
         s_.rgs.begin_request();
         return s_.rgs.shade_surface(s_);

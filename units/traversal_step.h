@@ -106,13 +106,23 @@ class TraversalStep {
     inner(t, node, active);
   }
 
-  // Pops the next node of the current group, or ends the group.
+  // The pop engine's cycles of the request executed last (0: it did not end in a pop).
+  std::uint16_t pop_cycles() const { return pop_cycles_; }
+  void clear_pop_cycles() { pop_cycles_ = 0; }
+
+  // Pops the next node of the current group, or ends the group: a request of its own after a
+  // list (Phase::kPop), or the end of a node step that leaves no child. The stack is a memory
+  // read one entry per cycle (the pop engine, units/traversal.cpp): pop_cycles() says how many
+  // entries this pop read, the dropped ones and the one that decided.
   void pop(State& t) {
+    pop_cycles_ = 1;
     // Entries whose rays have all finished (any-hit) are dropped without a node fetch.
     if (t.kind == RayKind::kShadow) {
       const std::uint64_t done = t.done_mask();
-      while (stack_size_ > stack_base_ && (stack_mask_[stack_size_ - 1] & ~done) == 0)
+      while (stack_size_ > stack_base_ && (stack_mask_[stack_size_ - 1] & ~done) == 0) {
         --stack_size_;
+        ++pop_cycles_;
+      }
     }
     // Early termination at the pop (paper section 3.1): the entry holds each ray's tn, so the
     // node-entry test (t_best < tn) runs on the stack's values before any node fetch, and an
@@ -122,6 +132,7 @@ class TraversalStep {
     while (stack_size_ > stack_base_ && entry_terminated(t, stack_size_ - 1)) {
       --stack_size_;
       ++t.u.stack_drops;
+      ++pop_cycles_;
     }
     // The compare of the entry popped below is its node-entry test, counted with its step.
     if (stack_size_ == stack_base_) return finish_group(t);
@@ -354,7 +365,7 @@ class TraversalStep {
       stack_base_ = top_stack_base_;
       for (int i = 0; i < t.p; ++i)
         t.lane(i).current = t.lane(i).world;
-      return t.list.resume(t);
+      return t.list.return_to_list(t);
     }
     t.phase = t.kind == RayKind::kShadow ? Phase::kShadeShadow : Phase::kShadeSurface;
     for (int i = 0; i < t.p; ++i)
@@ -376,6 +387,7 @@ class TraversalStep {
   std::vector<std::uint64_t> stack_mask_;
   std::vector<double> stack_t_;  // per entry: far tn per slot, then tf per slot (values)
   std::size_t stack_size_ = 0;   // entries in use (the vectors are allocated once)
+  std::uint16_t pop_cycles_ = 0;
 };
 
 }  // namespace saarcor::units

@@ -218,6 +218,75 @@ TEST(UnitTimingList, EntryHitLeavesAfterHitReadyIssueAndDepth) {
   EXPECT_EQ(cache.misses(), 1u);
 }
 
+// A thread back from an object whose top-level list is done (D49: the request names no entry,
+// memif::kNone) fetches nothing: it issues one cycle after its accept and leaves for the traversal
+// unit's pop after the mailbox compare's depth. Were it fetched, it would wait for a miss.
+TEST(UnitTimingList, DoneListFetchesNothingAndPassesOnToThePop) {
+  memif::MemoryImage img = memif::testing::random_scene_image(ff::kFp24, 2);
+  hw::Kernel k;
+  memif::MemorySystem mi(k, img);
+  memif::Cache& cache = mi.cache(0, ItemType::kList);
+  const Request done_list{UnitId::kList, Phase::kList, memif::kNone, 1, kMask};
+  const Request pop{UnitId::kTraversal, Phase::kPop, memif::kNone, 1, kMask};
+  ScriptedThreads threads(k, {{done_list, pop}});
+  const int depth = params().lat_cmp;
+  auto& lu = k.make<ListUnit>("t.list", threads, depth, cache);
+  ThreadPath& c = path(k, "t.path_c");
+  ThreadPath& to_traversal = path(k, "t.list_to_traversal");
+  lu.add_input(&c);
+  lu.set_output(UnitId::kTraversal, &to_traversal);
+  Source src(k, "t.source", c, {{0, 0}});
+  Sink sink(k, "t.sink", {&to_traversal});
+  k.run_to_completion([&] { return sink.got.size() == 1; }, 1000);
+
+  const std::uint64_t issue = 0 + kPathLatency + kReadyToIssue;
+  EXPECT_EQ(threads.issued_at(0), issue);
+  EXPECT_EQ(sink.got_at(0), issue + u64(depth + kPathLatency));  // 2 + 1 + 1
+  EXPECT_EQ(cache.requests_count(), 0u);
+}
+
+// The pop engine (D49, TraversalUnit::extra): three threads arrive on path f one cycle apart, each
+// with a pop request (nothing fetched, one issue cycle). The thread program says how many stack
+// entries each pop reads (Request::pop_cycles of the request after it): thread 0 one (the top
+// entry is popped), thread 1 four (three entries dropped, then one popped), thread 2 one. Each
+// reaches the engine at its issue + depth. Thread 0 leaves then; thread 1 reads one entry there
+// and the other three in the next cycles; thread 2 reaches the engine while thread 1 is in its
+// queue, waits, and reads its entry the cycle after thread 1's last. Were drops free (the old
+// rule), all three would leave at issue + depth.
+TEST(UnitTimingTraversal, PopEngineReadsOneStackEntryPerCycleAndQueues) {
+  memif::MemoryImage img = memif::testing::random_scene_image(ff::kFp24, 5);
+  hw::Kernel k;
+  memif::MemorySystem mi(k, img);
+  memif::Cache& cache = mi.cache(0, ItemType::kNode);
+  const Request pop{UnitId::kTraversal, Phase::kPop, memif::kNone, 1, kMask};
+  const auto after = [](int entries) {
+    Request r = shade();  // the next request: the top level ended, or any other unit
+    r.pop_cycles = static_cast<std::uint16_t>(entries);
+    return r;
+  };
+  ScriptedThreads threads(k, {{pop, after(1)}, {pop, after(4)}, {pop, after(1)}});
+  const int depth = params().traversal_depth();
+  auto& tu = k.make<TraversalUnit>("t.traversal", threads, depth, cache);
+  ThreadPath& f = path(k, "t.path_f");
+  ThreadPath& g = path(k, "t.path_g");
+  tu.add_input(&f);
+  tu.set_output(UnitId::kRgs, &g);
+  Source src(k, "t.source", f, {{0, 0}, {1, 1}, {2, 2}});
+  Sink sink(k, "t.sink", {&g});
+  k.run_to_completion([&] { return sink.got.size() == 3; }, 1000);
+
+  const std::uint64_t issue0 = 0 + kPathLatency + kReadyToIssue;  // a pop fetches nothing
+  EXPECT_EQ(threads.issued_at(0), issue0);
+  EXPECT_EQ(threads.issued_at(1), issue0 + 1);
+  EXPECT_EQ(threads.issued_at(2), issue0 + 2);
+  const std::uint64_t stage1 = issue0 + 1 + u64(depth);           // thread 1 reaches the engine
+  EXPECT_EQ(sink.got_at(0), issue0 + u64(depth + kPathLatency));  // 2 + 12 + 1
+  EXPECT_EQ(sink.got_at(1), stage1 + u64(3 + kPathLatency));      // + 3 dropped entries
+  EXPECT_EQ(sink.got_at(2), stage1 + u64(3 + 1 + kPathLatency));  // behind thread 1
+  EXPECT_EQ(tu.issue_cycles(), 3u);
+  EXPECT_EQ(cache.requests_count(), 0u);
+}
+
 // (2) Transformation: a ray-generation request (no fetch: the matrix comes from the RGS) holds the
 // issue slot for its steps, P + 1 with a shared origin and 2P without (D31): two packets arriving
 // back to back issue `steps` cycles apart, and each leaves steps - 1 + depth after its first step.
