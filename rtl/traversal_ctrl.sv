@@ -455,6 +455,16 @@ module traversal_ctrl #(
   assign gr_dest = ngrp != '0 ? DLoop : (level_r[qt] ? DResume : DRgs);
 
   // ---- outputs ------------------------------------------------------------------------------
+  // One thread per cycle on each path to another unit (and on the loop), as the model's paths take
+  // one push per cycle: the queue's head that decides while the last stage lets a thread go to the
+  // same unit waits a cycle and decides again (nothing it read has changed).
+  function automatic logic [1:0] dest_unit(input logic [1:0] d);
+    dest_unit = d == DLoop ? 2'd0 : (d == DRgs ? 2'd2 : 2'd1);  // traversal, list, RGS
+  endfunction
+  logic pe_block, pe_go;
+  assign pe_block = pe_valid && !pe_from_stage && !pe_drop && out_valid &&
+                    dest_unit(out_dest) == dest_unit(pe_dest);
+  assign pe_go = pe_valid && !pe_block;
   always_comb begin
     out_valid = 1'b0;
     out_thread = qt;
@@ -497,7 +507,7 @@ module traversal_ctrl #(
       end
       default: ;
     endcase
-    out2_valid = pe_valid && !pe_from_stage && !pe_drop;
+    out2_valid = pe_go && !pe_from_stage && !pe_drop;
     out2_thread = pe_t;
     out2_dest = pe_dest;
     out2_node = pe_node;
@@ -650,7 +660,7 @@ module traversal_ctrl #(
       endcase
 
       // The pop engine's entry of this cycle.
-      if (pe_valid) begin
+      if (pe_go) begin
         if (pe_drop) begin
           size_r[pe_t] <= pe_size - 1'b1;
           pop_phase2_r[pe_t] <= pe_phase2 | ~pe_done_drop;
@@ -691,7 +701,7 @@ module traversal_ctrl #(
       if (act == APop && !pe_from_stage) begin
         pq[pq_tail] <= qt;
         pq_tail <= next_slot(pq_tail);
-        pq_n <= (pe_valid && !pe_drop) ? pq_n : pq_n + 1'b1;
+        pq_n <= (pe_go && !pe_drop) ? pq_n : pq_n + 1'b1;
         pop_phase2_r[qt] <= 1'b0;
       end
     end
