@@ -90,6 +90,8 @@ class TravHarness {
         if (!clip(s)) return false;
       } else if (ph == units::Phase::kTraverse) {
         if (!step(s)) return false;
+      } else if (ph == units::Phase::kPop) {
+        if (!pop_request(s)) return false;
       } else if (ph == units::Phase::kList || ph == units::Phase::kIntersect ||
                  ph == units::Phase::kTransformObject || ph == units::Phase::kTransformTriangle) {
         if (!neighbour(s)) return false;
@@ -403,10 +405,7 @@ class TravHarness {
 
   // The model's list, transformation and intersection steps; their hand-overs to the RTL.
   bool neighbour(S& s) {
-    const Phase ph = s.phase;
-    const units::Level level = s.traversal.level();
-    const std::uint64_t drops0 = s.u.stack_drops;
-    switch (ph) {
+    switch (s.phase) {
       case Phase::kList:
         s.list.step(s);
         break;
@@ -424,11 +423,13 @@ class TravHarness {
       default:
         return true;
     }
-    // Did the list end (ListStep::resume popped)? Then the RTL pops.
-    const Phase now = s.phase;
-    const bool popped = now == Phase::kTraverse || now == Phase::kShadeSurface ||
-                        now == Phase::kShadeShadow || s.traversal.level() != level;
-    if (!popped) return true;
+    return true;
+  }
+
+  // A list ended (Phase::kPop, on f or list -> traversal): the model's pop and the RTL's.
+  bool pop_request(S& s) {
+    const std::uint64_t drops0 = s.u.stack_drops;
+    s.traversal.pop(s);
     drops_left_ = s.u.stack_drops - drops0;
     run_.drops += drops_left_;
     return pop(s);

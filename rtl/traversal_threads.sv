@@ -114,7 +114,7 @@ module traversal_threads #(
   assign par_skip_empty = SKIP_EMPTY;
   assign par_exit_only = EXIT_ONLY;
   localparam int Depth = LAT_ADD + LAT_DIV + LAT_CMP;
-  localparam int Inputs = 6;  // loop, loop (late pops), f, list, RGS, b
+  localparam int Inputs = 5;  // loop, f, list, RGS, b
 
   // ---- per-thread: what the accepted request is, the node words it fetched ------------------
   localparam logic [1:0] KNode = 2'd0, KClip = 2'd1, KPop = 2'd2;
@@ -165,18 +165,18 @@ module traversal_threads #(
   logic [Inputs-1:0] in_valid;
   logic [Inputs-1:0][TW-1:0] in_thread;
   always_comb begin
-    in_valid[0] = c_out_valid && c_out_dest == 2'd0;
-    in_thread[0] = c_out_thread;
-    in_valid[1] = c_out2_valid && c_out2_dest == 2'd0;
-    in_thread[1] = c_out2_thread;
-    in_valid[FAULT_PRIO_SWAP ? 5 : 2] = f_valid;
-    in_thread[FAULT_PRIO_SWAP ? 5 : 2] = f_thread;
-    in_valid[3] = l_valid;
-    in_thread[3] = l_thread;
-    in_valid[4] = r_valid;
-    in_thread[4] = r_thread;
-    in_valid[FAULT_PRIO_SWAP ? 2 : 5] = b_valid;
-    in_thread[FAULT_PRIO_SWAP ? 2 : 5] = b_thread;
+    // One loop path, as the model's: the two output ports never send to the same unit in one
+    // cycle (traversal_ctrl holds the pop queue's head), so its threads queue in arrival order.
+    in_valid[0] = (c_out_valid && c_out_dest == 2'd0) || (c_out2_valid && c_out2_dest == 2'd0);
+    in_thread[0] = c_out_valid && c_out_dest == 2'd0 ? c_out_thread : c_out2_thread;
+    in_valid[FAULT_PRIO_SWAP ? 4 : 1] = f_valid;
+    in_thread[FAULT_PRIO_SWAP ? 4 : 1] = f_thread;
+    in_valid[2] = l_valid;
+    in_thread[2] = l_thread;
+    in_valid[3] = r_valid;
+    in_thread[3] = r_thread;
+    in_valid[FAULT_PRIO_SWAP ? 1 : 4] = b_valid;
+    in_thread[FAULT_PRIO_SWAP ? 1 : 4] = b_thread;
   end
 
   logic acc_node;
