@@ -9,6 +9,7 @@
 #include <string>
 #include <type_traits>
 
+#include "rtl/port_bits.h"
 #include "rtl_list_builds.h"
 #include "units/boundary_list.h"
 #include "verilated.h"
@@ -16,39 +17,6 @@
 
 namespace saarcor::rtl {
 namespace {
-
-// A field of `width` bits at `lsb` of a Verilated port (an integer or a VlWide).
-template <class T>
-void put(T& port, int lsb, int width, std::uint64_t v) {
-  if constexpr (std::is_integral_v<T>) {
-    const std::uint64_t m = width >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << width) - 1;
-    std::uint64_t p = static_cast<std::uint64_t>(port);
-    p = (p & ~(m << lsb)) | ((v & m) << lsb);
-    port = static_cast<T>(p);
-  } else {
-    for (int b = 0; b < width; ++b) {
-      const int bit = lsb + b;
-      auto& w = port[static_cast<std::size_t>(bit / 32)];
-      const std::uint32_t m = std::uint32_t{1} << (bit % 32);
-      w = ((v >> b) & 1u) != 0 ? (w | m) : (w & ~m);
-    }
-  }
-}
-template <class T>
-std::uint64_t get(const T& port) {
-  if constexpr (std::is_integral_v<T>) {
-    return static_cast<std::uint64_t>(port);
-  } else {
-    return static_cast<std::uint64_t>(port[0]) | (static_cast<std::uint64_t>(port[1]) << 32);
-  }
-}
-
-int thread_bits(int threads) {
-  int b = 0;
-  while ((1 << b) < threads)
-    ++b;
-  return b < 1 ? 1 : b;
-}
 
 template <class V>
 class ListRtlOf final : public ListRtl {
@@ -58,7 +26,14 @@ class ListRtlOf final : public ListRtl {
     ctx_->traceEverOn(true);
     v_ = std::make_unique<V>(ctx_.get());
   }
-  ~ListRtlOf() override { stop_trace(); }
+  // The context goes with the model; Verilator's thread context (which the models built without
+  // one of their own use) must not be left pointing at it.
+  ~ListRtlOf() override {
+    stop_trace();
+    v_.reset();
+    ctx_.reset();
+    Verilated::threadContextp(Verilated::defaultContextp());
+  }
 
   void reset() override {
     v_->rst = 1;
@@ -75,18 +50,18 @@ class ListRtlOf final : public ListRtl {
     v.in_level = 0;
     for (int i = 0; i < 3; ++i) {
       const auto k = static_cast<std::size_t>(i);
-      put(v.in_valid, i, 1, in.valid[k]);
-      put(v.in_start, i, 1, in.start[k]);
-      put(v.in_level, i, 1, in.level[k]);
-      put(v.in_thread, i * tw_, tw_, in.thread[k]);
-      put(v.in_next, i * 32, 32, in.next[k]);
-      put(v.in_end, i * 32, 32, in.end[k]);
-      put(v.in_mask, i * p_, p_, in.mask[k]);
+      put_bits(v.in_valid, i, 1, in.valid[k]);
+      put_bits(v.in_start, i, 1, in.start[k]);
+      put_bits(v.in_level, i, 1, in.level[k]);
+      put_bits(v.in_thread, i * tw_, tw_, in.thread[k]);
+      put_bits(v.in_next, i * 32, 32, in.next[k]);
+      put_bits(v.in_end, i * 32, 32, in.end[k]);
+      put_bits(v.in_mask, i * p_, p_, in.mask[k]);
     }
     for (int c = 0; c < 2; ++c) {
       const auto k = static_cast<std::size_t>(c);
-      put(v.clr_valid, c, 1, in.clear[k]);
-      put(v.clr_thread, c * tw_, tw_, in.clear_thread[k]);
+      put_bits(v.clr_valid, c, 1, in.clear[k]);
+      put_bits(v.clr_thread, c * tw_, tw_, in.clear_thread[k]);
     }
     v.req_ready = in.req_ready;
     v.resp_valid = in.resp;
@@ -105,7 +80,7 @@ class ListRtlOf final : public ListRtl {
     o.level = v.out_level;
     o.next = v.out_next;
     o.entry = v.out_entry;
-    o.mask = get(v.out_mask);
+    o.mask = get_bits(v.out_mask, 0, p_);
     v.clk = 1;
     v.eval();
     if (vcd_) vcd_->dump(2 * cycle_ + 1);

@@ -1,15 +1,17 @@
-// The lockstep co-simulation of the cycle model and the Verilated list unit (rtl/lockstep.h).
+// The lockstep co-simulation of the cycle model and the Verilated units (rtl/lockstep.h).
 //
 // The model side is one DynRTP as the chip builds it (units/dynrtp.h, the memory system, the
 // RGC) over a thread table of one thread program per thread, so the boundary record can read the
-// packet state (units/boundary_list.h). Its BoundaryRecorder hands the list unit's events to the
-// Lockstep below in cycle order; when the first event of a later cycle arrives, the cycles before
-// it are complete and the RTL is clocked through them.
+// packet state (units/boundary_traversal.h, units/boundary_list.h). Its BoundaryRecorder hands the
+// events of the units in the run to the Cosim below in cycle order; when the first event of a
+// later cycle arrives, the cycles before it are complete and every RTL unit is clocked through
+// them, each beside its own comparer (Lockstep).
 #include "rtl/lockstep.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -24,7 +26,9 @@
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
 #include "rtl/list_rtl.h"
+#include "rtl/traversal_rtl.h"
 #include "units/boundary_list.h"
+#include "units/boundary_traversal.h"
 #include "units/cycle_params.h"
 #include "units/dynrtc_units.h"
 #include "units/dynrtp.h"
@@ -83,95 +87,52 @@ class LockstepThreads final : public units::ThreadTable {
   std::vector<std::unique_ptr<units::ThreadProgram<F, kLanes, units::FastDatapath>>> programs_;
 };
 
-// Thrown from inside the model's cycle when the comparison found a divergence or the replay
-// reached its cycle: the kernel is left where it stands.
+// Thrown from inside the model's cycle when a comparison found a divergence or the replay reached
+// its cycle: the kernel is left where it stands.
 struct Stop {};
 
+// One RTL unit beside the model's: its inputs of a cycle driven, its outputs matched with the
+// model's `window` cycles behind the clock.
 class Lockstep {
  public:
   Lockstep(UnitRtl& rtl, const LockstepOptions& o) : rtl_(rtl), o_(o) { rtl_.reset(); }
 
-  // The model's events of the unit, in cycle order.
-  void model_event(const BoundaryEvent& e) {
-    if (o_.model_events) o_.model_events(e);
-    if (e.cycle > cur_) advance_to(e.cycle);
-    pending_.push_back(e);
-  }
+  // A model event of cycle cur_ (the driver clocks the RTL before the events of a later cycle).
+  void model_event(BoundaryEvent e) { pending_.push_back(std::move(e)); }
 
-  // The model finished at cycle `end`: the RTL runs the window on and everything is compared.
-  void finish(std::uint64_t end) {
-    model_cycles_ = end;
-    advance_to(std::max(end, cur_) + static_cast<std::uint64_t>(o_.window) + 1);
-    compare(hw::kNever);
-    if (o_.write_wave) rtl_.stop_trace();
-  }
-
-  bool diverged() const { return diverged_; }
-  const Divergence& divergence() const { return div_; }
-  const std::string& screen() const { return screen_; }
-  const std::array<std::uint64_t, 6>& events() const { return events_; }
-  std::uint64_t cycles() const { return cur_; }
-  double rtl_seconds() const { return rtl_seconds_; }
-  std::uint64_t model_cycles() const { return model_cycles_; }
-
- private:
-  void advance_to(std::uint64_t c) {
-    while (cur_ < c) {
-      if (o_.until != 0 && cur_ > o_.until) {  // a replay: both sides are complete up to here
-        compare(o_.until);
-        throw Stop{};
-      }
-      step();
-      pending_.clear();
-      ++cur_;
-      if (cur_ > static_cast<std::uint64_t>(o_.window))
-        compare(cur_ - static_cast<std::uint64_t>(o_.window));
-    }
-  }
-
-  // One RTL cycle: the model's inputs of cycle cur_ in, the RTL's outputs out.
-  void step() {
+  // One RTL cycle: the model's inputs of the cycle in, the RTL's outputs out.
+  void step(std::uint64_t cur) {
     std::vector<BoundaryEvent> inputs, outputs;
-    for (const BoundaryEvent& e : pending_) {
+    for (BoundaryEvent& e : pending_) {
       remember(model_hist_, e);
       if (e.port == BoundaryPort::kCacheRequest || e.port == BoundaryPort::kOutput) {
-        outputs.push_back(e);
+        outputs.push_back(std::move(e));
         continue;
       }
-      ++events_[static_cast<std::size_t>(e.port)];  // driven (the outputs count when compared)
-      inputs.push_back(e);
+      ++events_[static_cast<std::size_t>(e.port)];  // given (the outputs count when compared)
       if (e.port != BoundaryPort::kCacheBlocked) remember(rtl_hist_, e);
+      inputs.push_back(std::move(e));
     }
-    // A cycle's outputs in port order (the model's come in the order its modules ran).
-    std::stable_sort(
-        outputs.begin(), outputs.end(),
-        [](const BoundaryEvent& a, const BoundaryEvent& b) { return a.port < b.port; });
-    model_out_.insert(model_out_.end(), outputs.begin(), outputs.end());
-    if (o_.write_wave && cur_ == o_.wave_from) rtl_.start_trace(o_.wave);
+    pending_.clear();
+    in_port_order(outputs);
+    for (BoundaryEvent& e : outputs)
+      model_out_.push_back(std::move(e));
+    if (o_.write_wave && cur == o_.wave_from)
+      rtl_.start_trace(wave_file(o_, units::unit_name(rtl_.unit())));
     outputs.clear();
     const auto t0 = Clock::now();
-    rtl_.cycle(cur_, inputs, outputs);
+    rtl_.cycle(cur, inputs, outputs);
     rtl_seconds_ += std::chrono::duration<double>(Clock::now() - t0).count();
-    if (o_.write_wave && cur_ == o_.wave_to) rtl_.stop_trace();
-    for (const BoundaryEvent& e : outputs) {
-      rtl_out_.push_back(e);
+    if (o_.write_wave && cur == o_.wave_to) rtl_.stop_trace();
+    in_port_order(outputs);
+    for (BoundaryEvent& e : outputs) {
       remember(rtl_hist_, e);
+      rtl_out_.push_back(std::move(e));
     }
   }
 
-  static void remember(std::deque<BoundaryEvent>& h, const BoundaryEvent& e) {
-    h.push_back(e);
-    if (h.size() > 256) h.pop_front();
-  }
-
-  static bool before(const BoundaryEvent& a, const BoundaryEvent& b) {
-    return a.cycle != b.cycle ? a.cycle < b.cycle : a.port < b.port;
-  }
-  static bool same_bits(const BoundaryEvent& a, const BoundaryEvent& b) {
-    return a.thread == b.thread && a.fields == b.fields && a.field == b.field;
-  }
-
-  // Matches the events of both sides up to cycle `upto`, in (cycle, port) order.
+  // Matches the events of both sides up to cycle `upto`, in (cycle, port) order (within a cycle
+  // and port, by thread).
   void compare(std::uint64_t upto) {
     for (;;) {
       const bool m = !model_out_.empty() && model_out_.front().cycle <= upto;
@@ -199,10 +160,61 @@ class Lockstep {
     }
   }
 
+  void stop_trace() { rtl_.stop_trace(); }
+  bool diverged() const { return diverged_; }
+  const Divergence& divergence() const { return div_; }
+  const std::string& screen() const { return screen_; }
+  const std::array<std::uint64_t, 6>& events() const { return events_; }
+  double rtl_seconds() const { return rtl_seconds_; }
+
+ private:
+  // The events of the last cycles: the window behind the clock and the 16 events before it.
+  void remember(std::deque<BoundaryEvent>& h, const BoundaryEvent& e) const {
+    h.push_back(e);
+    const std::uint64_t keep = 2 * static_cast<std::uint64_t>(o_.window) + 64;
+    while (h.size() > 16 && h.front().cycle + keep < e.cycle)
+      h.pop_front();
+  }
+
+  static bool before(const BoundaryEvent& a, const BoundaryEvent& b) {
+    return a.cycle != b.cycle ? a.cycle < b.cycle : a.port < b.port;
+  }
+  // A cycle's events in (port, thread) order: the model's come in the order its modules ran,
+  // the RTL's in its ports' order; a unit with two output ports (the traversal unit) may let two
+  // threads go in one cycle.
+  static void in_port_order(std::vector<BoundaryEvent>& v) {
+    std::stable_sort(v.begin(), v.end(), [](const BoundaryEvent& a, const BoundaryEvent& b) {
+      return a.port != b.port ? a.port < b.port : a.thread < b.thread;
+    });
+  }
+  static bool same_bits(const BoundaryEvent& a, const BoundaryEvent& b) {
+    return a.thread == b.thread && a.fields == b.fields && a.field == b.field && a.wide == b.wide;
+  }
+
   static const BoundaryEvent* find(const std::deque<BoundaryEvent>& q, const BoundaryEvent& e) {
     for (const BoundaryEvent& x : q)
       if (x.port == e.port && same_bits(x, e)) return &x;
     return nullptr;
+  }
+
+  // The field that differs (the thread when the threads differ; "event" when one side has none).
+  void first_difference(const BoundaryEvent* model, const BoundaryEvent* rtl) {
+    div_.field = "event";
+    div_.model_value = model != nullptr ? 1 : 0;
+    div_.rtl_value = rtl != nullptr ? 1 : 0;
+    if (model == nullptr || rtl == nullptr) return;
+    div_.field = "thread";
+    div_.model_value = model->thread;
+    div_.rtl_value = rtl->thread;
+    if (model->thread != rtl->thread) return;
+    for (int k = 0; k < model->fields; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (model->field[i] == rtl->field[i]) continue;
+      div_.field = model->names[k];
+      div_.model_value = model->field[i];
+      div_.rtl_value = rtl->field[i];
+      return;
+    }
   }
 
   [[noreturn]] void diverge(const char* kind, const BoundaryEvent* model, const BoundaryEvent* rtl,
@@ -213,24 +225,7 @@ class Lockstep {
     div_.port = units::boundary_port_name(e.port);
     div_.kind = kind;
     div_.other_cycle = other;
-    div_.field = "thread";
-    if (model != nullptr && rtl != nullptr) {
-      div_.model_value = model->thread;
-      div_.rtl_value = rtl->thread;
-      if (model->thread == rtl->thread)
-        for (int k = 0; k < model->fields; ++k)
-          if (model->field[static_cast<std::size_t>(k)] !=
-              rtl->field[static_cast<std::size_t>(k)]) {
-            div_.field = model->names[k];
-            div_.model_value = model->field[static_cast<std::size_t>(k)];
-            div_.rtl_value = rtl->field[static_cast<std::size_t>(k)];
-            break;
-          }
-    } else {
-      div_.field = "event";
-      div_.model_value = model != nullptr ? 1 : 0;
-      div_.rtl_value = rtl != nullptr ? 1 : 0;
-    }
+    first_difference(model, rtl);
     std::ostringstream s;
     s << "saarcor-rtl lockstep: DIVERGENCE at cycle " << div_.cycle << ", dynrtp0 " << div_.unit
       << " unit, port " << div_.port << ", field " << div_.field << "\n";
@@ -262,27 +257,85 @@ class Lockstep {
 
   UnitRtl& rtl_;
   const LockstepOptions& o_;
-  std::uint64_t cur_ = 0;  // the RTL's next cycle
   std::vector<BoundaryEvent> pending_;
   std::deque<BoundaryEvent> model_out_, rtl_out_;
   std::deque<BoundaryEvent> model_hist_, rtl_hist_;
   std::array<std::uint64_t, 6> events_{};
   double rtl_seconds_ = 0;
-  std::uint64_t model_cycles_ = 0;
   bool diverged_ = false;
   Divergence div_;
   std::string screen_;
 };
 
-const ListBuild& choose_build(const units::CycleParams& p, const std::string& fault) {
-  int faulty = 0;  // ListBuild::fault
-  if (fault == "mailbox-never-hits")
-    faulty = 1;
-  else if (fault == "priorities-swapped")
-    faulty = 2;
-  else if (!fault.empty())
-    throw std::runtime_error("lockstep: unknown fault '" + fault +
-                             "' (known: mailbox-never-hits, priorities-swapped)");
+// The RTL units clocked together: the model's events (in cycle order) go to their unit's
+// Lockstep; when the first event of a later cycle arrives, the cycles before it are complete and
+// every unit is clocked through them.
+class Cosim {
+ public:
+  explicit Cosim(const LockstepOptions& o) : o_(o) {}
+  void add(UnitRtl& rtl) {
+    units_[static_cast<std::size_t>(units::unit_index(rtl.unit()))] = &steps_.emplace_back(rtl, o_);
+  }
+
+  void model_event(const BoundaryEvent& e) {
+    if (o_.model_events) o_.model_events(e);
+    Lockstep* u = units_[static_cast<std::size_t>(units::unit_index(e.unit))];
+    if (u == nullptr) return;
+    if (e.cycle > cur_) advance_to(e.cycle);
+    u->model_event(e);
+  }
+
+  // The model finished at cycle `end`: the RTL runs the window on and everything is compared.
+  void finish(std::uint64_t end) {
+    model_cycles_ = end;
+    advance_to(std::max(end, cur_) + static_cast<std::uint64_t>(o_.window) + 1);
+    for (Lockstep& u : steps_)
+      u.compare(hw::kNever);
+    if (o_.write_wave)
+      for (Lockstep& u : steps_)
+        u.stop_trace();
+  }
+
+  const std::deque<Lockstep>& units() const { return steps_; }
+  std::uint64_t cycles() const { return cur_; }
+  std::uint64_t model_cycles() const { return model_cycles_; }
+
+ private:
+  void advance_to(std::uint64_t c) {
+    const auto window = static_cast<std::uint64_t>(o_.window);
+    while (cur_ < c) {
+      if (o_.until != 0 && cur_ > o_.until) {  // a replay: both sides are complete up to here
+        for (Lockstep& u : steps_)
+          u.compare(o_.until);
+        throw Stop{};
+      }
+      for (Lockstep& u : steps_)
+        u.step(cur_);
+      ++cur_;
+      if (cur_ > window)
+        for (Lockstep& u : steps_)
+          u.compare(cur_ - window);
+    }
+  }
+
+  const LockstepOptions& o_;
+  std::deque<Lockstep> steps_;  // (a deque: the pointers below stay valid)
+  std::array<Lockstep*, units::kMaxUnits> units_{};
+  std::uint64_t cur_ = 0;  // the RTL's next cycle
+  std::uint64_t model_cycles_ = 0;
+};
+
+// The fault builds (LockstepOptions::fault) of a unit: its fault number, 0 for none.
+int fault_of(const std::string& unit, const std::string& fault) {
+  if (fault.empty()) return 0;
+  if (unit == "list")
+    return fault == "mailbox-never-hits" ? 1 : fault == "priorities-swapped" ? 2 : 0;
+  if (fault == "pop-off") return 1;
+  if (fault == "short-pipeline") return 2;
+  return fault == "priorities-swapped" ? 3 : 0;
+}
+
+const ListBuild& choose_list_build(const units::CycleParams& p, int faulty) {
   std::string built;
   for (const ListBuild& b : list_builds()) {
     if (b.fault == faulty && b.threads == p.threads && b.packet == p.packet &&
@@ -302,9 +355,39 @@ const ListBuild& choose_build(const units::CycleParams& p, const std::string& fa
       " lat.cmp=" + std::to_string(p.list_depth()) + "; built:" + built);
 }
 
+std::string traversal_config(int threads, int packet, int stack, int add, int div, int cmp) {
+  return "threads=" + std::to_string(threads) + " packet=" + std::to_string(packet) +
+         " stack=" + std::to_string(stack) + " lat.add=" + std::to_string(add) +
+         " lat.div=" + std::to_string(div) + " lat.cmp=" + std::to_string(cmp);
+}
+
+// The traversal unit is built for the defaults of the rules it does not parameterise.
+const TraversalBuild& choose_traversal_build(const units::CycleParams& p, int faulty) {
+  if (!p.skip_empty || !p.clip_exit_only || p.clip_faces_per_step != 1)
+    throw std::runtime_error(
+        "lockstep: the Verilated traversal unit is built for traversal.skip_empty=1, "
+        "clip.exit_only=1 and clip.faces_per_step=1 only");
+  std::string built;
+  for (const TraversalBuild& b : traversal_builds()) {
+    if (b.fault == faulty && b.threads == p.threads && b.packet == p.packet && b.stack == p.stack &&
+        b.lat_add == p.lat_add && b.lat_div == p.lat_div && b.lat_cmp == p.lat_cmp)
+      return b;
+    if (b.fault == faulty)
+      built += " [" +
+               traversal_config(b.threads, b.packet, b.stack, b.lat_add, b.lat_div, b.lat_cmp) +
+               "]";
+  }
+  throw std::runtime_error(
+      "lockstep: no Verilated traversal unit for " +
+      traversal_config(p.threads, p.packet, p.stack, p.lat_add, p.lat_div, p.lat_cmp) +
+      "; built:" + built);
+}
+
 template <class F, int kLanes>
 void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
-               const units::FunctionalParams& shading, Lockstep* ls) {
+               const units::FunctionalParams& shading, const std::vector<UnitId>& recorded,
+               Cosim* cs) {
+  using State = units::PacketState<F, kLanes, units::FastDatapath>;
   memif::MemoryImage image = image_in;
   LockstepThreads<F, kLanes> threads(image, units::functional_params(p, shading), p.threads);
   hw::KernelConfig kc;
@@ -313,14 +396,15 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   memif::MemorySystem mi(k, image, units::memory_system_config(p));
   units::RayGenerationController rgc(threads.packets(), 1);
   units::DynRtp d(k, mi, p, threads, rgc, 0);
-  units::ListPayload<F, kLanes, units::FastDatapath> payload(
-      threads,
-      [&](units::ThreadToken t) -> const units::PacketState<F, kLanes, units::FastDatapath>& {
-        return threads.state(t);
-      });
-  units::BoundaryRecorder rec(threads, p.threads, {UnitId::kList}, payload,
-                              [&](const BoundaryEvent& e) { ls->model_event(e); });
-  if (ls != nullptr) d.observe(&rec);  // (none: the model alone, for the speed beside it)
+  const auto state = [&](units::ThreadToken t) -> const State& { return threads.state(t); };
+  units::ListPayload<F, kLanes, units::FastDatapath> list(threads, state);
+  units::TraversalPayload<F, kLanes, units::FastDatapath> traversal(threads, state);
+  units::UnitPayloads payloads(threads);
+  payloads.set(UnitId::kList, list);
+  payloads.set(UnitId::kTraversal, traversal);
+  units::BoundaryRecorder rec(threads, p.threads, recorded, payloads,
+                              [&](const BoundaryEvent& e) { cs->model_event(e); });
+  if (cs != nullptr) d.observe(&rec);  // (none: the model alone, for the speed beside it)
   const auto done = [&] {
     return rgc.all_handed_out() && d.rgs().idle() && mi.frame_writes_stored();
   };
@@ -328,7 +412,7 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   if (r.status == hw::RunResult::Status::kWatchdog)
     throw std::runtime_error("lockstep: the cycle model's watchdog fired at cycle " +
                              std::to_string(r.cycles));
-  if (ls != nullptr) ls->finish(k.now());
+  if (cs != nullptr) cs->finish(k.now());
 }
 
 // The cycle model alone on the same thread table (a program per thread), for its speed.
@@ -336,7 +420,7 @@ template <class F, int kLanes>
 double model_alone(const memif::MemoryImage& image, const units::CycleParams& p,
                    const units::FunctionalParams& shading) {
   const auto t0 = Clock::now();
-  run_model<F, kLanes>(image, p, shading, nullptr);
+  run_model<F, kLanes>(image, p, shading, {}, nullptr);
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
@@ -355,13 +439,26 @@ std::string lockstep_command(const LockstepOptions& o) {
   return s;
 }
 
-LockstepResult run_lockstep(const LockstepOptions& o) {
-  for (const std::string& u : o.units)
-    if (u != "list")
-      throw std::runtime_error("lockstep: unknown unit '" + u + "' (the RTL units: list)");
-  if (o.width < 1 || o.height < 1) throw std::runtime_error("lockstep: --res must be positive");
+std::string wave_file(const LockstepOptions& o, const std::string& unit) {
+  if (o.units.size() < 2) return o.wave;
+  const std::size_t dot = o.wave.rfind('.');
+  const std::size_t slash = o.wave.rfind('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+    return o.wave + "." + unit;
+  return o.wave.substr(0, dot) + "." + unit + o.wave.substr(dot);
+}
+
+const LockstepUnit& LockstepResult::unit(const std::string& name) const {
+  for (const LockstepUnit& u : units)
+    if (u.unit == name) return u;
+  throw std::logic_error("lockstep: the " + name + " unit did not run");
+}
+
+namespace {
+
+// The cycle model's parameters of the run (one DynRTP).
+units::CycleParams run_params(const LockstepOptions& o, host::ImageParams& ip) {
   units::CycleParams p = units::prototype_params();
-  host::ImageParams ip;
   for (const std::string& kv : o.set)
     if (host::is_tree_setting(kv))
       host::apply_tree_setting(ip, kv);
@@ -371,44 +468,96 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   if (p.pipelines != 1)
     throw std::runtime_error("lockstep: the harness drives one DynRTP (pipelines=1), not " +
                              std::to_string(p.pipelines));
-  const ListBuild& build = choose_build(p, o.fault);
+  return p;
+}
+
+// The Verilated build of each unit in o.units for the run's parameters (and fault): a list or a
+// traversal unit build.
+struct Chosen {
+  const ListBuild* list = nullptr;
+  const TraversalBuild* traversal = nullptr;
+};
+std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CycleParams& p,
+                                  std::vector<LockstepUnit>& info) {
+  bool fault_used = o.fault.empty();
+  std::vector<Chosen> chosen;
+  for (const std::string& u : o.units) {
+    if (u != "traversal" && u != "list")
+      throw std::runtime_error("lockstep: unknown unit '" + u +
+                               "' (the RTL units: traversal, list)");
+    for (const LockstepUnit& x : info)
+      if (x.unit == u) throw std::runtime_error("lockstep: unit '" + u + "' given twice");
+    const int fault = fault_of(u, o.fault);
+    fault_used = fault_used || fault != 0;
+    LockstepUnit& x = info.emplace_back();
+    x.unit = u;
+    Chosen& c = chosen.emplace_back();
+    if (u == "list")
+      x.build = (c.list = &choose_list_build(p, fault))->name;
+    else
+      x.build = (c.traversal = &choose_traversal_build(p, fault))->name;
+  }
+  if (!fault_used)
+    throw std::runtime_error("lockstep: no unit of the run has the fault '" + o.fault +
+                             "' (list: mailbox-never-hits, priorities-swapped; traversal: "
+                             "pop-off, short-pipeline, priorities-swapped)");
+  return chosen;
+}
+
+}  // namespace
+
+LockstepResult run_lockstep(const LockstepOptions& o) {
+  if (o.width < 1 || o.height < 1) throw std::runtime_error("lockstep: --res must be positive");
+  if (o.units.empty()) throw std::runtime_error("lockstep: no unit to run");
+  host::ImageParams ip;
+  const units::CycleParams p = run_params(o, ip);
   ip.width = o.width;
   ip.height = o.height;
   ip.max_depth = static_cast<std::uint32_t>(o.depth);
+  LockstepResult res;
+  const std::vector<Chosen> chosen = choose_builds(o, p, res.units);  // before the scene: fast
   const host::BuiltImage built = host::build_image(host::load_scene(o.scene), ip);
   units::FunctionalParams shading;
   shading.shadows = o.shadows;
   shading.secondary = o.depth > 0;
   shading.max_depth = o.depth > 0 ? o.depth : -1;
 
-  std::unique_ptr<UnitRtl> rtl = make_list_unit_rtl(build);
-  if (o.wrap_rtl) rtl = o.wrap_rtl(std::move(rtl));
-  Lockstep ls(*rtl, o);
+  std::vector<std::unique_ptr<UnitRtl>> rtl;
+  std::vector<UnitId> recorded;
+  Cosim cs(o);
+  for (const Chosen& c : chosen) {
+    rtl.push_back(c.list != nullptr
+                      ? make_list_unit_rtl(*c.list)
+                      : make_traversal_unit_rtl(*c.traversal, built.image.registers()));
+    if (o.wrap_rtl) rtl.back() = o.wrap_rtl(std::move(rtl.back()));
+    recorded.push_back(rtl.back()->unit());
+    cs.add(*rtl.back());
+  }
   const auto t1 = Clock::now();
+  using Fp24 = ff::Float<7, 16>;
   try {
-    using Fp24 = ff::Float<7, 16>;
     if (p.packet <= 4)
-      run_model<Fp24, 4>(built.image, p, shading, &ls);
+      run_model<Fp24, 4>(built.image, p, shading, recorded, &cs);
     else
-      run_model<Fp24, units::kMaxPacket>(built.image, p, shading, &ls);
+      run_model<Fp24, units::kMaxPacket>(built.image, p, shading, recorded, &cs);
   } catch (const Stop&) {
   }
-  LockstepResult res;
   res.seconds = std::chrono::duration<double>(Clock::now() - t1).count();
-  res.build = build.name;
-  res.diverged = ls.diverged();
-  res.divergence = ls.divergence();
-  res.screen = ls.screen();
-  res.events = ls.events();
-  res.cycles = ls.cycles();
-  res.rtl_seconds = ls.rtl_seconds();
-  res.model_cycles = ls.model_cycles();
-  if (o.bench && !res.diverged) {
-    using Fp24 = ff::Float<7, 16>;
+  std::size_t i = 0;
+  for (const Lockstep& u : cs.units()) {
+    res.units[i++].events = u.events();
+    res.rtl_seconds += u.rtl_seconds();
+    if (!u.diverged() || res.diverged) continue;
+    res.diverged = true;
+    res.divergence = u.divergence();
+    res.screen = u.screen();
+  }
+  res.cycles = cs.cycles();
+  res.model_cycles = cs.model_cycles();
+  if (o.bench && !res.diverged)
     res.model_seconds = p.packet <= 4
                             ? model_alone<Fp24, 4>(built.image, p, shading)
                             : model_alone<Fp24, units::kMaxPacket>(built.image, p, shading);
-  }
   return res;
 }
 

@@ -1,5 +1,5 @@
-// The list unit in lockstep with the cycle model at full size (label deep; rtl/lockstep.h): the
-// room at 512x384 and frame 0 of the BART kitchen at 256x192, 0 divergences.
+// The traversal and list units in lockstep with the cycle model at full size (label deep;
+// rtl/lockstep.h): the room at 512x384 and frame 0 of the BART kitchen at 256x192, 0 divergences.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -11,12 +11,14 @@ namespace {
 
 void expect_agreement(const std::string& scene, int w, int h) {
   LockstepOptions o;
+  o.units = {"traversal", "list"};
   o.scene = scene;
   o.width = w;
   o.height = h;
   const LockstepResult r = run_lockstep(o);
   EXPECT_FALSE(r.diverged) << r.screen;
-  EXPECT_GT(r.events[static_cast<std::size_t>(units::BoundaryPort::kOutput)], 0u);
+  EXPECT_GT(r.unit("list").event(units::BoundaryPort::kOutput), 0u);
+  EXPECT_GT(r.unit("traversal").event(units::BoundaryPort::kOutput), 0u);
 }
 
 TEST(ListLockstepDeep, Room512x384) {

@@ -1,6 +1,6 @@
-// The list unit's RTL (rtl/list_unit.sv) in lockstep with the cycle model (rtl/lockstep.h): 0
-// divergences on the CI scenes and configurations, the injected fault caught at its first wrong
-// event, bad input refused.
+// The RTL units (rtl/traversal_threads.sv, rtl/list_unit.sv) in lockstep with the cycle model
+// (rtl/lockstep.h): 0 divergences on the CI scenes and configurations, the injected faults caught
+// at their first wrong event, bad input refused.
 #include "rtl/lockstep.h"
 
 #include <gtest/gtest.h>
@@ -9,12 +9,16 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "rtl/list_rtl.h"
+#include "rtl/traversal_rtl.h"
 #include "units/boundary_list.h"
+#include "units/cycle_params.h"
 
 namespace saarcor::rtl {
 namespace {
@@ -30,6 +34,7 @@ std::string shared(const std::string& rel) {
 LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, int w = 24,
                    int h = 18, bool shadows = false, int depth = 0) {
   LockstepOptions o;
+  o.units = {"traversal", "list"};
   o.scene = scene;
   o.set = std::move(set);
   o.width = w;
@@ -39,47 +44,61 @@ LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, 
   return run_lockstep(o);
 }
 
+// Both units agree with the model on every port event: the list unit's each request answered and
+// each entry leaving; the traversal unit's node fetches answered, and more threads leaving than
+// node steps (the clips and pops leave too).
 void expect_agreement(const LockstepResult& r) {
   EXPECT_FALSE(r.diverged) << r.screen;
-  const auto ev = [&](BoundaryPort p) { return r.events[static_cast<std::size_t>(p)]; };
-  EXPECT_GT(ev(BoundaryPort::kCacheRequest), 0u);
-  EXPECT_EQ(ev(BoundaryPort::kCacheRequest), ev(BoundaryPort::kCacheResponse));
-  // Every list step fetches its entry but a return to a list that is done (D49: a thread back
-  // from an object whose top-level list has ended), which every scene here has (each packet that
-  // enters the last object of its list comes back to it).
-  EXPECT_GT(ev(BoundaryPort::kOutput), ev(BoundaryPort::kCacheRequest));
-  std::printf("  %s: %llu cycles, %llu requests, %llu outputs compared\n", r.build.c_str(),
-              static_cast<unsigned long long>(r.cycles),
-              static_cast<unsigned long long>(ev(BoundaryPort::kCacheRequest)),
-              static_cast<unsigned long long>(ev(BoundaryPort::kOutput)));
+  const LockstepUnit& list = r.unit("list");
+  const LockstepUnit& trav = r.unit("traversal");
+  EXPECT_GT(list.event(BoundaryPort::kCacheRequest), 0u);
+  EXPECT_EQ(list.event(BoundaryPort::kCacheRequest), list.event(BoundaryPort::kCacheResponse));
+  EXPECT_GE(list.event(BoundaryPort::kOutput), list.event(BoundaryPort::kCacheRequest));
+  EXPECT_GT(trav.event(BoundaryPort::kCacheRequest), 0u);
+  EXPECT_EQ(trav.event(BoundaryPort::kCacheRequest), trav.event(BoundaryPort::kCacheResponse));
+  EXPECT_GT(trav.event(BoundaryPort::kOutput), trav.event(BoundaryPort::kCacheRequest));
+  EXPECT_GT(trav.event(BoundaryPort::kSideBand), 0u);  // hit updates
+  std::printf(
+      "  %s/%s: %llu cycles; traversal %llu requests, %llu outputs; list %llu requests, "
+      "%llu outputs compared\n",
+      trav.build.c_str(), list.build.c_str(), static_cast<unsigned long long>(r.cycles),
+      static_cast<unsigned long long>(trav.event(BoundaryPort::kCacheRequest)),
+      static_cast<unsigned long long>(trav.event(BoundaryPort::kOutput)),
+      static_cast<unsigned long long>(list.event(BoundaryPort::kCacheRequest)),
+      static_cast<unsigned long long>(list.event(BoundaryPort::kOutput)));
 }
 
 const std::vector<std::string> kP1 = {"threads=13", "packet=1", "mailbox=1", "triangle_mailbox=1",
                                       "cache.list.items=8"};
 const std::vector<std::string> kP16 = {"threads=16", "packet=16", "cache.list.items=8"};
 
-TEST(ListLockstep, RoomPrototype) {
+TEST(Lockstep, RoomPrototype) {
   expect_agreement(run("builtin:room"));
 }
-TEST(ListLockstep, RoomP1ThirteenThreadsMailbox1Cache8) {
+TEST(Lockstep, RoomP1ThirteenThreadsMailbox1Cache8) {
   expect_agreement(run("builtin:room", kP1));
 }
-TEST(ListLockstep, RoomP16Cache8) {
+TEST(Lockstep, RoomP16Cache8) {
   expect_agreement(run("builtin:room", kP16, 32, 32));
 }
-TEST(ListLockstep, DynamicShadowsDepth2) {
+TEST(Lockstep, DynamicShadowsDepth2) {
   expect_agreement(run("builtin:dynamic", {}, 24, 18, true, 2));
 }
-TEST(ListLockstep, DynamicShadowsDepth2P1) {
+TEST(Lockstep, DynamicShadowsDepth2P1) {
   expect_agreement(run("builtin:dynamic", kP1, 16, 12, true, 2));
 }
-TEST(ListLockstep, SunCorTwoLevels) {
+TEST(Lockstep, SunCorTwoLevels) {
   expect_agreement(run("builtin:suncor", {}, 24, 18));
 }
-TEST(ListLockstep, DuckGltf) {
+// A small stack (16 entries: the traversal unit's proto_stack16 build beside the list unit's
+// proto).
+TEST(Lockstep, SunCorStack16) {
+  expect_agreement(run("builtin:suncor", {"stack=16"}, 24, 18));
+}
+TEST(Lockstep, DuckGltf) {
   expect_agreement(run(shared("Duck/Duck.gltf")));
 }
-TEST(ListLockstep, TwoCylinderEngineGltfP16) {
+TEST(Lockstep, TwoCylinderEngineGltfP16) {
   expect_agreement(run(shared("2CylinderEngine/2CylinderEngine.gltf"), kP16, 32, 24));
 }
 
@@ -88,16 +107,22 @@ TEST(ListLockstep, TwoCylinderEngineGltfP16) {
 // reduced (a skip, or an entry for fewer rays than the list holds).
 TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
   LockstepOptions o;
+  o.units = {"list"};
   o.scene = "builtin:room";
   o.width = 24;
   o.height = 18;
-  std::map<std::pair<std::uint32_t, std::uint64_t>, std::uint64_t> rays;  // (thread, level)
+  // Per (thread, level): the rays and the cursor the thread arrived with.
+  std::map<std::pair<std::uint32_t, std::uint64_t>, std::pair<std::uint64_t, std::uint64_t>> in;
   std::uint64_t first = 0;
   o.model_events = [&](const BoundaryEvent& e) {
-    if (e.port == BoundaryPort::kInput) rays[{e.thread, e.field[1]}] = e.field[4];
+    if (e.port == BoundaryPort::kInput) in[{e.thread, e.field[1]}] = {e.field[4], e.field[2]};
     if (e.port != BoundaryPort::kOutput || first != 0) return;
+    const auto& [rays, next] = in[{e.thread, e.field[1]}];
     const bool entry = e.field[0] == static_cast<std::uint64_t>(units::ListOut::kEntry);
-    if (!entry || e.field[4] != rays[{e.thread, e.field[1]}]) first = e.cycle;
+    // A thread back from an object whose list is done reads no entry (its cursor unchanged):
+    // no mailbox decides that.
+    if (!entry && e.field[2] == next) return;
+    if (!entry || e.field[4] != rays) first = e.cycle;
   };
   const LockstepResult healthy = run_lockstep(o);
   ASSERT_FALSE(healthy.diverged) << healthy.screen;
@@ -124,6 +149,7 @@ TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
 // the model's cache request for the loop's thread, the RTL's for the other (class order).
 TEST(ListLockstep, SwappedPrioritiesAreCaughtAtTheirFirstWrongEvent) {
   LockstepOptions o;
+  o.units = {"list"};
   o.scene = "builtin:dynamic";
   o.width = 24;
   o.height = 18;
@@ -223,6 +249,7 @@ TEST(ListLockstep, DivergencesAreClassified) {
   for (const auto& [fault, kind] : cases) {
     SCOPED_TRACE(kind);
     LockstepOptions o;
+    o.units = {"list"};
     o.scene = "builtin:room";
     o.width = 16;
     o.height = 12;
@@ -242,23 +269,155 @@ TEST(ListLockstep, DivergencesAreClassified) {
   }
 }
 
-TEST(ListLockstep, BadInputIsRefusedWithOneLine) {
+TEST(Lockstep, BadInputIsRefusedWithOneLine) {
   LockstepOptions o;
   o.scene = "builtin:room";
+  const auto error = [&]() -> std::string {
+    try {
+      run_lockstep(o);
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+      return e.what();
+    }
+    ADD_FAILURE() << "accepted";
+    return "";
+  };
   o.units = {"shading"};
-  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  EXPECT_NE(error().find("unknown unit 'shading'"), std::string::npos);
+  o.units = {"list", "list"};
+  EXPECT_NE(error().find("given twice"), std::string::npos);
   o.units = {"list"};
   o.set = {"threads=7"};
-  try {
-    run_lockstep(o);
-    ADD_FAILURE() << "threads=7 has no Verilated build";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("no Verilated list unit"), std::string::npos);
-    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
-  }
+  EXPECT_NE(error().find("no Verilated list unit"), std::string::npos);
+  o.units = {"traversal", "list"};
+  EXPECT_NE(error().find("no Verilated traversal unit"), std::string::npos);
+  o.set = {"stack=32"};
+  EXPECT_NE(error().find("stack=32"), std::string::npos);
   o.set = {};
   o.fault = "stack-off-by-one";
-  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  EXPECT_NE(error().find("no unit of the run has the fault"), std::string::npos);
+  o.units = {"list"};
+  o.fault = "pop-off";  // the traversal unit's
+  EXPECT_NE(error().find("no unit of the run has the fault"), std::string::npos);
+}
+
+// The first build of each unit is the prototype's (units/cycle_params.cpp defaults).
+TEST(Lockstep, PrototypeBuildsAreTheModelsDefaults) {
+  const units::CycleParams p = units::prototype_params();
+  const TraversalBuild& t = traversal_builds().front();
+  EXPECT_EQ(t.name, "proto");
+  EXPECT_EQ(t.threads, p.threads);
+  EXPECT_EQ(t.packet, p.packet);
+  EXPECT_EQ(t.stack, p.stack);
+  EXPECT_EQ(t.lat_add, p.lat_add);
+  EXPECT_EQ(t.lat_div, p.lat_div);
+  EXPECT_EQ(t.lat_cmp, p.lat_cmp);
+  EXPECT_EQ(t.fault, 0);
+  // Every traversal parameter set without a fault has the list unit's build beside it.
+  for (const TraversalBuild& b : traversal_builds()) {
+    if (b.fault != 0) continue;
+    bool list = false;
+    for (const ListBuild& l : list_builds())
+      list = list || (l.fault == 0 && l.threads == b.threads && l.packet == b.packet);
+    EXPECT_TRUE(list) << b.name;
+  }
+}
+
+// ---- the traversal unit ------------------------------------------------------------------------
+// Wraps the Verilated traversal unit and finds the first cycle in which a thread's stack shrank
+// from two or more entries: the first pop (or drop) that reads an entry with another below it,
+// where a pop one entry off first reads the wrong entry (the model's events do not show the
+// stack, the healthy RTL's dbg port does: it agrees with the model up to there, the lockstep
+// says so). `popped`: the thread left in that cycle (the entry decided: it was popped).
+class DeepPopProbe final : public UnitRtl {
+ public:
+  DeepPopProbe(std::unique_ptr<UnitRtl> rtl, int threads, std::uint64_t& cycle, bool& popped)
+      : cycle_(cycle),
+        popped_(popped),
+        rtl_(std::move(rtl)),
+        probe_(dynamic_cast<TraversalStackProbe*>(rtl_.get())),
+        size_(static_cast<std::size_t>(threads), 0) {}
+  units::UnitId unit() const override { return rtl_->unit(); }
+  void reset() override { rtl_->reset(); }
+  void start_trace(const std::string& p) override { rtl_->start_trace(p); }
+  void stop_trace() override { rtl_->stop_trace(); }
+  void cycle(std::uint64_t c, const std::vector<BoundaryEvent>& in,
+             std::vector<BoundaryEvent>& out) override {
+    rtl_->cycle(c, in, out);
+    if (cycle_ != 0 || probe_ == nullptr) return;
+    for (std::uint32_t t = 0; t < size_.size(); ++t) {
+      const int s = probe_->stack_size(t);
+      if (s < size_[t] && size_[t] >= 2 && cycle_ == 0) {
+        cycle_ = c;
+        for (const BoundaryEvent& e : out)
+          popped_ = popped_ || (e.port == BoundaryPort::kOutput && e.thread == t);
+      }
+      size_[t] = s;
+    }
+  }
+
+ private:
+  std::uint64_t& cycle_;
+  bool& popped_;
+  std::unique_ptr<UnitRtl> rtl_;
+  TraversalStackProbe* probe_;
+  std::vector<int> size_;
+};
+
+// The stack pop one entry off (traversal_ctrl.sv FAULT_POP_OFF: the entry below the top) is
+// caught at the first pop from a stack of two or more entries, which the healthy run names. The
+// room's first such pop decides (it pops, no drop): the faulty unit lets the thread go in the
+// same cycle with the entry below, whose node is another: class payload.
+TEST(TraversalLockstep, StackPopOneEntryOffIsCaughtAtTheFirstDeepPop) {
+  LockstepOptions o;
+  o.units = {"traversal"};
+  o.scene = "builtin:room";
+  o.width = 24;
+  o.height = 18;
+  std::uint64_t deep = 0;
+  bool popped = false;
+  o.wrap_rtl = [&](std::unique_ptr<UnitRtl> rtl) {
+    return std::unique_ptr<UnitRtl>(std::make_unique<DeepPopProbe>(
+        std::move(rtl), units::prototype_params().threads, deep, popped));
+  };
+  const LockstepResult healthy = run_lockstep(o);
+  ASSERT_FALSE(healthy.diverged) << healthy.screen;
+  ASSERT_NE(deep, 0u) << "no pop from a stack of two entries";
+  ASSERT_TRUE(popped) << "the room's first deep pop drops its entry";
+
+  o.wrap_rtl = nullptr;
+  o.fault = "pop-off";
+  const LockstepResult r = run_lockstep(o);
+  ASSERT_TRUE(r.diverged);
+  EXPECT_EQ(r.divergence.cycle, deep) << r.screen;
+  EXPECT_EQ(r.divergence.unit, "traversal");
+  EXPECT_EQ(r.divergence.port, "output");
+  EXPECT_EQ(r.divergence.kind, "payload") << r.screen;
+}
+
+// The traversal pipeline one cycle short (FAULT_SHORT: the lanes' compare stage a wire) is
+// caught at the unit's first output, the first clip chain's end: the RTL has it one cycle before
+// the model (class timing, the model's cycle beside it).
+TEST(TraversalLockstep, PipelineOneCycleShortIsCaughtAtTheFirstOutput) {
+  LockstepOptions o;
+  o.units = {"traversal"};
+  o.scene = "builtin:room";
+  o.width = 24;
+  o.height = 18;
+  o.fault = "short-pipeline";
+  std::uint64_t first = 0;
+  o.model_events = [&](const BoundaryEvent& e) {
+    if (first == 0 && e.unit == units::UnitId::kTraversal && e.port == BoundaryPort::kOutput)
+      first = e.cycle;
+  };
+  const LockstepResult r = run_lockstep(o);
+  ASSERT_TRUE(r.diverged);
+  ASSERT_NE(first, 0u);
+  EXPECT_EQ(r.divergence.cycle, first - 1) << r.screen;
+  EXPECT_EQ(r.divergence.other_cycle, first) << r.screen;
+  EXPECT_EQ(r.divergence.unit, "traversal");
+  EXPECT_EQ(r.divergence.port, "output");
+  EXPECT_EQ(r.divergence.kind, "timing");
 }
 
 }  // namespace

@@ -4,8 +4,8 @@
 //
 //   saarcor-rtl check FILE [--out OUT] [--max N]
 //
-//   saarcor-rtl lockstep SCENE [--units list] [--res WxH] [--set KEY=VALUE ...] [--shadows]
-//                        [--depth N] [--until CYCLE] [--wave FILE] [--bench]
+//   saarcor-rtl lockstep SCENE [--units traversal,list] [--res WxH] [--set KEY=VALUE ...]
+//                        [--shadows] [--depth N] [--until CYCLE] [--wave FILE] [--bench]
 //
 // check: exit status 0 every vector matches, 2 some differ (or the RTL's latency is not the cycle
 // model's unit depth), 1 usage error or malformed file. lockstep (rtl/lockstep.h): 0 no
@@ -27,12 +27,12 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: saarcor-rtl check FILE [--out OUT] [--max N]\n"
-    "       saarcor-rtl lockstep SCENE [--units list] [--res WxH] [--set KEY=VALUE ...]\n"
+    "       saarcor-rtl lockstep SCENE [--units traversal,list] [--res WxH] [--set KEY=VALUE ...]\n"
     "                            [--shadows] [--depth N] [--until CYCLE] [--wave FILE] [--bench]\n"
-    "  lockstep: runs the cycle model and the Verilated list unit side by side and compares\n"
-    "  every port event in the same cycle; exit 2 at the first divergence (its screen, a VCD\n"
-    "  window of the RTL around it and the replay command printed). --bench also times the cycle\n"
-    "  model alone on the same frame.\n"
+    "  lockstep: runs the cycle model and the Verilated units (traversal, list; default both)\n"
+    "  side by side and compares every port event of each in the same cycle; exit 2 at the\n"
+    "  first divergence (its screen, a VCD window of the RTL around it and the replay command\n"
+    "  printed). --bench also times the cycle model alone on the same frame.\n"
     "  Runs the unit vectors in FILE (saarcor vectors --out FILE) through the Verilated unit and\n"
     "  lists the vectors whose outputs differ from the file's (at most N, default 20).\n"
     "  --out OUT  also writes FILE with the RTL's outputs (saarcor vectors --check OUT checks it)\n"
@@ -182,7 +182,8 @@ int report_divergence(const LockstepOptions& o, const saarcor::rtl::LockstepResu
   w.until = w.wave_to;
   (void)saarcor::rtl::run_lockstep(w);  // the same run again, traced around the cycle
   std::fputs(r.screen.c_str(), stdout);
-  std::printf("  waveform: %s (RTL cycles %llu..%llu, 2 time units per cycle)\n", w.wave.c_str(),
+  std::printf("  waveform: %s (RTL cycles %llu..%llu, 2 time units per cycle)\n",
+              saarcor::rtl::wave_file(o, r.divergence.unit).c_str(),
               static_cast<unsigned long long>(w.wave_from),
               static_cast<unsigned long long>(w.wave_to));
   std::printf("  replay:   %s --until %llu --wave %s\n", saarcor::rtl::lockstep_command(o).c_str(),
@@ -197,22 +198,23 @@ void report_agreement(const LockstepOptions& o, const saarcor::rtl::LockstepResu
         "it; waveform %s (RTL cycles %llu..%llu)\n",
         static_cast<unsigned long long>(o.until), o.wave.c_str(),
         static_cast<unsigned long long>(o.wave_from), static_cast<unsigned long long>(o.wave_to));
-  static constexpr const char* kPorts[] = {"input",          "side_band",     "cache_request",
-                                           "cache_response", "cache_blocked", "output"};
-  std::printf(
-      "saarcor-rtl lockstep: %s %dx%d, list unit (build %s): 0 divergences in %llu cycles\n",
-      o.scene.c_str(), o.width, o.height, r.build.c_str(),
-      static_cast<unsigned long long>(r.model_cycles));
-  std::printf("  driven:  ");
-  for (int p : {0, 1, 3, 4})
-    std::printf(" %s %llu", kPorts[p],
-                static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
-  std::printf("\n  compared:");
-  for (int p : {2, 5})
-    std::printf(" %s %llu", kPorts[p],
-                static_cast<unsigned long long>(r.events[static_cast<std::size_t>(p)]));
+  std::printf("saarcor-rtl lockstep: %s %dx%d: 0 divergences in %llu cycles\n", o.scene.c_str(),
+              o.width, o.height, static_cast<unsigned long long>(r.model_cycles));
+  using saarcor::units::BoundaryPort;
+  for (const saarcor::rtl::LockstepUnit& u : r.units) {
+    std::printf("  %s unit (build %s): in:", u.unit.c_str(), u.build.c_str());
+    for (BoundaryPort p : {BoundaryPort::kInput, BoundaryPort::kSideBand,
+                           BoundaryPort::kCacheResponse, BoundaryPort::kCacheBlocked})
+      std::printf(" %s %llu", saarcor::units::boundary_port_name(p),
+                  static_cast<unsigned long long>(u.event(p)));
+    std::printf("; compared:");
+    for (BoundaryPort p : {BoundaryPort::kCacheRequest, BoundaryPort::kOutput})
+      std::printf(" %s %llu", saarcor::units::boundary_port_name(p),
+                  static_cast<unsigned long long>(u.event(p)));
+    std::printf("\n");
+  }
   const double c = static_cast<double>(r.model_cycles);
-  std::printf("\n  speed: RTL %.0f k cycles/s, co-simulation %.0f k cycles/s",
+  std::printf("  speed: RTL %.0f k cycles/s, co-simulation %.0f k cycles/s",
               r.rtl_seconds > 0 ? static_cast<double>(r.cycles) / r.rtl_seconds / 1e3 : 0.0,
               r.seconds > 0 ? c / r.seconds / 1e3 : 0.0);
   if (o.bench)

@@ -52,33 +52,30 @@ module traversal_ctrl #(
     input  logic [   3*W-1:0] scene_lo,
     input  logic [   3*W-1:0] scene_hi,
     input  logic [NODE_W-1:0] top_root,
-    // Lane load (path b's payload, a lane per cycle): the world ray with t_best, valid and done,
-    // or (ld_object) the object ray of the bottom level.
-    input  logic              ld_valid,
-    input  logic [    TW-1:0] ld_thread,
-    input  logic [    LW-1:0] ld_lane,
-    input  logic              ld_object,
-    input  logic [   3*W-1:0] ld_o,
-    input  logic [   3*W-1:0] ld_d,
-    input  logic [     W-1:0] ld_tbest,
-    input  logic              ld_lane_valid,
-    input  logic              ld_done,
-    // Hit update (the intersection unit's accepted hits): t_best and done of one lane.
-    input  logic              hu_valid,
-    input  logic [    TW-1:0] hu_thread,
-    input  logic [    LW-1:0] hu_lane,
-    input  logic [     W-1:0] hu_tbest,
-    input  logic              hu_done,
-    // Level start (b, or RGS -> traversal): the top level from the world rays, or an object's
-    // bottom level with its box (rows 4-5 of the instance record), root and entry mask.
-    input  logic              st_valid,
-    input  logic [    TW-1:0] st_thread,
-    input  logic              st_bottom,
-    input  logic              st_shadow,
-    input  logic [     P-1:0] st_mask,
-    input  logic [   3*W-1:0] st_lo,
-    input  logic [   3*W-1:0] st_hi,
-    input  logic [NODE_W-1:0] st_root,
+    // Level start with its rays (path b from the transformation unit: port 0; RGS -> traversal:
+    // port 1), all P lanes in the cycle the thread is pushed: the top level's world rays with
+    // t_best, valid and done, or (ld_bottom) an object's rays with its box (rows 4-5 of the
+    // instance record), root and entry mask. The bottom level reads t_best from the unit's copy
+    // (the hit updates keep it).
+    input  logic [1:0]                  ld_valid,
+    input  logic [1:0][TW-1:0]          ld_thread,
+    input  logic [1:0]                  ld_bottom,
+    input  logic [1:0]                  ld_shadow,
+    input  logic [1:0][P-1:0]           ld_mask,
+    input  logic [1:0][3*W-1:0]         ld_lo,
+    input  logic [1:0][3*W-1:0]         ld_hi,
+    input  logic [1:0][NODE_W-1:0]      ld_root,
+    input  logic [1:0][P-1:0][3*W-1:0]  ld_o,
+    input  logic [1:0][P-1:0][3*W-1:0]  ld_d,
+    input  logic [1:0][P-1:0][W-1:0]    ld_tbest,
+    input  logic [1:0][P-1:0]           ld_lane_valid,
+    input  logic [1:0][P-1:0]           ld_done,
+    // Hit update (the intersection unit's hits, as the thread leaves it): t_best and done of
+    // every lane.
+    input  logic                        hu_valid,
+    input  logic [TW-1:0]               hu_thread,
+    input  logic [P-1:0][W-1:0]         hu_tbest,
+    input  logic [P-1:0]                hu_done,
     // The thread's next request (what the accept stage fetches): a clip face or a node.
     input  logic [    TW-1:0] rq_thread,
     output logic              rq_clip,
@@ -93,9 +90,10 @@ module traversal_ctrl #(
     input  logic [      31:0] is_w1,
     output logic              is_busy,
     output logic              is_chain,  // the face issued now is followed by another (a chain)
-    // Leaving threads. dest 0: own loop (out_node is the next node), 1: a leaf's list to the list
-    // unit (first, end, mask, level), 2: back to the top level's list (the object is done),
-    // 3: the RGS (path g). Port 2 carries the pops that dropped entries.
+    // Leaving threads. dest 0: own loop (node, mask: the next node), 1: a leaf's list to the list
+    // unit (first, end, mask), 2: back to the top level's list (the object is done), 3: the RGS
+    // (path g); level: the level of the request. Fields a destination does not carry are 0.
+    // Port 2 carries the pops that dropped entries (node, mask, level).
     output logic              out_valid,
     output logic [    TW-1:0] out_thread,
     output logic [       1:0] out_dest,
@@ -109,6 +107,7 @@ module traversal_ctrl #(
     output logic [       1:0] out2_dest,
     output logic [NODE_W-1:0] out2_node,
     output logic [     P-1:0] out2_mask,
+    output logic              out2_level,
     output logic              overflow,
     // Debug read of one lane's state (the testbench compares it with the model).
     input  logic [    TW-1:0] dbg_thread,
@@ -130,15 +129,17 @@ module traversal_ctrl #(
   localparam logic [1:0] DLoop = 2'd0, DLeaf = 2'd1, DResume = 2'd2, DRgs = 2'd3;
 
   // ---- per-thread state (memories indexed by thread id) -----------------------------------
-  logic [W-1:0] wo[THREADS][P][3], wd[THREADS][P][3], oo[THREADS][P][3], od[THREADS][P][3];
-  logic [W-1:0] tn_r[THREADS][P], tf_r[THREADS][P], ctn_r[THREADS][P], ctf_r[THREADS][P];
-  logic [W-1:0] tbest_r[THREADS][P];
-  logic [P-1:0] valid_r[THREADS], done_r[THREADS];
+  // (Rays, t_best, the clipped segment and the box are packed per thread, as the load ports carry
+  // them: a level start writes each in one piece.)
+  logic [P-1:0][2:0][W-1:0] wo[THREADS], wd[THREADS], oo[THREADS], od[THREADS];
+  logic [W-1:0] tn_r[THREADS][P], tf_r[THREADS][P];
+  logic [P-1:0][W-1:0] ctn_r[THREADS], ctf_r[THREADS], tbest_r[THREADS];
+  logic [P-1:0] done_r[THREADS];
   logic level_r[THREADS], shadow_r[THREADS], stride2_r[THREADS];
   logic [2:0] face_r[THREADS];
   logic [NODE_W-1:0] node_r[THREADS], root_r[THREADS];
   logic [P-1:0] mask_r[THREADS], cmask_r[THREADS];
-  logic [W-1:0] blo_r[THREADS][3], bhi_r[THREADS][3];
+  logic [2:0][W-1:0] blo_r[THREADS], bhi_r[THREADS];
   logic [P-1:0] groups_r[THREADS][8], tgroups_r[THREADS][8];
   logic [3:0] ngroups_r[THREADS], group_r[THREADS], tngroups_r[THREADS], tgroup_r[THREADS];
   logic [SW-1:0] size_r[THREADS], base_r[THREADS], tbase_r[THREADS];
@@ -443,6 +444,7 @@ module traversal_ctrl #(
         pe_mask = groups_r[pe_t][3'(group_r[pe_t]+4'd1)];
       end else begin
         pe_dest = level_r[pe_t] ? DResume : DRgs;
+        pe_node = '0;
         pe_mask = '0;
       end
     end
@@ -453,6 +455,16 @@ module traversal_ctrl #(
   assign gr_dest = ngrp != '0 ? DLoop : (level_r[qt] ? DResume : DRgs);
 
   // ---- outputs ------------------------------------------------------------------------------
+  // One thread per cycle on each path to another unit (and on the loop), as the model's paths take
+  // one push per cycle: the queue's head that decides while the last stage lets a thread go to the
+  // same unit waits a cycle and decides again (nothing it read has changed).
+  function automatic logic [1:0] dest_unit(input logic [1:0] d);
+    dest_unit = d == DLoop ? 2'd0 : (d == DRgs ? 2'd2 : 2'd1);  // traversal, list, RGS
+  endfunction
+  logic pe_block, pe_go;
+  assign pe_block = pe_valid && !pe_from_stage && !pe_drop && out_valid &&
+                    dest_unit(out_dest) == dest_unit(pe_dest);
+  assign pe_go = pe_valid && !pe_block;
   always_comb begin
     out_valid = 1'b0;
     out_thread = qt;
@@ -466,7 +478,7 @@ module traversal_ctrl #(
       AGroups: begin
         out_valid = 1'b1;
         out_dest = gr_dest;
-        out_node = level_r[qt] ? root_r[qt] : top_root;
+        out_node = gr_dest != DLoop ? '0 : (level_r[qt] ? root_r[qt] : top_root);
         out_mask = grp[0];
       end
       ALeaf: begin
@@ -495,11 +507,12 @@ module traversal_ctrl #(
       end
       default: ;
     endcase
-    out2_valid = pe_valid && !pe_from_stage && !pe_drop;
+    out2_valid = pe_go && !pe_from_stage && !pe_drop;
     out2_thread = pe_t;
     out2_dest = pe_dest;
     out2_node = pe_node;
     out2_mask = pe_mask;
+    out2_level = level_r[pe_t];
   end
 
   // ---- the request each thread names next -----------------------------------------------------
@@ -508,20 +521,23 @@ module traversal_ctrl #(
   assign rq_node = node_r[rq_thread];
   assign rq_mask = rq_clip ? cmask_r[rq_thread] : mask_r[rq_thread];
 
-  // Origins inside the level's box (closed, value compares; NaN is outside): exit faces only.
-  logic st_inside;
+  // Per load port: the origins inside the level's box (closed, value compares; NaN is outside):
+  // exit faces only.
+  logic [1:0] st_inside;
   always_comb begin
-    st_inside = 1'b1;
-    for (int i = 0; i < P; i++) begin
-      logic in_mask;
-      in_mask = st_bottom ? st_mask[i] : (valid_r[st_thread][i] & ~done_r[st_thread][i]);
-      for (int k = 0; k < 3; k++) begin
-        logic [W-1:0] o, lo, hi;
-        o = st_bottom ? oo[st_thread][i][k] : wo[st_thread][i][k];
-        lo = st_bottom ? fld(st_lo, 2'(k)) : fld(scene_lo, 2'(k));
-        hi = st_bottom ? fld(st_hi, 2'(k)) : fld(scene_hi, 2'(k));
-        // !(o >= lo && o <= hi): o >= lo is !(o < lo) only when neither is NaN.
-        if (in_mask && (f_nan(o) || f_lt(o, lo) || f_lt(hi, o))) st_inside = 1'b0;
+    for (int k = 0; k < 2; k++) begin
+      st_inside[k] = 1'b1;
+      for (int i = 0; i < P; i++) begin
+        logic in_mask;
+        in_mask = ld_bottom[k] ? ld_mask[k][i] : (ld_lane_valid[k][i] & ~ld_done[k][i]);
+        for (int a = 0; a < 3; a++) begin
+          logic [W-1:0] o, lo, hi;
+          o = fld(ld_o[k][i], 2'(a));
+          lo = ld_bottom[k] ? fld(ld_lo[k], 2'(a)) : fld(scene_lo, 2'(a));
+          hi = ld_bottom[k] ? fld(ld_hi[k], 2'(a)) : fld(scene_hi, 2'(a));
+          // !(o >= lo && o <= hi): o >= lo is !(o < lo) only when neither is NaN.
+          if (in_mask && (f_nan(o) || f_lt(o, lo) || f_lt(hi, o))) st_inside[k] = 1'b0;
+        end
       end
     end
   end
@@ -543,52 +559,39 @@ module traversal_ctrl #(
         group_r[t] <= '0;
       end
     end else begin
-      // Lane loads and hit updates.
-      if (ld_valid) begin
-        for (int k = 0; k < 3; k++) begin
-          if (ld_object) begin
-            oo[ld_thread][ld_lane][k] <= fld(ld_o, 2'(k));
-            od[ld_thread][ld_lane][k] <= fld(ld_d, 2'(k));
+      // Level starts with their rays (TraversalStep::start_level; enter_object saves the top
+      // level's groups), then hit updates: different threads.
+      for (int k = 0; k < 2; k++)
+        if (ld_valid[k]) begin
+          if (ld_bottom[k]) begin
+            oo[ld_thread[k]] <= ld_o[k];
+            od[ld_thread[k]] <= ld_d[k];
+            tgroups_r[ld_thread[k]] <= groups_r[ld_thread[k]];
+            tngroups_r[ld_thread[k]] <= ngroups_r[ld_thread[k]];
+            tgroup_r[ld_thread[k]] <= group_r[ld_thread[k]];
+            tbase_r[ld_thread[k]] <= base_r[ld_thread[k]];
+            blo_r[ld_thread[k]] <= ld_lo[k];
+            bhi_r[ld_thread[k]] <= ld_hi[k];
+            root_r[ld_thread[k]] <= ld_root[k];
+            cmask_r[ld_thread[k]] <= ld_mask[k];
+            ctf_r[ld_thread[k]] <= tbest_r[ld_thread[k]];
           end else begin
-            wo[ld_thread][ld_lane][k] <= fld(ld_o, 2'(k));
-            wd[ld_thread][ld_lane][k] <= fld(ld_d, 2'(k));
+            wo[ld_thread[k]] <= ld_o[k];
+            wd[ld_thread[k]] <= ld_d[k];
+            tbest_r[ld_thread[k]] <= ld_tbest[k];
+            done_r[ld_thread[k]] <= ld_done[k];
+            cmask_r[ld_thread[k]] <= ld_lane_valid[k] & ~ld_done[k];
+            shadow_r[ld_thread[k]] <= ld_shadow[k];
+            ctf_r[ld_thread[k]] <= ld_tbest[k];
           end
+          level_r[ld_thread[k]] <= ld_bottom[k];
+          ctn_r[ld_thread[k]] <= '0;
+          stride2_r[ld_thread[k]] <= EXIT_ONLY && st_inside[k];
+          face_r[ld_thread[k]] <= EXIT_ONLY && st_inside[k] ? 3'd1 : 3'd0;
         end
-        if (!ld_object) begin
-          tbest_r[ld_thread][ld_lane] <= ld_tbest;
-          valid_r[ld_thread][ld_lane] <= ld_lane_valid;
-          done_r[ld_thread][ld_lane] <= ld_done;
-        end
-      end
       if (hu_valid) begin
-        tbest_r[hu_thread][hu_lane] <= hu_tbest;
-        done_r[hu_thread][hu_lane] <= hu_done;
-      end
-
-      // Level start (TraversalStep::start_level; enter_object saves the top level's groups).
-      if (st_valid) begin
-        if (st_bottom) begin
-          tgroups_r[st_thread] <= groups_r[st_thread];
-          tngroups_r[st_thread] <= ngroups_r[st_thread];
-          tgroup_r[st_thread] <= group_r[st_thread];
-          tbase_r[st_thread] <= base_r[st_thread];
-          for (int k = 0; k < 3; k++) begin
-            blo_r[st_thread][k] <= fld(st_lo, 2'(k));
-            bhi_r[st_thread][k] <= fld(st_hi, 2'(k));
-          end
-          root_r[st_thread] <= st_root;
-          cmask_r[st_thread] <= st_mask;
-        end else begin
-          cmask_r[st_thread] <= valid_r[st_thread] & ~done_r[st_thread];
-          shadow_r[st_thread] <= st_shadow;
-        end
-        level_r[st_thread] <= st_bottom;
-        for (int i = 0; i < P; i++) begin
-          ctn_r[st_thread][i] <= '0;
-          ctf_r[st_thread][i] <= tbest_r[st_thread][i];
-        end
-        stride2_r[st_thread] <= EXIT_ONLY && st_inside;
-        face_r[st_thread] <= EXIT_ONLY && st_inside ? 3'd1 : 3'd0;
+        tbest_r[hu_thread] <= hu_tbest;
+        done_r[hu_thread] <= hu_done;
       end
 
       // The clip chain issues its faces one per cycle.
@@ -657,7 +660,7 @@ module traversal_ctrl #(
       endcase
 
       // The pop engine's entry of this cycle.
-      if (pe_valid) begin
+      if (pe_go) begin
         if (pe_drop) begin
           size_r[pe_t] <= pe_size - 1'b1;
           pop_phase2_r[pe_t] <= pe_phase2 | ~pe_done_drop;
@@ -698,7 +701,7 @@ module traversal_ctrl #(
       if (act == APop && !pe_from_stage) begin
         pq[pq_tail] <= qt;
         pq_tail <= next_slot(pq_tail);
-        pq_n <= (pe_valid && !pe_drop) ? pq_n : pq_n + 1'b1;
+        pq_n <= (pe_go && !pe_drop) ? pq_n : pq_n + 1'b1;
         pop_phase2_r[qt] <= 1'b0;
       end
     end

@@ -2,8 +2,8 @@
 // (units/traversal_step.h) on real frames, request by request (rtl/traversal_ctrl_testing.h):
 // every node step, clip chain and pop, the next request it names, the lanes' segments, and the
 // cycle the thread leaves as issue + (faces - 1) + depth (+ one per dropped stack entry). The
-// test-only faults (a pop one entry off, a pipeline one cycle short) must be caught at their first
-// wrong event.
+// test-only faults of the traversal unit are caught in lockstep with the cycle model
+// (rtl/lockstep_test.cpp).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -13,8 +13,6 @@
 #include "Vtraversal_ctrl.h"
 #include "Vtraversal_ctrl_p1.h"
 #include "Vtraversal_ctrl_p16.h"
-#include "Vtraversal_ctrl_pop_off.h"
-#include "Vtraversal_ctrl_short.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
 #include "rtl/traversal_ctrl_testing.h"
@@ -142,31 +140,6 @@ INSTANTIATE_TEST_SUITE_P(Scenes, RtlTraversalOnModels,
                            std::string n = i.param;
                            return n.substr(0, n.find('/'));
                          });
-
-// A pipeline one cycle short: the first request (the scene box's clip chain) leaves one cycle
-// early, and the report says so.
-TEST(RtlTraversalFaults, PipelineOneCycleShortIsCaughtAtTheFirstRequest) {
-  const TravRun r = run_scene<Vtraversal_ctrl_short>("builtin:room", 5, depth());
-  ASSERT_TRUE(r.first.found) << describe(r);
-  EXPECT_EQ(r.first.request, 1u) << describe(r);
-  EXPECT_EQ(r.first.kind, "timing") << describe(r);
-  EXPECT_NE(r.first.what.find("depth 12"), std::string::npos) << describe(r);
-  std::printf("RtlTraversalFaults short pipeline: %s\n", describe(r).c_str());
-}
-
-// A pop one entry off (the entry below the top): caught at the first pop from a stack of two
-// or more entries, which the good RTL's run names: the wrong entry is popped (payload: the next
-// node) or dropped (timing: a cycle late).
-TEST(RtlTraversalFaults, StackPopOneEntryOffIsCaughtAtTheFirstDeepPop) {
-  const TravRun good = run_scene<Vtraversal_ctrl>("builtin:room", 40, depth());
-  ASSERT_FALSE(good.first.found) << describe(good);
-  ASSERT_GT(good.first_deep_pop, 0u) << describe(good);
-  const TravRun r = run_scene<Vtraversal_ctrl_pop_off>("builtin:room", 40, depth());
-  ASSERT_TRUE(r.first.found) << describe(r);
-  EXPECT_EQ(r.first.request, good.first_deep_pop) << describe(r);
-  EXPECT_TRUE(r.first.kind == "payload" || r.first.kind == "timing") << describe(r);
-  std::printf("RtlTraversalFaults pop one entry off: %s\n", describe(r).c_str());
-}
 
 }  // namespace
 }  // namespace saarcor::rtl::testing

@@ -3,7 +3,8 @@
 // units are the mock neighbours: its list, transformation and intersection steps run the packet
 // between traversal requests, and what they hand the traversal unit goes onto the RTL's ports
 // (the world rays and t_best on path b, the object rays and box for a bottom level, the hit
-// update after each intersection, a pop when a leaf's list ends: docs/hw-interface.md). Every
+// update after each intersection, a pop when a leaf's list ends: docs/hw-interface.md; a level
+// start with its rays and a hit update take one cycle, all lanes at once). Every
 // traversal request is issued to the RTL and to the model; the thread's next request (unit,
 // node, mask, list start), the lanes' segments and the cycle it leaves are compared, and the run
 // stops at the first difference with a one-line report.
@@ -17,6 +18,7 @@
 
 #include "fixedfloat/float.h"
 #include "memif/image_format.h"
+#include "rtl/port_bits.h"
 #include "units/fast_datapath.h"
 #include "units/packet_state.h"
 #include "units/reference_datapath.h"
@@ -25,7 +27,8 @@
 namespace saarcor::rtl::testing {
 
 using F = ff::fp24;
-inline constexpr int kLanes = 4;  // P of the default build
+inline constexpr int kLanes = 4;     // P of the default build
+inline constexpr int kThreads = 64;  // THREADS of every traversal_ctrl build
 using State = units::PacketState<F, kLanes, units::FastDatapath>;
 
 // The first difference between the RTL and the model.
@@ -42,9 +45,6 @@ struct TravRun {
   std::uint64_t requests = 0;  // traversal requests compared (clip chains count once)
   std::uint64_t node_steps = 0, clips = 0, pops = 0, leaves = 0, drops = 0, pushes_seen = 0;
   std::uint64_t cycles = 0;
-  // The first request that popped (or dropped) a stack entry with another below it: where a pop
-  // one entry off first reads the wrong entry.
-  std::uint64_t first_deep_pop = 0;
   TravDivergence first;
 };
 
@@ -82,8 +82,7 @@ class TravHarness {
   bool packet(S& s, std::uint32_t thread, bool shade = false) {
     ++run_.packets;
     thread_ = thread;
-    // Path b: the generated world rays and t_best, then the top level's start.
-    load_world(s);
+    // Path b: the top level's start with the generated world rays and t_best.
     start(s, false);
     for (;;) {
       const units::Phase ph = s.phase;
@@ -126,7 +125,6 @@ class TravHarness {
     ++run_.cycles;
     top_->ld_valid = 0;
     top_->hu_valid = 0;
-    top_->st_valid = 0;
     top_->is_valid = 0;
   }
   void settle() {
@@ -148,45 +146,38 @@ class TravHarness {
     return o.str();
   }
 
-  void load_world(const S& s) {
-    for (int i = 0; i < s.p; ++i) {
-      const auto& l = s.lane(i);
-      top_->ld_valid = 1;
-      top_->ld_thread = thread_;
-      top_->ld_lane = static_cast<std::uint32_t>(i);
-      top_->ld_object = 0;
-      set3(top_->ld_o, bits3(l.world.o));
-      set3(top_->ld_d, bits3(l.world.d));
-      top_->ld_tbest = l.hit.t.bits;
-      top_->ld_lane_valid = l.valid;
-      top_->ld_done = l.done;
-      tick();
-    }
-  }
-  void load_object(const S& s) {
-    for (int i = 0; i < s.p; ++i) {
-      const auto& l = s.lane(i);
-      top_->ld_valid = 1;
-      top_->ld_thread = thread_;
-      top_->ld_lane = static_cast<std::uint32_t>(i);
-      top_->ld_object = 1;
-      set3(top_->ld_o, bits3(l.current.o));
-      set3(top_->ld_d, bits3(l.current.d));
-      tick();
-    }
-  }
+  // Port 0 of the level start (path b) for the thread: the level's rays of every lane (the world
+  // rays with t_best, valid and done; or the object rays), and for a bottom level the object's
+  // box, root and entry mask.
   void start(const S& s, bool bottom) {
-    top_->st_valid = 1;
-    top_->st_thread = thread_;
-    top_->st_bottom = bottom;
-    top_->st_shadow = s.kind == units::RayKind::kShadow;
+    constexpr int kW = 24, kRay = 3 * kW;
+    top_->ld_valid = 1;
+    put_bits(top_->ld_thread, 0, thread_bits(kThreads), thread_);
+    top_->ld_bottom = bottom;
+    top_->ld_shadow = s.kind == units::RayKind::kShadow;
+    std::uint64_t valid = 0, done = 0;
+    for (int i = 0; i < s.p; ++i) {
+      const auto& l = s.lane(i);
+      const units::Ray<F>& ray = bottom ? l.current : l.world;
+      for (int k = 0; k < 3; ++k) {
+        put_bits(top_->ld_o, i * kRay + k * kW, kW, ray.o[static_cast<std::size_t>(k)].bits);
+        put_bits(top_->ld_d, i * kRay + k * kW, kW, ray.d[static_cast<std::size_t>(k)].bits);
+      }
+      put_bits(top_->ld_tbest, i * kW, kW, l.hit.t.bits);
+      valid |= std::uint64_t{l.valid} << i;
+      done |= std::uint64_t{l.done} << i;
+    }
+    put_bits(top_->ld_lane_valid, 0, s.p, valid);
+    put_bits(top_->ld_done, 0, s.p, done);
+    put_bits(top_->ld_mask, 0, s.p, bottom ? s.list.entry_mask() : 0);
     if (bottom) {
       const std::uint32_t row = s.list.instance_row();
       const auto lo = image_.row(row + 4), hi = image_.row(row + 5);
-      set3(top_->st_lo, {lo[0], lo[1], lo[2]});
-      set3(top_->st_hi, {hi[0], hi[1], hi[2]});
-      top_->st_root = s.list.header().root;
-      top_->st_mask = static_cast<std::uint32_t>(s.list.entry_mask());
+      for (int k = 0; k < 3; ++k) {
+        put_bits(top_->ld_lo, k * kW, kW, lo[static_cast<std::size_t>(k)]);
+        put_bits(top_->ld_hi, k * kW, kW, hi[static_cast<std::size_t>(k)]);
+      }
+      put_bits(top_->ld_root, 0, 28, s.list.header().root);
     }
     tick();
   }
@@ -273,9 +264,6 @@ class TravHarness {
 
   bool clip(S& s) {
     if (!check_request(s)) return false;
-    top_->dbg_thread = thread_;
-    settle();
-    size_before_ = top_->dbg_size;
     const std::uint64_t issue = cycle_;
     top_->is_valid = 1;
     top_->is_thread = thread_;
@@ -297,9 +285,6 @@ class TravHarness {
     if (!check_request(s) || !check_segments(s)) return false;
     const memif::KdNode n = image_.node(s.traversal.node());
     const auto w = memif::encode_node(n);
-    top_->dbg_thread = thread_;
-    settle();
-    size_before_ = top_->dbg_size;
     const std::uint64_t issue = cycle_;
     top_->is_valid = 1;
     top_->is_thread = thread_;
@@ -315,20 +300,8 @@ class TravHarness {
     return outcome(s, o, issue + static_cast<std::uint64_t>(lat_.depth));
   }
 
-  // The pop request a list's end sends (D49): the model's pop and the RTL's, side by side.
-  bool pop_request(S& s) {
-    const std::uint64_t drops0 = s.u.stack_drops;
-    s.traversal.pop(s);
-    drops_left_ = s.u.stack_drops - drops0;
-    run_.drops += drops_left_;
-    return pop(s);
-  }
-
-  // Issues a pop to the RTL (the model's has run) and compares its outcome.
+  // A pop the model ran in the list or intersection unit: the thread passes through the RTL.
   bool pop(S& s) {
-    top_->dbg_thread = thread_;
-    settle();
-    size_before_ = top_->dbg_size;
     const std::uint64_t issue = cycle_;
     top_->is_valid = 1;
     top_->is_thread = thread_;
@@ -340,31 +313,33 @@ class TravHarness {
 
   // The RTL's outcome against the model's state after the request. The thread leaves `due` =
   // issue + depth, one cycle later per stack entry dropped. A bottom level that ended inside the
-  // request goes back to the top level's list (dest 2), as the model's (D49).
+  // request goes back to the top level's list (dest 2); when the model popped the top level as
+  // well (that list was over), the RTL pops on, and the request's drops are split over the two.
   bool outcome(S& s, const Out& o, std::uint64_t due) {
     ++run_.requests;
     top_->dbg_thread = thread_;
     settle();
-    if (run_.first_deep_pop == 0 && top_->dbg_size < size_before_ && size_before_ >= 2)
-      run_.first_deep_pop = run_.requests;
     if (!o.valid)
       return fail("missing", top_->overflow ? "RTL stack overflow" : "the thread never left");
     const Phase ph = s.phase;
+    const bool more = o.dest == 2 && !(ph == Phase::kList || ph == Phase::kTransformObject);
     const std::uint64_t extra = o.cycle >= due ? o.cycle - due : ~std::uint64_t{0};
     // Shadow packets also drop entries whose rays are all done, which the model does not count:
     // there the RTL may leave later than the counted drops say, never earlier.
     const bool shadow = s.kind == units::RayKind::kShadow;
-    if (shadow ? (extra == ~std::uint64_t{0} || extra < drops_left_) : extra != drops_left_)
+    if (shadow ? (extra == ~std::uint64_t{0} || (!more && extra < drops_left_))
+               : (more ? extra > drops_left_ : extra != drops_left_))
       return fail("timing", "thread left in cycle " + std::to_string(o.cycle) + ", model " +
                                 std::to_string(due + drops_left_) + " (depth " +
                                 std::to_string(lat_.depth) + " + " + std::to_string(drops_left_) +
                                 " drops after the issue)");
     drops_left_ = drops_left_ > extra ? drops_left_ - extra : 0;
     if (o.dest == 2) {
-      // Back at the top level's list: the model's thread goes there too.
-      if (s.traversal.level() != units::Level::kTop || ph != Phase::kList)
+      // Back at the top level's list: the model continued there or popped the top level too.
+      if (s.traversal.level() != units::Level::kTop)
         return fail("payload", "RTL ended the object, the model is still in it");
-      return true;
+      if (!more) return true;
+      return pop(s);
     }
     switch (ph) {
       case Phase::kTraverse:
@@ -424,7 +399,6 @@ class TravHarness {
     }
     if (s.phase == Phase::kClipTop) {
       ++run_.packets;
-      load_world(s);
       start(s, false);
     }
   }
@@ -437,7 +411,6 @@ class TravHarness {
         break;
       case Phase::kTransformObject:
         s.transformation.object(s);
-        load_object(s);
         start(s, true);
         return true;
       case Phase::kTransformTriangle:
@@ -445,21 +418,34 @@ class TravHarness {
         return true;
       case Phase::kIntersect:
         s.intersection.step(s);
-        for (int i = 0; i < s.p; ++i) {
-          top_->hu_valid = 1;
-          top_->hu_thread = thread_;
-          top_->hu_lane = static_cast<std::uint32_t>(i);
-          top_->hu_tbest = s.lane(i).hit.t.bits;
-          top_->hu_done = s.lane(i).done;
-          tick();
-        }
+        hit_update(s);
         break;
       default:
         return true;
     }
-    // A list that ends sends the thread on with a pop request (Phase::kPop, D49): the loop
-    // in packet() issues it.
     return true;
+  }
+
+  // A list ended (Phase::kPop, on f or list -> traversal): the model's pop and the RTL's.
+  bool pop_request(S& s) {
+    const std::uint64_t drops0 = s.u.stack_drops;
+    s.traversal.pop(s);
+    drops_left_ = s.u.stack_drops - drops0;
+    run_.drops += drops_left_;
+    return pop(s);
+  }
+
+  // The hit update of every lane in one cycle.
+  void hit_update(const S& s) {
+    top_->hu_valid = 1;
+    top_->hu_thread = thread_;
+    std::uint64_t done = 0;
+    for (int i = 0; i < s.p; ++i) {
+      put_bits(top_->hu_tbest, i * 24, 24, s.lane(i).hit.t.bits);
+      done |= std::uint64_t{s.lane(i).done} << i;
+    }
+    put_bits(top_->hu_done, 0, s.p, done);
+    tick();
   }
 
   const memif::MemoryImage& image_;
@@ -467,9 +453,7 @@ class TravHarness {
   std::unique_ptr<V> top_;
   std::uint64_t cycle_ = 0;
   std::uint32_t thread_ = 0;
-  std::uint64_t drops_left_ = 0;
-  std::uint32_t size_before_ = 0;  // the thread's stack size at the request's issue  // the model's
-                                   // drops of the request not yet seen in the RTL
+  std::uint64_t drops_left_ = 0;  // the model's drops of the request not yet seen in the RTL
   TravRun run_;
 };
 

@@ -10,7 +10,9 @@
 //
 // A thread arriving on f or list -> traversal pops (docs/hw-interface.md: the model pops in the
 // list and intersection units; here the thread passes through the traversal unit for it).
-// FAULT_PRIO_SWAP (test only) swaps the priorities of f and b.
+// Test-only faults (0 in every real build): FAULT_PRIO_SWAP swaps the priorities of f and b;
+// FAULT_POP_OFF and FAULT_SHORT are traversal_ctrl's (a pop one entry off, a pipeline one cycle
+// short).
 module traversal_threads #(
     parameter int E               = 7,
     parameter int M               = 16,
@@ -24,9 +26,10 @@ module traversal_threads #(
     parameter bit SKIP_EMPTY      = 1'b1,
     parameter bit EXIT_ONLY       = 1'b1,
     parameter bit FAULT_PRIO_SWAP = 1'b0,
+    parameter bit FAULT_POP_OFF   = 1'b0,
+    parameter bit FAULT_SHORT     = 1'b0,
     localparam int W              = E + M + 1,
     localparam int TW             = THREADS > 1 ? $clog2(THREADS) : 1,
-    localparam int LW             = P > 1 ? $clog2(P) : 1,
     localparam int SW             = $clog2(STACK + 1)
 ) (
     input  logic              clk,
@@ -34,29 +37,26 @@ module traversal_threads #(
     input  logic [   3*W-1:0] scene_lo,
     input  logic [   3*W-1:0] scene_hi,
     input  logic [NODE_W-1:0] top_root,
-    // Path payloads written before the thread is pushed (traversal_ctrl's ports).
-    input  logic              ld_valid,
-    input  logic [    TW-1:0] ld_thread,
-    input  logic [    LW-1:0] ld_lane,
-    input  logic              ld_object,
-    input  logic [   3*W-1:0] ld_o,
-    input  logic [   3*W-1:0] ld_d,
-    input  logic [     W-1:0] ld_tbest,
-    input  logic              ld_lane_valid,
-    input  logic              ld_done,
-    input  logic              hu_valid,
-    input  logic [    TW-1:0] hu_thread,
-    input  logic [    LW-1:0] hu_lane,
-    input  logic [     W-1:0] hu_tbest,
-    input  logic              hu_done,
-    input  logic              st_valid,
-    input  logic [    TW-1:0] st_thread,
-    input  logic              st_bottom,
-    input  logic              st_shadow,
-    input  logic [     P-1:0] st_mask,
-    input  logic [   3*W-1:0] st_lo,
-    input  logic [   3*W-1:0] st_hi,
-    input  logic [NODE_W-1:0] st_root,
+    // Path payloads in the cycle the thread is pushed (traversal_ctrl's ports): the level start
+    // with its rays on b (port 0) and RGS -> traversal (port 1); the hit update as the thread
+    // leaves the intersection unit.
+    input  logic [1:0]                  ld_valid,
+    input  logic [1:0][TW-1:0]          ld_thread,
+    input  logic [1:0]                  ld_bottom,
+    input  logic [1:0]                  ld_shadow,
+    input  logic [1:0][P-1:0]           ld_mask,
+    input  logic [1:0][3*W-1:0]         ld_lo,
+    input  logic [1:0][3*W-1:0]         ld_hi,
+    input  logic [1:0][NODE_W-1:0]      ld_root,
+    input  logic [1:0][P-1:0][3*W-1:0]  ld_o,
+    input  logic [1:0][P-1:0][3*W-1:0]  ld_d,
+    input  logic [1:0][P-1:0][W-1:0]    ld_tbest,
+    input  logic [1:0][P-1:0]           ld_lane_valid,
+    input  logic [1:0][P-1:0]           ld_done,
+    input  logic                        hu_valid,
+    input  logic [TW-1:0]               hu_thread,
+    input  logic [P-1:0][W-1:0]         hu_tbest,
+    input  logic [P-1:0]                hu_done,
     // Input paths (a thread pushed this cycle).
     input  logic              f_valid,
     input  logic [    TW-1:0] f_thread,
@@ -75,11 +75,13 @@ module traversal_threads #(
     input  logic [    TW-1:0] resp_thread,
     input  logic [      31:0] resp_w0,
     input  logic [      31:0] resp_w1,
-    // Leaving threads (dest 1: leaf to the list unit, 2: the top level's list, 3: the RGS); port
-    // 2 carries pops that dropped stack entries.
+    // Leaving threads (dest 0: the unit's own loop, taken back inside; 1: leaf to the list unit,
+    // 2: the top level's list, 3: the RGS); port 2 carries pops that dropped stack entries. The
+    // fields a destination does not carry are 0 (traversal_ctrl).
     output logic              out_valid,
     output logic [    TW-1:0] out_thread,
     output logic [       1:0] out_dest,
+    output logic [NODE_W-1:0] out_node,
     output logic [      31:0] out_first,
     output logic [      31:0] out_end,
     output logic [     P-1:0] out_mask,
@@ -87,10 +89,16 @@ module traversal_threads #(
     output logic              out2_valid,
     output logic [    TW-1:0] out2_thread,
     output logic [       1:0] out2_dest,
+    output logic [NODE_W-1:0] out2_node,
+    output logic [     P-1:0] out2_mask,
+    output logic              out2_level,
     // The issue slot, for tests: the thread issued this cycle.
     output logic              iss_valid,
     output logic [    TW-1:0] iss_thread,
     output logic              overflow,
+    // A thread's stack size, for tests.
+    input  logic [    TW-1:0] dbg_thread,
+    output logic [    SW-1:0] dbg_size,
     // The parameters, as constants: a test pins them to the cycle model's table.
     output logic [      15:0] par_packet,
     output logic [      15:0] par_threads,
@@ -106,7 +114,7 @@ module traversal_threads #(
   assign par_skip_empty = SKIP_EMPTY;
   assign par_exit_only = EXIT_ONLY;
   localparam int Depth = LAT_ADD + LAT_DIV + LAT_CMP;
-  localparam int Inputs = 6;  // loop, loop (late pops), f, list, RGS, b
+  localparam int Inputs = 5;  // loop, f, list, RGS, b
 
   // ---- per-thread: what the accepted request is, the node words it fetched ------------------
   localparam logic [1:0] KNode = 2'd0, KClip = 2'd1, KPop = 2'd2;
@@ -122,8 +130,6 @@ module traversal_threads #(
   /* verilator lint_off UNUSEDSIGNAL */
   logic [2:0] rq_face;  // the clip face and mask: the lockstep monitor's, not the machinery's
   logic [P-1:0] rq_mask;
-  logic [NODE_W-1:0] c_out_node, c_out2_node;  // the loop's node: the thread's own request
-  logic [P-1:0] c_out2_mask;
   /* verilator lint_on UNUSEDSIGNAL */
   logic c_busy, c_chain;
   logic c_out_valid, c_out2_valid;
@@ -133,45 +139,43 @@ module traversal_threads #(
   logic [TW-1:0] ut_iss_thread;
   /* verilator lint_off UNUSEDSIGNAL */
   logic [W-1:0] dbg_tn, dbg_tf, dbg_ctn, dbg_ctf;
-  logic [SW-1:0] dbg_size;
   logic dbg_level;
   /* verilator lint_on UNUSEDSIGNAL */
 
   traversal_ctrl #(
       .E(E), .M(M), .LAT_ADD(LAT_ADD), .LAT_DIV(LAT_DIV), .LAT_CMP(LAT_CMP), .P(P),
       .THREADS(THREADS), .STACK(STACK), .NODE_W(NODE_W), .SKIP_EMPTY(SKIP_EMPTY),
-      .EXIT_ONLY(EXIT_ONLY)
+      .EXIT_ONLY(EXIT_ONLY), .FAULT_POP_OFF(FAULT_POP_OFF), .FAULT_SHORT(FAULT_SHORT)
   ) u_core (
       .clk, .rst, .scene_lo, .scene_hi, .top_root,
-      .ld_valid, .ld_thread, .ld_lane, .ld_object, .ld_o, .ld_d, .ld_tbest, .ld_lane_valid,
-      .ld_done, .hu_valid, .hu_thread, .hu_lane, .hu_tbest, .hu_done,
-      .st_valid, .st_thread, .st_bottom, .st_shadow, .st_mask, .st_lo, .st_hi, .st_root,
+      .ld_valid, .ld_thread, .ld_bottom, .ld_shadow, .ld_mask, .ld_lo, .ld_hi, .ld_root, .ld_o,
+      .ld_d, .ld_tbest, .ld_lane_valid, .ld_done, .hu_valid, .hu_thread, .hu_tbest, .hu_done,
       .rq_thread(acc_thread), .rq_clip, .rq_face, .rq_node, .rq_mask,
       .is_valid(ut_iss_valid && !c_busy), .is_thread(ut_iss_thread),
       .is_kind(kind_r[ut_iss_thread]), .is_w0(w0_r[ut_iss_thread]), .is_w1(w1_r[ut_iss_thread]),
       .is_busy(c_busy), .is_chain(c_chain),
       .out_valid(c_out_valid), .out_thread(c_out_thread), .out_dest(c_out_dest),
-      .out_node(c_out_node), .out_first, .out_end, .out_mask, .out_level,
+      .out_node, .out_first, .out_end, .out_mask, .out_level,
       .out2_valid(c_out2_valid), .out2_thread(c_out2_thread), .out2_dest(c_out2_dest),
-      .out2_node(c_out2_node), .out2_mask(c_out2_mask), .overflow,
-      .dbg_thread('0), .dbg_lane('0), .dbg_tn, .dbg_tf, .dbg_ctn, .dbg_ctf, .dbg_size, .dbg_level
+      .out2_node, .out2_mask, .out2_level, .overflow,
+      .dbg_thread, .dbg_lane('0), .dbg_tn, .dbg_tf, .dbg_ctn, .dbg_ctf, .dbg_size, .dbg_level
   );
 
   // ---- the thread machinery --------------------------------------------------------------------
   logic [Inputs-1:0] in_valid;
   logic [Inputs*TW-1:0] in_thread;  // path i's thread at [i*TW +: TW]
-  localparam int PathF = FAULT_PRIO_SWAP ? 5 : 2, PathB = FAULT_PRIO_SWAP ? 2 : 5;
+  localparam int PathF = FAULT_PRIO_SWAP ? 4 : 1, PathB = FAULT_PRIO_SWAP ? 1 : 4;
   always_comb begin
-    in_valid[0] = c_out_valid && c_out_dest == 2'd0;
-    in_thread[0+:TW] = c_out_thread;
-    in_valid[1] = c_out2_valid && c_out2_dest == 2'd0;
-    in_thread[TW+:TW] = c_out2_thread;
+    // One loop path, as the model's: the two output ports never send to the same unit in one
+    // cycle (traversal_ctrl holds the pop queue's head), so its threads queue in arrival order.
+    in_valid[0] = (c_out_valid && c_out_dest == 2'd0) || (c_out2_valid && c_out2_dest == 2'd0);
+    in_thread[0+:TW] = c_out_valid && c_out_dest == 2'd0 ? c_out_thread : c_out2_thread;
     in_valid[PathF] = f_valid;
     in_thread[PathF*TW+:TW] = f_thread;
-    in_valid[3] = l_valid;
-    in_thread[3*TW+:TW] = l_thread;
-    in_valid[4] = r_valid;
-    in_thread[4*TW+:TW] = r_thread;
+    in_valid[2] = l_valid;
+    in_thread[2*TW+:TW] = l_thread;
+    in_valid[3] = r_valid;
+    in_thread[3*TW+:TW] = r_thread;
     in_valid[PathB] = b_valid;
     in_thread[PathB*TW+:TW] = b_thread;
   end
@@ -199,10 +203,10 @@ module traversal_threads #(
   assign iss_valid = ut_iss_valid;
   assign iss_thread = ut_iss_thread;
 
-  assign out_valid = c_out_valid && c_out_dest != 2'd0;
+  assign out_valid = c_out_valid;
   assign out_thread = c_out_thread;
   assign out_dest = c_out_dest;
-  assign out2_valid = c_out2_valid && c_out2_dest != 2'd0;
+  assign out2_valid = c_out2_valid;
   assign out2_thread = c_out2_thread;
   assign out2_dest = c_out2_dest;
 

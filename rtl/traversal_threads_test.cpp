@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "Vtraversal_threads.h"
-#include "Vtraversal_threads_prio_swap.h"
+#include "Vtrav_proto.h"
+#include "Vtrav_proto_fault_priority.h"
 #include "host/image_builder.h"
 #include "host/scene.h"
 #include "rtl/traversal_ctrl_testing.h"
@@ -76,25 +76,27 @@ class Rig {
   }
   ~Rig() { top_->final(); }
 
-  // Path b's payload for `thread` (the packet's world rays) and its top level's start.
+  // Path b's payload for `thread` (the packet's world rays) and its top level's start, in one
+  // cycle (load port 0).
   void load(std::uint32_t thread) {
+    top_->ld_valid = 1;
+    put_bits(top_->ld_thread, 0, thread_bits(kThreads), thread);
+    top_->ld_bottom = 0;
+    top_->ld_shadow = 0;
+    std::uint64_t valid = 0, done = 0;
     for (int i = 0; i < pk_.s->p; ++i) {
       const auto& l = pk_.s->lane(i);
-      top_->ld_valid = 1;
-      top_->ld_thread = thread;
-      top_->ld_lane = static_cast<std::uint32_t>(i);
-      top_->ld_object = 0;
-      set3(top_->ld_o, {l.world.o[0].bits, l.world.o[1].bits, l.world.o[2].bits});
-      set3(top_->ld_d, {l.world.d[0].bits, l.world.d[1].bits, l.world.d[2].bits});
-      top_->ld_tbest = l.hit.t.bits;
-      top_->ld_lane_valid = l.valid;
-      top_->ld_done = l.done;
-      step();
+      for (int k = 0; k < 3; ++k) {
+        const auto a = static_cast<std::size_t>(k);
+        put_bits(top_->ld_o, i * 72 + k * 24, 24, l.world.o[a].bits);
+        put_bits(top_->ld_d, i * 72 + k * 24, 24, l.world.d[a].bits);
+      }
+      put_bits(top_->ld_tbest, i * 24, 24, l.hit.t.bits);
+      valid |= std::uint64_t{l.valid} << i;
+      done |= std::uint64_t{l.done} << i;
     }
-    top_->st_valid = 1;
-    top_->st_thread = thread;
-    top_->st_bottom = 0;
-    top_->st_shadow = 0;
+    put_bits(top_->ld_lane_valid, 0, pk_.s->p, valid);
+    put_bits(top_->ld_done, 0, pk_.s->p, done);
     step();
   }
   std::uint64_t cycle() const { return cycle_; }
@@ -153,7 +155,6 @@ class Rig {
     top_->clk = 1;
     top_->eval();
     top_->ld_valid = 0;
-    top_->st_valid = 0;
     top_->b_valid = 0;
     top_->f_valid = 0;
     top_->l_valid = 0;
@@ -183,7 +184,7 @@ int depth() {
 // top level is a single leaf: for the list unit).
 TEST(RtlTraversalThreads, ClipThenRootFetchAtSumsOfLatencies) {
   const Packet pk;
-  Rig<Vtraversal_threads> rig(pk);
+  Rig<Vtrav_proto> rig(pk);
   rig.load(5);
   const std::uint64_t pushed = rig.cycle();
   rig.push_b(5);
@@ -234,7 +235,7 @@ std::vector<Event> two_paths(const Packet& pk) {
 
 TEST(RtlTraversalThreads, HigherPriorityPathIsIssuedFirst) {
   const Packet pk;
-  const auto ev = two_paths<Vtraversal_threads>(pk);
+  const auto ev = two_paths<Vtrav_proto>(pk);
   const auto issues = of(ev, "issue");
   ASSERT_GE(issues.size(), 2u);
   const std::uint64_t pushed = issues[0].cycle - kPathLatency - kReadyToIssue;
@@ -254,7 +255,7 @@ TEST(RtlTraversalThreads, HigherPriorityPathIsIssuedFirst) {
 // clip.exit_only (only clip.faces_per_step = 1 is built).
 TEST(RtlTraversalThreads, ParametersAreTheCycleModelsDefaults) {
   const units::CycleParams p = units::prototype_params();
-  auto top = std::make_unique<Vtraversal_threads>();
+  auto top = std::make_unique<Vtrav_proto>();
   top->eval();
   EXPECT_EQ(top->par_packet, p.packet);
   EXPECT_EQ(top->par_threads, p.threads);
@@ -268,8 +269,8 @@ TEST(RtlTraversalThreads, ParametersAreTheCycleModelsDefaults) {
 
 TEST(RtlTraversalThreadsFaults, SwappedPrioritiesAreCaughtAtTheFirstIssue) {
   const Packet pk;
-  const auto good = two_paths<Vtraversal_threads>(pk);
-  const auto bad = two_paths<Vtraversal_threads_prio_swap>(pk);
+  const auto good = two_paths<Vtrav_proto>(pk);
+  const auto bad = two_paths<Vtrav_proto_fault_priority>(pk);
   std::size_t k = 0;
   while (k < good.size() && k < bad.size() && good[k] == bad[k])
     ++k;

@@ -28,6 +28,21 @@ std::string format_boundary(const BoundaryEvent& e) {
     std::snprintf(v, sizeof v, "%llx", static_cast<unsigned long long>(e.field[k]));
     s << " " << (e.names != nullptr ? e.names[k] : "?") << "=" << v;
   }
+  if (!e.wide.empty()) {
+    // FNV-1a over the words: two records with the same checksum carry the same words (as far as
+    // one line can tell).
+    std::uint32_t sum = 2166136261u;
+    s << " wide[" << e.wide.size() << "]=";
+    for (std::size_t k = 0; k < e.wide.size(); ++k) {
+      sum = (sum ^ e.wide[k]) * 16777619u;
+      char v[16];
+      std::snprintf(v, sizeof v, "%x", static_cast<unsigned>(e.wide[k]));
+      if (k < 8) s << (k != 0 ? "," : "") << v;
+    }
+    char v[16];
+    std::snprintf(v, sizeof v, "%08x", static_cast<unsigned>(sum));
+    s << (e.wide.size() > 8 ? ",..." : "") << " sum=" << v;
+  }
   return s.str();
 }
 
@@ -46,6 +61,17 @@ void RequestPayload::input(UnitId, UnitId, ThreadToken t, BoundaryEvent& e) {
 }
 void RequestPayload::output(UnitId, ThreadToken t, BoundaryEvent& e) {
   request_fields(threads_.request(t), e);
+}
+
+bool UnitPayloads::side_band(UnitId to, UnitId from, ThreadToken t, BoundaryEvent& side) {
+  for (BoundaryPayload* p : of_)
+    if (p != nullptr && p->side_band(to, from, t, side)) return true;
+  return false;
+}
+
+void UnitPayloads::issued(UnitId unit, ThreadToken t, const Request& r) {
+  for (BoundaryPayload* p : of_)
+    if (p != nullptr) p->issued(unit, t, r);
 }
 
 BoundaryRecorder::BoundaryRecorder(const ThreadTable& threads, int threads_per_pipeline,
@@ -79,6 +105,7 @@ void BoundaryRecorder::queued(std::uint64_t cycle, UnitId to, ThreadToken t) {
     e.fields = side.fields;
     e.field = side.field;
     e.names = side.names;
+    e.wide = std::move(side.wide);
     sink_(e);
   }
   if (!recorded(to)) return;

@@ -50,9 +50,13 @@ struct BoundaryEvent {
   std::array<std::uint64_t, kBoundaryFields> field{};
   // The fields' names (static storage, `fields` of them): payload-specific.
   const char* const* names = nullptr;
+  // The words of a wide payload (a path that carries rays: the traversal unit's level start and
+  // hit update, units/boundary_traversal.h); empty for the others.
+  std::vector<std::uint32_t> wide;
 };
 
-// One line: cycle, dynrtp, unit, port, thread, path, name=value (hex) for each field.
+// One line: cycle, dynrtp, unit, port, thread, path, name=value (hex) for each field, then the
+// wide words (their count, the first eight in hex and a checksum of all).
 std::string format_boundary(const BoundaryEvent& e);
 
 // What a unit carries on its ports. Called from the recorder's hooks, in cycle order.
@@ -82,6 +86,34 @@ class RequestPayload final : public BoundaryPayload {
 
  private:
   const ThreadTable& threads_;
+};
+
+// Each unit's payload from its own BoundaryPayload (the others: RequestPayload), so several units
+// are recorded at once. A hand-over is a side-band event of at most one unit (the packet start
+// goes to the transformation unit, the hit update comes from the intersection unit): the first
+// payload that claims it wins.
+class UnitPayloads final : public BoundaryPayload {
+ public:
+  explicit UnitPayloads(const ThreadTable& threads) : fallback_(threads) {}
+  void set(UnitId unit, BoundaryPayload& p) {
+    of_[static_cast<std::size_t>(unit_index(unit))] = &p;
+  }
+  void input(UnitId unit, UnitId from, ThreadToken t, BoundaryEvent& e) override {
+    payload(unit).input(unit, from, t, e);
+  }
+  bool side_band(UnitId to, UnitId from, ThreadToken t, BoundaryEvent& side) override;
+  void issued(UnitId unit, ThreadToken t, const Request& r) override;
+  void output(UnitId unit, ThreadToken t, BoundaryEvent& e) override {
+    payload(unit).output(unit, t, e);
+  }
+
+ private:
+  BoundaryPayload& payload(UnitId u) {
+    BoundaryPayload* p = of_[static_cast<std::size_t>(unit_index(u))];
+    return p != nullptr ? *p : fallback_;
+  }
+  RequestPayload fallback_;
+  std::array<BoundaryPayload*, kMaxUnits> of_{};
 };
 
 // The model's side of the record: a UnitObserver on every unit of a DynRTP (DynRtp::observe)

@@ -123,5 +123,74 @@ TEST(BoundaryRecord, ListUnitEventsInTheCyclesOfTheTimingRules) {
                 " dynrtp0 list output thread 1 to transformation phase=4 item=1e mask=f");
 }
 
+// A wide payload prints its word count, the words (the first eight) and their FNV-1a checksum:
+// 2166136261 ^ 0x3f8000, times 16777619 (mod 2^32) = 0x0f47dd1f; ^ 0x400000, times 16777619 =
+// 0xc86117cd.
+TEST(BoundaryRecord, WideWordsPrintCompactly) {
+  BoundaryEvent e;
+  e.cycle = 7;
+  e.unit = UnitId::kTraversal;
+  e.port = BoundaryPort::kSideBand;
+  e.thread = 3;
+  static constexpr const char* kNames[] = {"done"};
+  e.fields = 1;
+  e.names = kNames;
+  e.field[0] = 2;
+  e.wide = {0x3f8000, 0x400000};
+  EXPECT_EQ(format_boundary(e),
+            "cycle 7 dynrtp0 traversal side_band thread 3 done=2 wide[2]=3f8000,400000 "
+            "sum=c86117cd");
+  e.wide.assign(9, 0);
+  EXPECT_NE(format_boundary(e).find("wide[9]=0,0,0,0,0,0,0,0,... sum="), std::string::npos);
+}
+
+// Several units recorded at once: each unit's events carry its own payload, the others the
+// thread program's request; the issue of any unit reaches every payload.
+class Tagged final : public BoundaryPayload {
+ public:
+  explicit Tagged(std::uint64_t tag) : tag_(tag) {}
+  void input(UnitId, UnitId, ThreadToken, BoundaryEvent& e) override {
+    e.fields = 1;
+    e.field[0] = tag_;
+  }
+  bool side_band(UnitId, UnitId from, ThreadToken, BoundaryEvent& side) override {
+    side.unit = UnitId::kTraversal;
+    return from == UnitId::kIntersection && tag_ == 2;
+  }
+  void issued(UnitId, ThreadToken, const Request&) override { ++issues; }
+  void output(UnitId, ThreadToken, BoundaryEvent& e) override {
+    e.fields = 1;
+    e.field[0] = tag_ + 10;
+  }
+  int issues = 0;
+
+ private:
+  std::uint64_t tag_;
+};
+
+TEST(BoundaryRecord, UnitPayloadsDispatchByUnit) {
+  hw::Kernel k;
+  const Request r{UnitId::kList, Phase::kList, 11, 1, kMask};
+  testing::ScriptedThreads threads(k, {{r}});
+  Tagged list(1), traversal(2);
+  UnitPayloads p(threads);
+  p.set(UnitId::kList, list);
+  p.set(UnitId::kTraversal, traversal);
+  BoundaryEvent e;
+  p.input(UnitId::kList, UnitId::kTraversal, 0, e);
+  EXPECT_EQ(e.field[0], 1u);
+  p.output(UnitId::kTraversal, 0, e);
+  EXPECT_EQ(e.field[0], 12u);
+  p.input(UnitId::kIntersection, UnitId::kTransformation, 0, e);  // the request: phase, item
+  EXPECT_EQ(e.fields, 3);
+  EXPECT_EQ(e.field[1], 11u);
+  p.issued(UnitId::kRgs, 0, r);
+  EXPECT_EQ(list.issues + traversal.issues, 2);
+  BoundaryEvent side;
+  EXPECT_TRUE(p.side_band(UnitId::kList, UnitId::kIntersection, 0, side));
+  EXPECT_EQ(side.unit, UnitId::kTraversal);
+  EXPECT_FALSE(p.side_band(UnitId::kList, UnitId::kList, 0, side));
+}
+
 }  // namespace
 }  // namespace saarcor::units

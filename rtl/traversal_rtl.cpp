@@ -1,0 +1,300 @@
+// The Verilated traversal unit builds (rtl/traversal_rtl.h). The builds and their parameters come
+// from one list in rtl/CMakeLists.txt, which generates rtl_traversal_builds.h (the Verilated
+// headers and the table below) and passes the same values to Verilator as -G parameters.
+#include "rtl/traversal_rtl.h"
+
+#include <array>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+#include "rtl/port_bits.h"
+#include "rtl_traversal_builds.h"
+#include "units/boundary_traversal.h"
+#include "verilated.h"
+#include "verilated_vcd_c.h"
+
+namespace saarcor::rtl {
+namespace {
+
+using units::BoundaryEvent;
+using units::BoundaryPort;
+using units::UnitId;
+
+constexpr int kW = 24;         // fp24: the builds' float format
+constexpr int kRay = 3 * kW;   // O or D of one lane
+constexpr int kNodeBits = 28;  // NODE_W
+constexpr int kLoadPorts = 2;  // 0: path b (the transformation unit), 1: RGS -> traversal
+
+// The input path a sending unit's thread arrives on (f, list -> traversal, RGS -> traversal, b);
+// -1 for the unit's own loop, which the RTL closes itself.
+int input_path(UnitId from) {
+  switch (from) {
+    case UnitId::kTraversal:
+      return -1;
+    case UnitId::kIntersection:
+      return 0;
+    case UnitId::kList:
+      return 1;
+    case UnitId::kRgs:
+      return 2;
+    case UnitId::kTransformation:
+      return 3;
+    default:
+      throw std::logic_error(
+          std::string("lockstep: a thread reached the traversal unit from the ") +
+          units::unit_name(from) + " unit, which has no path to it");
+  }
+}
+
+template <class V>
+class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
+ public:
+  TraversalRtlOf(const TraversalBuild& b, const memif::FrameRegisters& frame)
+      : tw_(thread_bits(b.threads)), p_(b.packet), ctx_(std::make_unique<VerilatedContext>()) {
+    ctx_->traceEverOn(true);
+    v_ = std::make_unique<V>(ctx_.get());
+    for (int k = 0; k < 3; ++k) {
+      const auto a = static_cast<std::size_t>(k);
+      put_bits(v_->scene_lo, k * kW, kW, frame.scene_min[a]);
+      put_bits(v_->scene_hi, k * kW, kW, frame.scene_max[a]);
+    }
+    v_->top_root = frame.top_root;
+  }
+  // The context goes with the model; Verilator's thread context (which the models built without
+  // one of their own use) must not be left pointing at it.
+  ~TraversalRtlOf() override {
+    stop_trace();
+    v_.reset();
+    ctx_.reset();
+    Verilated::threadContextp(Verilated::defaultContextp());
+  }
+
+  UnitId unit() const override { return UnitId::kTraversal; }
+
+  void reset() override {
+    v_->rst = 1;
+    for (int i = 0; i < 2; ++i) {
+      v_->clk = 0;
+      v_->eval();
+      v_->clk = 1;
+      v_->eval();
+    }
+    v_->rst = 0;
+    cycle_ = 0;
+  }
+
+  void cycle(std::uint64_t cycle, const std::vector<BoundaryEvent>& inputs,
+             std::vector<BoundaryEvent>& outputs) override {
+    V& v = *v_;
+    clear_inputs();
+    for (const BoundaryEvent& e : inputs)
+      drive(e);
+    v.clk = 0;
+    v.eval();
+    if (vcd_) vcd_->dump(2 * cycle_);
+    if (v.req_valid && v.req_ready) {
+      BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, v.req_thread);
+      e.fields = 3;
+      e.names = units::kCacheRequestFields;
+      e.field[0] = v.req_item;
+      e.field[1] = static_cast<std::uint64_t>(units::unit_index(UnitId::kTraversal));
+      e.field[2] = v.req_thread;
+    }
+    if (v.out_valid)
+      leaving(outputs, cycle, v.out_thread, v.out_dest,
+              {v.out_node, v.out_first, v.out_end, get_bits(v.out_mask, 0, p_), v.out_level});
+    if (v.out2_valid)
+      leaving(outputs, cycle, v.out2_thread, v.out2_dest,
+              {v.out2_node, 0, 0, get_bits(v.out2_mask, 0, p_), v.out2_level});
+    v.clk = 1;
+    v.eval();
+    if (vcd_) vcd_->dump(2 * cycle_ + 1);
+    ++cycle_;
+  }
+
+  int stack_size(std::uint32_t thread) override {
+    v_->dbg_thread = static_cast<std::remove_reference_t<decltype(v_->dbg_thread)>>(thread);
+    v_->eval();
+    return static_cast<int>(v_->dbg_size);
+  }
+
+  void start_trace(const std::string& path) override {
+    stop_trace();
+    vcd_ = std::make_unique<VerilatedVcdC>();
+    v_->trace(vcd_.get(), 99);
+    vcd_->open(path.c_str());
+    if (!vcd_->isOpen()) throw std::runtime_error("cannot write the waveform " + path);
+  }
+  void stop_trace() override {
+    if (!vcd_) return;
+    vcd_->close();
+    vcd_.reset();
+  }
+
+ private:
+  void clear_inputs() {
+    V& v = *v_;
+    v.ld_valid = 0;
+    v.hu_valid = 0;
+    v.f_valid = 0;
+    v.l_valid = 0;
+    v.r_valid = 0;
+    v.b_valid = 0;
+    v.resp_valid = 0;
+    v.req_ready = 1;
+  }
+
+  // One input event of the model's traversal unit onto the ports.
+  void drive(const BoundaryEvent& e) {
+    V& v = *v_;
+    switch (e.port) {
+      case BoundaryPort::kInput:
+        return arrive(e);
+      case BoundaryPort::kSideBand:
+        return hit_update(e);
+      case BoundaryPort::kCacheBlocked:
+        v.req_ready = 0;
+        return;
+      case BoundaryPort::kCacheResponse:
+        v.resp_valid = 1;
+        v.resp_thread = static_cast<std::remove_reference_t<decltype(v.resp_thread)>>(e.thread);
+        v.resp_w0 = static_cast<std::uint32_t>(e.field[1]);
+        v.resp_w1 = static_cast<std::uint32_t>(e.field[2]);
+        return;
+      default:
+        throw std::logic_error("lockstep: an output event given to the traversal unit as an input");
+    }
+  }
+
+  // A thread pushed on one of the input paths (with its level start on b and RGS -> traversal).
+  void arrive(const BoundaryEvent& e) {
+    V& v = *v_;
+    const int path = input_path(e.path);
+    if (path < 0) return;  // the unit's own loop: the RTL takes its thread back itself
+    const auto t = static_cast<std::uint32_t>(e.thread);
+    const auto taken = [](auto& valid) {
+      if (valid)
+        throw std::logic_error("lockstep: two threads on one traversal unit path in a cycle");
+      valid = 1;
+    };
+    using TW = std::remove_reference_t<decltype(v.f_thread)>;
+    switch (path) {
+      case 0:
+        taken(v.f_valid);
+        v.f_thread = static_cast<TW>(t);
+        return;
+      case 1:
+        taken(v.l_valid);
+        v.l_thread = static_cast<TW>(t);
+        return;
+      case 2:
+        taken(v.r_valid);
+        v.r_thread = static_cast<TW>(t);
+        return load(1, e);
+      default:
+        taken(v.b_valid);
+        v.b_thread = static_cast<TW>(t);
+        return load(0, e);
+    }
+  }
+
+  // Load port k: the level start's fields and the lanes' rays (units/boundary_traversal.h).
+  void load(int k, const BoundaryEvent& e) {
+    V& v = *v_;
+    const bool bottom = e.field[1] != 0;
+    const std::size_t words =
+        static_cast<std::size_t>(p_ * units::kTraversalLaneWords) + (bottom ? 6u : 0u);
+    if (e.fields != 7 || e.field[0] != 0 || e.wide.size() != words)
+      throw std::logic_error("lockstep: a level start without its " + std::to_string(words) +
+                             " words for the traversal unit");
+    put_bits(v.ld_valid, k, 1, 1);
+    put_bits(v.ld_thread, k * tw_, tw_, e.thread);
+    put_bits(v.ld_bottom, k, 1, e.field[1]);
+    put_bits(v.ld_shadow, k, 1, e.field[2]);
+    put_bits(v.ld_lane_valid, k * p_, p_, e.field[3]);
+    put_bits(v.ld_done, k * p_, p_, e.field[4]);
+    put_bits(v.ld_mask, k * p_, p_, e.field[5]);
+    put_bits(v.ld_root, k * kNodeBits, kNodeBits, e.field[6]);
+    for (int i = 0; i < p_; ++i) {
+      const std::uint32_t* w = &e.wide[static_cast<std::size_t>(i * units::kTraversalLaneWords)];
+      const int lane = (k * p_ + i) * kRay;
+      for (int a = 0; a < 3; ++a) {
+        put_bits(v.ld_o, lane + a * kW, kW, w[a]);
+        put_bits(v.ld_d, lane + a * kW, kW, w[3 + a]);
+      }
+      put_bits(v.ld_tbest, (k * p_ + i) * kW, kW, w[6]);
+    }
+    const std::size_t box = static_cast<std::size_t>(p_ * units::kTraversalLaneWords);
+    for (int a = 0; a < 3; ++a) {
+      const auto s = static_cast<std::size_t>(a);
+      put_bits(v.ld_lo, k * kRay + a * kW, kW, bottom ? e.wide[box + s] : 0);
+      put_bits(v.ld_hi, k * kRay + a * kW, kW, bottom ? e.wide[box + 3 + s] : 0);
+    }
+  }
+
+  // The hit update: every lane's t_best and done.
+  void hit_update(const BoundaryEvent& e) {
+    V& v = *v_;
+    if (v.hu_valid) throw std::logic_error("lockstep: two hit updates in one cycle");
+    if (e.fields != 1 || e.wide.size() != static_cast<std::size_t>(p_))
+      throw std::logic_error("lockstep: a hit update without its " + std::to_string(p_) +
+                             " words for the traversal unit");
+    v.hu_valid = 1;
+    v.hu_thread = static_cast<std::remove_reference_t<decltype(v.hu_thread)>>(e.thread);
+    put_bits(v.hu_done, 0, p_, e.field[0]);
+    for (int i = 0; i < p_; ++i)
+      put_bits(v.hu_tbest, i * kW, kW, e.wide[static_cast<std::size_t>(i)]);
+  }
+
+  // A thread leaving on an output port: {node, first, end, mask, level} after the destination.
+  static void leaving(std::vector<BoundaryEvent>& out, std::uint64_t cycle, std::uint32_t thread,
+                      std::uint32_t dest, const std::array<std::uint64_t, 5>& f) {
+    constexpr UnitId kTo[] = {UnitId::kTraversal, UnitId::kList, UnitId::kList, UnitId::kRgs};
+    BoundaryEvent& e = event(out, cycle, BoundaryPort::kOutput, thread);
+    e.path = kTo[dest & 3u];
+    e.fields = 6;
+    e.names = units::kTraversalOutputFields;
+    e.field = {dest, f[0], f[1], f[2], f[3], f[4]};
+  }
+
+  static BoundaryEvent& event(std::vector<BoundaryEvent>& v, std::uint64_t cycle, BoundaryPort port,
+                              std::uint32_t thread) {
+    BoundaryEvent& e = v.emplace_back();
+    e.cycle = cycle;
+    e.unit = UnitId::kTraversal;
+    e.port = port;
+    e.thread = thread;
+    return e;
+  }
+
+  int tw_, p_;
+  std::unique_ptr<VerilatedContext> ctx_;
+  std::unique_ptr<V> v_;
+  std::unique_ptr<VerilatedVcdC> vcd_;
+  std::uint64_t cycle_ = 0;
+};
+
+}  // namespace
+
+const std::vector<TraversalBuild>& traversal_builds() {
+  static const std::vector<TraversalBuild> b = {
+#define SAARCOR_TRAVERSAL_BUILD(id, cls, threads, packet, stack, add, div, cmp, fault) \
+  {#id, threads, packet, stack, add, div, cmp, fault},
+      SAARCOR_TRAVERSAL_BUILDS(SAARCOR_TRAVERSAL_BUILD)
+#undef SAARCOR_TRAVERSAL_BUILD
+  };
+  return b;
+}
+
+std::unique_ptr<UnitRtl> make_traversal_unit_rtl(const TraversalBuild& build,
+                                                 const memif::FrameRegisters& frame) {
+#define SAARCOR_TRAVERSAL_BUILD(id, cls, threads, packet, stack, add, div, cmp, fault) \
+  if (build.name == #id) return std::make_unique<TraversalRtlOf<cls>>(build, frame);
+  SAARCOR_TRAVERSAL_BUILDS(SAARCOR_TRAVERSAL_BUILD)
+#undef SAARCOR_TRAVERSAL_BUILD
+  throw std::runtime_error("no Verilated traversal unit build named '" + build.name + "'");
+}
+
+}  // namespace saarcor::rtl
