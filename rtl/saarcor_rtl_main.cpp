@@ -192,12 +192,15 @@ int report_divergence(const LockstepOptions& o, const saarcor::rtl::LockstepResu
 }
 
 void report_agreement(const LockstepOptions& o, const saarcor::rtl::LockstepResult& r) {
-  if (o.until != 0 && r.cycles <= o.until + 1)
+  if (o.until != 0 && r.cycles <= o.until + 1) {
     std::printf(
-        "saarcor-rtl lockstep: stopped after cycle %llu (--until), no divergence up to "
-        "it; waveform %s (RTL cycles %llu..%llu)\n",
-        static_cast<unsigned long long>(o.until), o.wave.c_str(),
-        static_cast<unsigned long long>(o.wave_from), static_cast<unsigned long long>(o.wave_to));
+        "saarcor-rtl lockstep: stopped after cycle %llu (--until), no divergence up to it\n",
+        static_cast<unsigned long long>(o.until));
+    for (const saarcor::rtl::LockstepUnit& u : r.units)  // one waveform per RTL unit
+      std::printf(
+          "  waveform: %s (RTL cycles %llu..%llu)\n", saarcor::rtl::wave_file(o, u.unit).c_str(),
+          static_cast<unsigned long long>(o.wave_from), static_cast<unsigned long long>(o.wave_to));
+  }
   std::printf("saarcor-rtl lockstep: %s %dx%d: 0 divergences in %llu cycles\n", o.scene.c_str(),
               o.width, o.height, static_cast<unsigned long long>(r.model_cycles));
   using saarcor::units::BoundaryPort;
