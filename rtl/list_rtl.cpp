@@ -10,10 +10,10 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
+#include "rtl/waveform.h"
 #include "rtl_list_builds.h"
 #include "units/boundary_list.h"
 #include "verilated.h"
-#include "verilated_vcd_c.h"
 
 namespace saarcor::rtl {
 namespace {
@@ -69,7 +69,7 @@ class ListRtlOf final : public ListRtl {
     v.resp_word = in.resp_word;
     v.clk = 0;
     v.eval();
-    if (vcd_) vcd_->dump(2 * cycle_);
+    wave_.dump(2 * cycle_);
     ListOutputs o;
     o.req = v.req_valid && in.req_ready;
     o.req_item = v.req_item;
@@ -83,23 +83,13 @@ class ListRtlOf final : public ListRtl {
     o.mask = get_bits(v.out_mask, 0, p_);
     v.clk = 1;
     v.eval();
-    if (vcd_) vcd_->dump(2 * cycle_ + 1);
+    wave_.dump(2 * cycle_ + 1);
     ++cycle_;
     return o;
   }
 
-  void start_trace(const std::string& path) override {
-    stop_trace();
-    vcd_ = std::make_unique<VerilatedVcdC>();
-    v_->trace(vcd_.get(), 99);
-    vcd_->open(path.c_str());
-    if (!vcd_->isOpen()) throw std::runtime_error("cannot write the waveform " + path);
-  }
-  void stop_trace() override {
-    if (!vcd_) return;
-    vcd_->close();
-    vcd_.reset();
-  }
+  void start_trace(const std::string& path) override { wave_.start(*v_, path); }
+  void stop_trace() override { wave_.stop(); }
 
  private:
   void clock() {
@@ -112,7 +102,7 @@ class ListRtlOf final : public ListRtl {
   int tw_, p_;
   std::unique_ptr<VerilatedContext> ctx_;
   std::unique_ptr<V> v_;
-  std::unique_ptr<VerilatedVcdC> vcd_;
+  Waveform wave_;
   std::uint64_t cycle_ = 0;
 };
 

@@ -10,10 +10,10 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
+#include "rtl/waveform.h"
 #include "rtl_traversal_builds.h"
 #include "units/boundary_traversal.h"
 #include "verilated.h"
-#include "verilated_vcd_c.h"
 
 namespace saarcor::rtl {
 namespace {
@@ -93,7 +93,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
       drive(e);
     v.clk = 0;
     v.eval();
-    if (vcd_) vcd_->dump(2 * cycle_);
+    wave_.dump(2 * cycle_);
     if (v.req_valid && v.req_ready) {
       BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, v.req_thread);
       e.fields = 3;
@@ -110,7 +110,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
               {v.out2_node, 0, 0, get_bits(v.out2_mask, 0, p_), v.out2_level});
     v.clk = 1;
     v.eval();
-    if (vcd_) vcd_->dump(2 * cycle_ + 1);
+    wave_.dump(2 * cycle_ + 1);
     ++cycle_;
   }
 
@@ -120,18 +120,8 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
     return static_cast<int>(v_->dbg_size);
   }
 
-  void start_trace(const std::string& path) override {
-    stop_trace();
-    vcd_ = std::make_unique<VerilatedVcdC>();
-    v_->trace(vcd_.get(), 99);
-    vcd_->open(path.c_str());
-    if (!vcd_->isOpen()) throw std::runtime_error("cannot write the waveform " + path);
-  }
-  void stop_trace() override {
-    if (!vcd_) return;
-    vcd_->close();
-    vcd_.reset();
-  }
+  void start_trace(const std::string& path) override { wave_.start(*v_, path); }
+  void stop_trace() override { wave_.stop(); }
 
  private:
   void clear_inputs() {
@@ -272,7 +262,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
   int tw_, p_;
   std::unique_ptr<VerilatedContext> ctx_;
   std::unique_ptr<V> v_;
-  std::unique_ptr<VerilatedVcdC> vcd_;
+  Waveform wave_;
   std::uint64_t cycle_ = 0;
 };
 
