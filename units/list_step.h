@@ -64,7 +64,7 @@ class ListStep {
     // Back from an object whose top-level list is done: the thread passes on to the traversal
     // unit's pop without reading an entry (the unit holds the cursor; the traversal unit cannot
     // know the list is done).
-    if (c.next >= c.end || c.mask == 0) {
+    if (done(level)) {
       ++t.u.list_returns;
       t.phase = Phase::kPop;
       return;
