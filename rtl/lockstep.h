@@ -1,6 +1,7 @@
 // The lockstep co-simulation (docs/rtl.md "The units in lockstep with the cycle model"): the cycle
 // model runs a frame and the Verilated units (the traversal unit, rtl/traversal_threads.sv; the
-// mailboxed list unit, rtl/list_unit.sv) run beside it, cycle by cycle, each on its own. In every
+// mailboxed list unit, rtl/list_unit.sv; the intersection unit, rtl/intersection_threads.sv) run
+// beside it, cycle by cycle, each on its own. In every
 // cycle each RTL unit gets what the model's unit gets (threads arriving on its paths with their
 // payload, side-band signals, the cache's back-pressure, the cache responses with the SRAM words:
 // the boundary record's input events, units/boundary.h), and each of its outputs (cache requests,
@@ -28,13 +29,15 @@ namespace saarcor::rtl {
 
 struct LockstepOptions {
   std::string scene;  // host::load_scene spec (builtin:room, a glTF path)
-  std::vector<std::string> units{"traversal", "list"};  // the RTL units: traversal, list
+  // The RTL units: traversal, list, intersection.
+  std::vector<std::string> units{"traversal", "list"};
   int width = 32, height = 24;
   std::vector<std::string> set;  // cycle-model KEY=VALUE (and kd.* tree keys)
   bool shadows = false;
   int depth = 0;  // secondary-ray depth (0: none)
   // "" or an injected fault (tests): mailbox-never-hits (list), pop-off, short-pipeline
-  // (traversal), priorities-swapped (both); each unit that has it runs its fault build.
+  // (traversal), priorities-swapped (both), strict-uv (intersection); each unit that has it runs
+  // its fault build.
   std::string fault;
   // The RTL waveform around a divergence (with several units: one file per unit, the unit's name
   // before the extension; wave_file).
