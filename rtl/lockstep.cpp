@@ -217,6 +217,14 @@ class Lockstep {
       div_.rtl_value = rtl->field[i];
       return;
     }
+    // The fields agree: the first wide word that differs (a ray's or a hit record's).
+    for (std::size_t k = 0; k < model->wide.size() && k < rtl->wide.size(); ++k) {
+      if (model->wide[k] == rtl->wide[k]) continue;
+      div_.field = "wide[" + std::to_string(k) + "]";
+      div_.model_value = model->wide[k];
+      div_.rtl_value = rtl->wide[k];
+      return;
+    }
   }
 
   [[noreturn]] void diverge(const char* kind, const BoundaryEvent* model, const BoundaryEvent* rtl,
