@@ -27,9 +27,11 @@
 #include "memif/memory_system.h"
 #include "rtl/intersection_rtl.h"
 #include "rtl/list_rtl.h"
+#include "rtl/transformation_rtl.h"
 #include "rtl/traversal_rtl.h"
 #include "units/boundary_intersection.h"
 #include "units/boundary_list.h"
+#include "units/boundary_transformation.h"
 #include "units/boundary_traversal.h"
 #include "units/cycle_params.h"
 #include "units/dynrtc_units.h"
@@ -339,6 +341,7 @@ class Cosim {
 int fault_of(const std::string& unit, const std::string& fault) {
   if (fault.empty()) return 0;
   if (unit == "intersection") return fault == "strict-uv" ? 1 : 0;
+  if (unit == "transformation") return fault == "n-plus-one-off" ? 1 : 0;
   if (unit == "list")
     return fault == "mailbox-never-hits" ? 1 : fault == "priorities-swapped" ? 2 : 0;
   if (fault == "pop-off") return 1;
@@ -391,6 +394,22 @@ const IntersectionBuild& choose_intersection_build(const units::CycleParams& p, 
       "; built:" + built);
 }
 
+const TransformationBuild& choose_transformation_build(const units::CycleParams& p, int faulty) {
+  std::string built;
+  const auto config = [](int threads, int packet, int add, int mul) {
+    return "threads=" + std::to_string(threads) + " packet=" + std::to_string(packet) +
+           " lat.add=" + std::to_string(add) + " lat.mul=" + std::to_string(mul);
+  };
+  for (const TransformationBuild& b : transformation_builds()) {
+    if (b.fault == faulty && b.threads == p.threads && b.packet == p.packet &&
+        b.lat_add == p.lat_add && b.lat_mul == p.lat_mul)
+      return b;
+    if (b.fault == faulty) built += " [" + config(b.threads, b.packet, b.lat_add, b.lat_mul) + "]";
+  }
+  throw std::runtime_error("lockstep: no Verilated transformation unit for " +
+                           config(p.threads, p.packet, p.lat_add, p.lat_mul) + "; built:" + built);
+}
+
 std::string traversal_config(int threads, int packet, int stack, int add, int div, int cmp) {
   return "threads=" + std::to_string(threads) + " packet=" + std::to_string(packet) +
          " stack=" + std::to_string(stack) + " lat.add=" + std::to_string(add) +
@@ -436,7 +455,9 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   units::ListPayload<F, kLanes, units::FastDatapath> list(threads, state);
   units::TraversalPayload<F, kLanes, units::FastDatapath> traversal(threads, state);
   units::IntersectionPayload<F, kLanes, units::FastDatapath> intersection(threads, state);
+  units::TransformationPayload<F, kLanes, units::FastDatapath> transformation(threads, state);
   units::UnitPayloads payloads(threads);
+  payloads.set(UnitId::kTransformation, transformation);
   payloads.set(UnitId::kIntersection, intersection);
   payloads.set(UnitId::kList, list);
   payloads.set(UnitId::kTraversal, traversal);
@@ -515,15 +536,16 @@ struct Chosen {
   const ListBuild* list = nullptr;
   const TraversalBuild* traversal = nullptr;
   const IntersectionBuild* intersection = nullptr;
+  const TransformationBuild* transformation = nullptr;
 };
 std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CycleParams& p,
                                   std::vector<LockstepUnit>& info) {
   bool fault_used = o.fault.empty();
   std::vector<Chosen> chosen;
   for (const std::string& u : o.units) {
-    if (u != "traversal" && u != "list" && u != "intersection")
+    if (u != "traversal" && u != "list" && u != "intersection" && u != "transformation")
       throw std::runtime_error("lockstep: unknown unit '" + u +
-                               "' (the RTL units: traversal, list, intersection)");
+                               "' (the RTL units: traversal, list, transformation, intersection)");
     for (const LockstepUnit& x : info)
       if (x.unit == u) throw std::runtime_error("lockstep: unit '" + u + "' given twice");
     const int fault = fault_of(u, o.fault);
@@ -535,6 +557,8 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
       x.build = (c.list = &choose_list_build(p, fault))->name;
     else if (u == "intersection")
       x.build = (c.intersection = &choose_intersection_build(p, fault))->name;
+    else if (u == "transformation")
+      x.build = (c.transformation = &choose_transformation_build(p, fault))->name;
     else
       x.build = (c.traversal = &choose_traversal_build(p, fault))->name;
   }
@@ -542,7 +566,7 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
     throw std::runtime_error("lockstep: no unit of the run has the fault '" + o.fault +
                              "' (list: mailbox-never-hits, priorities-swapped; traversal: "
                              "pop-off, short-pipeline, priorities-swapped; intersection: "
-                             "strict-uv)");
+                             "strict-uv; transformation: n-plus-one-off)");
   return chosen;
 }
 
@@ -572,6 +596,8 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
       rtl.push_back(make_list_unit_rtl(*c.list));
     else if (c.intersection != nullptr)
       rtl.push_back(make_intersection_unit_rtl(*c.intersection));
+    else if (c.transformation != nullptr)
+      rtl.push_back(make_transformation_unit_rtl(*c.transformation, built.image.registers()));
     else
       rtl.push_back(make_traversal_unit_rtl(*c.traversal, built.image.registers()));
     if (o.wrap_rtl) rtl.back() = o.wrap_rtl(std::move(rtl.back()));
