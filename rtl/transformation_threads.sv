@@ -93,14 +93,18 @@ module transformation_threads #(
   logic [TW-1:0] acc_thread, iss_thread;
   logic [31:0] acc_first;
   logic [2:0] acc_count;
+  // The first row: 6 or 3 rows an entry, as shifts and adds (a constant multiply would take
+  // multiplier blocks on the FPGA).
+  logic [31:0] acc_entry;
+  assign acc_entry = entry_r[acc_thread];
   always_comb begin
     acc_first = '0;
     acc_count = '0;
     if (op_r[acc_thread] == 2'(OpObject)) begin
-      acc_first = instance_row_base + 32'd6 * entry_r[acc_thread];
+      acc_first = instance_row_base + (acc_entry << 2) + (acc_entry << 1);
       acc_count = 3'd6;
     end else if (op_r[acc_thread] == 2'(OpTriangle)) begin
-      acc_first = trb_r[acc_thread] + 32'd3 * entry_r[acc_thread];
+      acc_first = trb_r[acc_thread] + (acc_entry << 1) + acc_entry;
       acc_count = 3'd3;
     end
   end
