@@ -22,7 +22,8 @@ module intersection_unit #(
     parameter int LAT_MUL = 3,
     parameter int LAT_DIV = 8,
     parameter int LAT_CMP = 1,
-    parameter int IDW     = 32
+    parameter int IDW     = 32,
+    parameter bit FAULT_STRICT_UV = 1'b0  // tests only: accepts on u + v < 1 instead of <= 1
 ) (
     input  logic           clk,
     input  logic           rst,
@@ -126,7 +127,8 @@ module intersection_unit #(
   logic in4, acc4;
   always_comb begin
     in4 = ~is_zero(c4) & ~is_nan(c4) & ~t4[E+M] & ~is_zero(t4) & ~is_nan(t4) &
-          (mag(t4) != InfMag) & nonneg(u4) & nonneg(v4) & nonneg(s4) & (mag(s4) <= OneMag);
+          (mag(t4) != InfMag) & nonneg(u4) & nonneg(v4) & nonneg(s4) &
+          (FAULT_STRICT_UV ? mag(s4) < OneMag : mag(s4) <= OneMag);
     if (mag(t4) != mag(best_t4)) acc4 = in4 & (mag(t4) < mag(best_t4));
     else if (inst4 != best_inst4) acc4 = in4 & (inst4 < best_inst4);
     else acc4 = in4 & (tri4 < best_tri4);

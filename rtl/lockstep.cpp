@@ -25,9 +25,13 @@
 #include "host/tree_settings.h"
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
+#include "rtl/intersection_rtl.h"
 #include "rtl/list_rtl.h"
+#include "rtl/transformation_rtl.h"
 #include "rtl/traversal_rtl.h"
+#include "units/boundary_intersection.h"
 #include "units/boundary_list.h"
+#include "units/boundary_transformation.h"
 #include "units/boundary_traversal.h"
 #include "units/cycle_params.h"
 #include "units/dynrtc_units.h"
@@ -215,6 +219,14 @@ class Lockstep {
       div_.rtl_value = rtl->field[i];
       return;
     }
+    // The fields agree: the first wide word that differs (a ray's or a hit record's).
+    for (std::size_t k = 0; k < model->wide.size() && k < rtl->wide.size(); ++k) {
+      if (model->wide[k] == rtl->wide[k]) continue;
+      div_.field = "wide[" + std::to_string(k) + "]";
+      div_.model_value = model->wide[k];
+      div_.rtl_value = rtl->wide[k];
+      return;
+    }
   }
 
   [[noreturn]] void diverge(const char* kind, const BoundaryEvent* model, const BoundaryEvent* rtl,
@@ -328,6 +340,8 @@ class Cosim {
 // The fault builds (LockstepOptions::fault) of a unit: its fault number, 0 for none.
 int fault_of(const std::string& unit, const std::string& fault) {
   if (fault.empty()) return 0;
+  if (unit == "intersection") return fault == "strict-uv" ? 1 : 0;
+  if (unit == "transformation") return fault == "n-plus-one-off" ? 1 : 0;
   if (unit == "list")
     return fault == "mailbox-never-hits" ? 1 : fault == "priorities-swapped" ? 2 : 0;
   if (fault == "pop-off") return 1;
@@ -353,6 +367,47 @@ const ListBuild& choose_list_build(const units::CycleParams& p, int faulty) {
       " packet=" + std::to_string(p.packet) + " mailbox=" + std::to_string(p.mailbox) +
       " triangle_mailbox=" + std::to_string(p.triangle_mailbox) +
       " lat.cmp=" + std::to_string(p.list_depth()) + "; built:" + built);
+}
+
+std::string intersection_config(int threads, int packet, int add, int mul, int div, int cmp) {
+  return "threads=" + std::to_string(threads) + " packet=" + std::to_string(packet) +
+         " lat.add=" + std::to_string(add) + " lat.mul=" + std::to_string(mul) +
+         " lat.div=" + std::to_string(div) + " lat.cmp=" + std::to_string(cmp);
+}
+
+const IntersectionBuild& choose_intersection_build(const units::CycleParams& p, int faulty) {
+  std::string built;
+  for (const IntersectionBuild& b : intersection_builds()) {
+    if (b.fault == faulty && b.threads == p.threads && b.packet == p.packet &&
+        b.lat_add == p.lat_add && b.lat_mul == p.lat_mul && b.lat_div == p.lat_div &&
+        b.lat_cmp == p.lat_cmp)
+      return b;
+    if (b.fault == faulty)
+      built +=
+          " [" +
+          intersection_config(b.threads, b.packet, b.lat_add, b.lat_mul, b.lat_div, b.lat_cmp) +
+          "]";
+  }
+  throw std::runtime_error(
+      "lockstep: no Verilated intersection unit for " +
+      intersection_config(p.threads, p.packet, p.lat_add, p.lat_mul, p.lat_div, p.lat_cmp) +
+      "; built:" + built);
+}
+
+const TransformationBuild& choose_transformation_build(const units::CycleParams& p, int faulty) {
+  std::string built;
+  const auto config = [](int threads, int packet, int add, int mul) {
+    return "threads=" + std::to_string(threads) + " packet=" + std::to_string(packet) +
+           " lat.add=" + std::to_string(add) + " lat.mul=" + std::to_string(mul);
+  };
+  for (const TransformationBuild& b : transformation_builds()) {
+    if (b.fault == faulty && b.threads == p.threads && b.packet == p.packet &&
+        b.lat_add == p.lat_add && b.lat_mul == p.lat_mul)
+      return b;
+    if (b.fault == faulty) built += " [" + config(b.threads, b.packet, b.lat_add, b.lat_mul) + "]";
+  }
+  throw std::runtime_error("lockstep: no Verilated transformation unit for " +
+                           config(p.threads, p.packet, p.lat_add, p.lat_mul) + "; built:" + built);
 }
 
 std::string traversal_config(int threads, int packet, int stack, int add, int div, int cmp) {
@@ -399,7 +454,11 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   const auto state = [&](units::ThreadToken t) -> const State& { return threads.state(t); };
   units::ListPayload<F, kLanes, units::FastDatapath> list(threads, state);
   units::TraversalPayload<F, kLanes, units::FastDatapath> traversal(threads, state);
+  units::IntersectionPayload<F, kLanes, units::FastDatapath> intersection(threads, state);
+  units::TransformationPayload<F, kLanes, units::FastDatapath> transformation(threads, state);
   units::UnitPayloads payloads(threads);
+  payloads.set(UnitId::kTransformation, transformation);
+  payloads.set(UnitId::kIntersection, intersection);
   payloads.set(UnitId::kList, list);
   payloads.set(UnitId::kTraversal, traversal);
   units::BoundaryRecorder rec(threads, p.threads, recorded, payloads,
@@ -471,20 +530,22 @@ units::CycleParams run_params(const LockstepOptions& o, host::ImageParams& ip) {
   return p;
 }
 
-// The Verilated build of each unit in o.units for the run's parameters (and fault): a list or a
-// traversal unit build.
+// The Verilated build of each unit in o.units for the run's parameters (and fault): a list, a
+// traversal or an intersection unit build.
 struct Chosen {
   const ListBuild* list = nullptr;
   const TraversalBuild* traversal = nullptr;
+  const IntersectionBuild* intersection = nullptr;
+  const TransformationBuild* transformation = nullptr;
 };
 std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CycleParams& p,
                                   std::vector<LockstepUnit>& info) {
   bool fault_used = o.fault.empty();
   std::vector<Chosen> chosen;
   for (const std::string& u : o.units) {
-    if (u != "traversal" && u != "list")
+    if (u != "traversal" && u != "list" && u != "intersection" && u != "transformation")
       throw std::runtime_error("lockstep: unknown unit '" + u +
-                               "' (the RTL units: traversal, list)");
+                               "' (the RTL units: traversal, list, transformation, intersection)");
     for (const LockstepUnit& x : info)
       if (x.unit == u) throw std::runtime_error("lockstep: unit '" + u + "' given twice");
     const int fault = fault_of(u, o.fault);
@@ -494,13 +555,18 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
     Chosen& c = chosen.emplace_back();
     if (u == "list")
       x.build = (c.list = &choose_list_build(p, fault))->name;
+    else if (u == "intersection")
+      x.build = (c.intersection = &choose_intersection_build(p, fault))->name;
+    else if (u == "transformation")
+      x.build = (c.transformation = &choose_transformation_build(p, fault))->name;
     else
       x.build = (c.traversal = &choose_traversal_build(p, fault))->name;
   }
   if (!fault_used)
     throw std::runtime_error("lockstep: no unit of the run has the fault '" + o.fault +
                              "' (list: mailbox-never-hits, priorities-swapped; traversal: "
-                             "pop-off, short-pipeline, priorities-swapped)");
+                             "pop-off, short-pipeline, priorities-swapped; intersection: "
+                             "strict-uv; transformation: n-plus-one-off)");
   return chosen;
 }
 
@@ -526,9 +592,14 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   std::vector<UnitId> recorded;
   Cosim cs(o);
   for (const Chosen& c : chosen) {
-    rtl.push_back(c.list != nullptr
-                      ? make_list_unit_rtl(*c.list)
-                      : make_traversal_unit_rtl(*c.traversal, built.image.registers()));
+    if (c.list != nullptr)
+      rtl.push_back(make_list_unit_rtl(*c.list));
+    else if (c.intersection != nullptr)
+      rtl.push_back(make_intersection_unit_rtl(*c.intersection));
+    else if (c.transformation != nullptr)
+      rtl.push_back(make_transformation_unit_rtl(*c.transformation, built.image.registers()));
+    else
+      rtl.push_back(make_traversal_unit_rtl(*c.traversal, built.image.registers()));
     if (o.wrap_rtl) rtl.back() = o.wrap_rtl(std::move(rtl.back()));
     recorded.push_back(rtl.back()->unit());
     cs.add(*rtl.back());

@@ -1,12 +1,13 @@
 // The lockstep co-simulation (docs/rtl.md "The units in lockstep with the cycle model"): the cycle
 // model runs a frame and the Verilated units (the traversal unit, rtl/traversal_threads.sv; the
-// mailboxed list unit, rtl/list_unit.sv) run beside it, cycle by cycle, each on its own. In every
-// cycle each RTL unit gets what the model's unit gets (threads arriving on its paths with their
-// payload, side-band signals, the cache's back-pressure, the cache responses with the SRAM words:
-// the boundary record's input events, units/boundary.h), and each of its outputs (cache requests,
-// threads leaving with their payload) is compared with the model's unit's. One comparer per unit;
-// events are matched `window` cycles behind the RTL's clock, so a divergence is classified with
-// both sides' neighbourhood known:
+// mailboxed list unit, rtl/list_unit.sv; the transformation unit, rtl/transformation_threads.sv;
+// the intersection unit, rtl/intersection_threads.sv) run beside it, cycle by cycle, each on its
+// own. In every cycle each RTL unit gets what the model's unit gets (threads arriving on its paths
+// with their payload, side-band signals, the cache's back-pressure, the cache responses with the
+// SRAM words: the boundary record's input events, units/boundary.h), and each of its outputs (cache
+// requests, threads leaving with their payload) is compared with the model's unit's. One comparer
+// per unit; events are matched `window` cycles behind the RTL's clock, so a divergence is
+// classified with both sides' neighbourhood known:
 //   payload  the same port, cycle and thread, other bits;
 //   order    the same port and cycle, another thread;
 //   timing   the same event (port, thread, bits) in another cycle;
@@ -28,13 +29,15 @@ namespace saarcor::rtl {
 
 struct LockstepOptions {
   std::string scene;  // host::load_scene spec (builtin:room, a glTF path)
-  std::vector<std::string> units{"traversal", "list"};  // the RTL units: traversal, list
+  // The RTL units: traversal, list, transformation, intersection.
+  std::vector<std::string> units{"traversal", "list"};
   int width = 32, height = 24;
   std::vector<std::string> set;  // cycle-model KEY=VALUE (and kd.* tree keys)
   bool shadows = false;
   int depth = 0;  // secondary-ray depth (0: none)
   // "" or an injected fault (tests): mailbox-never-hits (list), pop-off, short-pipeline
-  // (traversal), priorities-swapped (both); each unit that has it runs its fault build.
+  // (traversal), priorities-swapped (both), strict-uv (intersection), n-plus-one-off
+  // (transformation); each unit that has it runs its fault build.
   std::string fault;
   // The RTL waveform around a divergence (with several units: one file per unit, the unit's name
   // before the extension; wave_file).
@@ -60,7 +63,7 @@ struct Divergence {
 
 // One RTL unit's part of a run.
 struct LockstepUnit {
-  std::string unit;   // "traversal", "list"
+  std::string unit;   // "traversal", "list", "transformation", "intersection"
   std::string build;  // the Verilated build that ran
   // Per port (units::BoundaryPort): events given to the RTL (inputs) or compared (outputs).
   std::array<std::uint64_t, 6> events{};

@@ -1,7 +1,9 @@
-// The traversal and list units in lockstep with the cycle model at full size (label deep;
-// rtl/lockstep.h): the room at 512x384 and frame 0 of the BART kitchen at 256x192, 0 divergences.
+// The four units (traversal, list, transformation, intersection) in lockstep with the cycle model
+// at full size (label deep; rtl/lockstep.h): the room at 512x384 and frame 0 of the BART kitchen
+// at 256x192, 0 divergences.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 
 #include "rtl/lockstep.h"
@@ -11,7 +13,7 @@ namespace {
 
 void expect_agreement(const std::string& scene, int w, int h) {
   LockstepOptions o;
-  o.units = {"traversal", "list"};
+  o.units = {"traversal", "list", "transformation", "intersection"};
   o.scene = scene;
   o.width = w;
   o.height = h;
@@ -19,6 +21,10 @@ void expect_agreement(const std::string& scene, int w, int h) {
   EXPECT_FALSE(r.diverged) << r.screen;
   EXPECT_GT(r.unit("list").event(units::BoundaryPort::kOutput), 0u);
   EXPECT_GT(r.unit("traversal").event(units::BoundaryPort::kOutput), 0u);
+  EXPECT_GT(r.unit("transformation").event(units::BoundaryPort::kCacheRequest), 0u);
+  EXPECT_GT(r.unit("intersection").event(units::BoundaryPort::kOutput), 0u);
+  std::printf("  %llu cycles, %.0f k cycles/s co-simulated\n",
+              static_cast<unsigned long long>(r.cycles), r.cycles / r.seconds / 1e3);
 }
 
 TEST(ListLockstepDeep, Room512x384) {

@@ -1,4 +1,5 @@
-// The RTL units (rtl/traversal_threads.sv, rtl/list_unit.sv) in lockstep with the cycle model
+// The RTL units (rtl/traversal_threads.sv, rtl/list_unit.sv, rtl/transformation_threads.sv,
+// rtl/intersection_threads.sv) in lockstep with the cycle model
 // (rtl/lockstep.h): 0 divergences on the CI scenes and configurations, the injected faults caught
 // at their first wrong event, bad input refused.
 #include "rtl/lockstep.h"
@@ -15,7 +16,9 @@
 #include <utility>
 #include <vector>
 
+#include "rtl/intersection_rtl.h"
 #include "rtl/list_rtl.h"
+#include "rtl/transformation_rtl.h"
 #include "rtl/traversal_rtl.h"
 #include "units/boundary_list.h"
 #include "units/cycle_params.h"
@@ -34,7 +37,7 @@ std::string shared(const std::string& rel) {
 LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, int w = 24,
                    int h = 18, bool shadows = false, int depth = 0) {
   LockstepOptions o;
-  o.units = {"traversal", "list"};
+  o.units = {"traversal", "list", "transformation", "intersection"};
   o.scene = scene;
   o.set = std::move(set);
   o.width = w;
@@ -44,9 +47,11 @@ LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, 
   return run_lockstep(o);
 }
 
-// Both units agree with the model on every port event: the list unit's each request answered and
+// The units agree with the model on every port event: the list unit's each request answered and
 // each entry leaving; the traversal unit's node fetches answered, and more threads leaving than
-// node steps (the clips and pops leave too).
+// node steps (the clips and pops leave too); the transformation unit's row fetches answered and
+// every thread leaving again; the intersection unit's every triangle leaving again (one hit
+// update each), each packet start seen by the list and the intersection unit.
 void expect_agreement(const LockstepResult& r) {
   EXPECT_FALSE(r.diverged) << r.screen;
   const LockstepUnit& list = r.unit("list");
@@ -58,14 +63,27 @@ void expect_agreement(const LockstepResult& r) {
   EXPECT_EQ(trav.event(BoundaryPort::kCacheRequest), trav.event(BoundaryPort::kCacheResponse));
   EXPECT_GT(trav.event(BoundaryPort::kOutput), trav.event(BoundaryPort::kCacheRequest));
   EXPECT_GT(trav.event(BoundaryPort::kSideBand), 0u);  // hit updates
+  const LockstepUnit& isect = r.unit("intersection");
+  EXPECT_GT(isect.event(BoundaryPort::kInput), 0u);
+  EXPECT_EQ(isect.event(BoundaryPort::kOutput), isect.event(BoundaryPort::kInput));
+  EXPECT_EQ(isect.event(BoundaryPort::kOutput), trav.event(BoundaryPort::kSideBand));
+  EXPECT_EQ(isect.event(BoundaryPort::kSideBand), list.event(BoundaryPort::kSideBand));
+  const LockstepUnit& xf = r.unit("transformation");
+  EXPECT_GT(xf.event(BoundaryPort::kCacheRequest), 0u);
+  EXPECT_EQ(xf.event(BoundaryPort::kCacheRequest), xf.event(BoundaryPort::kCacheResponse));
+  EXPECT_EQ(xf.event(BoundaryPort::kOutput), xf.event(BoundaryPort::kInput));
+  EXPECT_GE(xf.event(BoundaryPort::kOutput), isect.event(BoundaryPort::kInput));
   std::printf(
       "  %s/%s: %llu cycles; traversal %llu requests, %llu outputs; list %llu requests, "
-      "%llu outputs compared\n",
+      "%llu outputs; transformation %llu rows, %llu outputs; intersection %llu outputs compared\n",
       trav.build.c_str(), list.build.c_str(), static_cast<unsigned long long>(r.cycles),
       static_cast<unsigned long long>(trav.event(BoundaryPort::kCacheRequest)),
       static_cast<unsigned long long>(trav.event(BoundaryPort::kOutput)),
       static_cast<unsigned long long>(list.event(BoundaryPort::kCacheRequest)),
-      static_cast<unsigned long long>(list.event(BoundaryPort::kOutput)));
+      static_cast<unsigned long long>(list.event(BoundaryPort::kOutput)),
+      static_cast<unsigned long long>(xf.event(BoundaryPort::kCacheRequest)),
+      static_cast<unsigned long long>(xf.event(BoundaryPort::kOutput)),
+      static_cast<unsigned long long>(isect.event(BoundaryPort::kOutput)));
 }
 
 const std::vector<std::string> kP1 = {"threads=13", "packet=1", "mailbox=1", "triangle_mailbox=1",
@@ -299,6 +317,15 @@ TEST(Lockstep, BadInputIsRefusedWithOneLine) {
   o.units = {"list"};
   o.fault = "pop-off";  // the traversal unit's
   EXPECT_NE(error().find("no unit of the run has the fault"), std::string::npos);
+  o.fault = "strict-uv";  // the intersection unit's
+  EXPECT_NE(error().find("no unit of the run has the fault"), std::string::npos);
+  o.fault = {};
+  o.units = {"intersection"};
+  o.set = {"lat.div=9"};
+  EXPECT_NE(error().find("no Verilated intersection unit"), std::string::npos);
+  o.units = {"transformation"};
+  o.set = {"lat.mul=4"};
+  EXPECT_NE(error().find("no Verilated transformation unit"), std::string::npos);
 }
 
 // The first build of each unit is the prototype's (units/cycle_params.cpp defaults).
@@ -320,6 +347,38 @@ TEST(Lockstep, PrototypeBuildsAreTheModelsDefaults) {
     for (const ListBuild& l : list_builds())
       list = list || (l.fault == 0 && l.threads == b.threads && l.packet == b.packet);
     EXPECT_TRUE(list) << b.name;
+  }
+  const IntersectionBuild& i = intersection_builds().front();
+  EXPECT_EQ(i.name, "proto");
+  EXPECT_EQ(i.threads, p.threads);
+  EXPECT_EQ(i.packet, p.packet);
+  EXPECT_EQ(i.lat_add, p.lat_add);
+  EXPECT_EQ(i.lat_mul, p.lat_mul);
+  EXPECT_EQ(i.lat_div, p.lat_div);
+  EXPECT_EQ(i.lat_cmp, p.lat_cmp);
+  EXPECT_EQ(i.fault, 0);
+  const TransformationBuild& x = transformation_builds().front();
+  EXPECT_EQ(x.name, "proto");
+  EXPECT_EQ(x.threads, p.threads);
+  EXPECT_EQ(x.packet, p.packet);
+  EXPECT_EQ(x.lat_add, p.lat_add);
+  EXPECT_EQ(x.lat_mul, p.lat_mul);
+  EXPECT_EQ(x.fault, 0);
+  for (const TransformationBuild& b : transformation_builds()) {
+    if (b.fault != 0) continue;
+    bool intersection = false;
+    for (const IntersectionBuild& n : intersection_builds())
+      intersection =
+          intersection || (n.fault == 0 && n.threads == b.threads && n.packet == b.packet);
+    EXPECT_TRUE(intersection) << b.name;
+  }
+  // Every intersection parameter set without a fault has the traversal unit's build beside it.
+  for (const IntersectionBuild& b : intersection_builds()) {
+    if (b.fault != 0) continue;
+    bool traversal = false;
+    for (const TraversalBuild& t : traversal_builds())
+      traversal = traversal || (t.fault == 0 && t.threads == b.threads && t.packet == b.packet);
+    EXPECT_TRUE(traversal) << b.name;
   }
 }
 

@@ -4,8 +4,9 @@
 //
 //   saarcor-rtl check FILE [--out OUT] [--max N]
 //
-//   saarcor-rtl lockstep SCENE [--units traversal,list] [--res WxH] [--set KEY=VALUE ...]
-//                        [--shadows] [--depth N] [--until CYCLE] [--wave FILE] [--bench]
+//   saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection] [--res WxH]
+//                        [--set KEY=VALUE ...] [--shadows] [--depth N] [--until CYCLE]
+//                        [--wave FILE] [--bench]
 //
 // check: exit status 0 every vector matches, 2 some differ (or the RTL's latency is not the cycle
 // model's unit depth), 1 usage error or malformed file. lockstep (rtl/lockstep.h): 0 no
@@ -27,12 +28,14 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: saarcor-rtl check FILE [--out OUT] [--max N]\n"
-    "       saarcor-rtl lockstep SCENE [--units traversal,list] [--res WxH] [--set KEY=VALUE ...]\n"
-    "                            [--shadows] [--depth N] [--until CYCLE] [--wave FILE] [--bench]\n"
-    "  lockstep: runs the cycle model and the Verilated units (traversal, list; default both)\n"
-    "  side by side and compares every port event of each in the same cycle; exit 2 at the\n"
-    "  first divergence (its screen, a VCD window of the RTL around it and the replay command\n"
-    "  printed). --bench also times the cycle model alone on the same frame.\n"
+    "       saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection]\n"
+    "                            [--res WxH] [--set KEY=VALUE ...] [--shadows] [--depth N]\n"
+    "                            [--until CYCLE] [--wave FILE] [--bench] [--fault NAME]\n"
+    "  lockstep: runs the cycle model and the Verilated units (traversal, list, transformation,\n"
+    "  intersection; default traversal,list) side by side and compares every port event of each\n"
+    "  in the same cycle; exit 2 at the first divergence (its screen, a VCD window of the RTL\n"
+    "  around it and the replay command printed). --bench also times the cycle model alone on\n"
+    "  the same frame.\n"
     "  Runs the unit vectors in FILE (saarcor vectors --out FILE) through the Verilated unit and\n"
     "  lists the vectors whose outputs differ from the file's (at most N, default 20).\n"
     "  --out OUT  also writes FILE with the RTL's outputs (saarcor vectors --check OUT checks it)\n"

@@ -12,7 +12,8 @@
 #   RTL_NETLIST_DIR=DIR          also writes each flattened netlist as DIR/TOP.v
 #   RTL_LOG_DIR=DIR              keeps yosys's log and statistics of each top as DIR/TOP.{log,stat}
 # Tops: the operators (fp_add ...), the datapaths (*_unit), and the whole units traversal_ctrl
-# (P lanes, the stack, the per-thread state) and list_unit (the thread machinery, the mailboxes).
+# (P lanes, the stack, the per-thread state), list_unit (the thread machinery, the mailboxes),
+# transformation_threads and intersection_threads (the thread machinery around the datapaths).
 # Default tops: every operator and datapath (generic: about 4 minutes; xc2v: longer); the whole
 # units only when named (traversal_ctrl takes minutes even with 2 threads; list_unit.sv's own
 # default is 16 threads, the prototype's 64 is RTL_PARAMS="THREADS=64").
@@ -51,6 +52,10 @@ sources() {  # the files a top needs beside the operators
   case "$1" in
     list_unit) echo "$here/unit_threads.sv $here/list_mailbox.sv $here/list_unit.sv" ;;
     traversal_ctrl) echo "$here/traversal_unit.sv $here/traversal_ctrl.sv" ;;
+    transformation_threads)
+      echo "$here/transform_unit.sv $here/unit_threads.sv $here/transformation_threads.sv" ;;
+    intersection_threads)
+      echo "$here/intersection_unit.sv $here/unit_threads.sv $here/intersection_threads.sv" ;;
     traversal_unit | transform_unit | intersection_unit) echo "$here/$1.sv" ;;
     fp_*) echo "" ;;
     *) return 1 ;;

@@ -67,7 +67,7 @@ module unit_threads #(
   logic [TW-1:0] path_q[INPUTS][QS];
   logic [QB:0] path_head[INPUTS], path_tail[INPUTS];
   logic [INPUTS-1:0] path_any;
-  localparam int SelW = $clog2(INPUTS + 1);
+  localparam int SelW = INPUTS > 1 ? $clog2(INPUTS) : 1;  // path index bits
   logic [SelW-1:0] sel;
   always_comb begin
     sel = '0;

@@ -69,6 +69,12 @@ bool UnitPayloads::side_band(UnitId to, UnitId from, ThreadToken t, BoundaryEven
   return false;
 }
 
+void UnitPayloads::side_bands(UnitId to, UnitId from, ThreadToken t,
+                              std::vector<BoundaryEvent>& sides) {
+  for (BoundaryPayload* p : of_)
+    if (p != nullptr) p->side_bands(to, from, t, sides);
+}
+
 void UnitPayloads::issued(UnitId unit, ThreadToken t, const Request& r) {
   for (BoundaryPayload* p : of_)
     if (p != nullptr) p->issued(unit, t, r);
@@ -98,8 +104,10 @@ BoundaryEvent BoundaryRecorder::event(std::uint64_t cycle, UnitId unit, Boundary
 }
 
 void BoundaryRecorder::queued(std::uint64_t cycle, UnitId to, ThreadToken t) {
-  BoundaryEvent side;
-  if (payload_.side_band(to, at_[t], t, side) && recorded(side.unit)) {
+  sides_.clear();
+  payload_.side_bands(to, at_[t], t, sides_);
+  for (BoundaryEvent& side : sides_) {
+    if (!recorded(side.unit)) continue;
     BoundaryEvent e = event(cycle, side.unit, BoundaryPort::kSideBand, t);
     e.path = at_[t];
     e.fields = side.fields;

@@ -68,6 +68,13 @@ class BoundaryPayload {
   // Thread t was pushed towards `to` by `from` (any path of the DynRTP). Fills `side` and returns
   // true when that is a side-band event of another unit (side.unit names it).
   virtual bool side_band(UnitId to, UnitId from, ThreadToken t, BoundaryEvent& side) = 0;
+  // Every side-band event of the hand-over (several units may see one: the packet start goes to
+  // the list and the intersection units), appended to `sides`.
+  virtual void side_bands(UnitId to, UnitId from, ThreadToken t,
+                          std::vector<BoundaryEvent>& sides) {
+    BoundaryEvent side;
+    if (side_band(to, from, t, side)) sides.push_back(std::move(side));
+  }
   // Thread t's request `r` was executed on `unit` (any unit of the DynRTP).
   virtual void issued(UnitId unit, ThreadToken t, const Request& r) = 0;
   // Thread t, issued on `unit` just now, will leave with this payload (e.port kOutput).
@@ -89,9 +96,9 @@ class RequestPayload final : public BoundaryPayload {
 };
 
 // Each unit's payload from its own BoundaryPayload (the others: RequestPayload), so several units
-// are recorded at once. A hand-over is a side-band event of at most one unit (the packet start
-// goes to the transformation unit, the hit update comes from the intersection unit): the first
-// payload that claims it wins.
+// are recorded at once. A hand-over is a side-band event of each unit whose payload claims it (the
+// packet start on path a: the list and the intersection units; the hit update from the
+// intersection unit: the traversal unit); side_band() alone gives the first claim.
 class UnitPayloads final : public BoundaryPayload {
  public:
   explicit UnitPayloads(const ThreadTable& threads) : fallback_(threads) {}
@@ -102,6 +109,8 @@ class UnitPayloads final : public BoundaryPayload {
     payload(unit).input(unit, from, t, e);
   }
   bool side_band(UnitId to, UnitId from, ThreadToken t, BoundaryEvent& side) override;
+  void side_bands(UnitId to, UnitId from, ThreadToken t,
+                  std::vector<BoundaryEvent>& sides) override;
   void issued(UnitId unit, ThreadToken t, const Request& r) override;
   void output(UnitId unit, ThreadToken t, BoundaryEvent& e) override {
     payload(unit).output(unit, t, e);
@@ -146,6 +155,7 @@ class BoundaryRecorder final : public UnitObserver {
   Sink sink_;
   std::vector<UnitId> at_;              // per thread: the unit it was last taken into
   std::vector<BoundaryEvent> leaving_;  // per thread: the output payload, from its issue
+  std::vector<BoundaryEvent> sides_;    // queued(): the hand-over's side-band events
 };
 
 }  // namespace saarcor::units

@@ -192,5 +192,40 @@ TEST(BoundaryRecord, UnitPayloadsDispatchByUnit) {
   EXPECT_FALSE(p.side_band(UnitId::kList, UnitId::kList, 0, side));
 }
 
+// A hand-over several units' payloads claim (the packet start on path a: the list unit's mailbox
+// clear and the intersection unit's hit reset) is one side-band event for each, in unit order.
+class Claims final : public BoundaryPayload {
+ public:
+  explicit Claims(UnitId unit) : unit_(unit) {}
+  void input(UnitId, UnitId, ThreadToken, BoundaryEvent&) override {}
+  bool side_band(UnitId to, UnitId, ThreadToken, BoundaryEvent& side) override {
+    side.unit = unit_;
+    return to == UnitId::kTransformation;
+  }
+  void issued(UnitId, ThreadToken, const Request&) override {}
+  void output(UnitId, ThreadToken, BoundaryEvent&) override {}
+
+ private:
+  UnitId unit_;
+};
+
+TEST(BoundaryRecord, AHandOverIsASideBandEventOfEveryUnitThatClaimsIt) {
+  hw::Kernel k;
+  const Request r{UnitId::kTransformation, Phase::kGenerate, 0, 1, kMask};
+  testing::ScriptedThreads threads(k, {{r}});
+  Claims list(UnitId::kList), intersection(UnitId::kIntersection);
+  UnitPayloads p(threads);
+  p.set(UnitId::kIntersection, intersection);
+  p.set(UnitId::kList, list);
+  std::vector<BoundaryEvent> sides;
+  p.side_bands(UnitId::kTransformation, UnitId::kRgs, 0, sides);
+  ASSERT_EQ(sides.size(), 2u);
+  EXPECT_EQ(sides[0].unit, UnitId::kList);  // (unit order: list before intersection)
+  EXPECT_EQ(sides[1].unit, UnitId::kIntersection);
+  sides.clear();
+  p.side_bands(UnitId::kTraversal, UnitId::kRgs, 0, sides);
+  EXPECT_TRUE(sides.empty());
+}
+
 }  // namespace
 }  // namespace saarcor::units
