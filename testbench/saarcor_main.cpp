@@ -138,13 +138,15 @@ void add_render_trace_options(CLI::App* sub, saarcor::RenderOptions& render_opts
                   "write the request trace: a line per unit request with its transactions "
                   "(fp24, e7mM and cycle models)");
   given.trace_from = sub->add_option("--trace-from", render_opts.trace.from,
-                                     "cycle model: first cycle of --trace and --konata");
+                                     "cycle model: first cycle of --trace, --konata, --perfetto");
   given.trace_to = sub->add_option("--trace-to", render_opts.trace.to,
-                                   "cycle model: last cycle of --trace and --konata");
+                                   "cycle model: last cycle of --trace, --konata, --perfetto");
   sub->add_option("--konata", render_opts.trace.konata,
                   "cycle model: write a Kanata pipeline log (opens in Konata)");
   sub->add_option("--konata-threads", render_opts.trace.konata_threads,
                   "cycle model: the threads of --konata, e.g. 0,3,8-11 (default: all)");
+  sub->add_option("--perfetto", render_opts.trace.perfetto,
+                  "cycle model: write a Perfetto / chrome://tracing timeline (trace-event JSON)");
 }
 
 // Frame sequences (testbench/frame_sequence.h, docs/frames.md)
