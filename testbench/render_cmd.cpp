@@ -703,8 +703,9 @@ void write_frame_outputs(const RenderOptions& opts, const ModelSpec& model,
 
 int run_render(const RenderOptions& opts) {
   if (opts.frames_given) return run_frame_sequence(opts);
-  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty())
-    throw std::runtime_error("--fps, --dt, --frame-gap and --bus-sweep need --frames N");
+  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty() ||
+      !opts.resume.empty())
+    throw std::runtime_error("--fps, --dt, --frame-gap, --bus-sweep and --resume need --frames N");
   const ModelSpec model = parse_model(opts.model);
   RenderSettings settings =
       frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);

@@ -176,6 +176,9 @@ struct RenderOptions {
   double dt = 0.0;
   bool frame_gap = false;
   std::string bus_sweep;
+  // --resume DIR: the run folder of a sequence that was stopped (testbench/run_journal.h): only
+  // the frames its journal lacks are rendered. Implies --out-dir DIR.
+  std::string resume;
   bool frames_given = false, fps_given = false, dt_given = false;
 };
 
