@@ -243,6 +243,8 @@ int Cache::miss(const CacheRequest& req, int port, std::size_t first) {
   mr.counted_bytes = 0;
   mr.offset = loc.offset;
   ++*misses_;
+  if (observer_ != nullptr) [[unlikely]]
+    observer_->miss(now(), *this, req.index, id, req.label);
   return 1;
 }
 
@@ -285,6 +287,8 @@ int Cache::accept_fill() {
     lines_[line].words = f.words;
   }
   filled_.push_back(static_cast<int>(f.tag));
+  if (observer_ != nullptr) [[unlikely]]
+    observer_->filled(now(), *this, static_cast<int>(f.tag));
   fills_.drop();  // last: `f` refers to the channel's slot
   return 1;
 }

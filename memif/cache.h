@@ -42,6 +42,19 @@
 
 namespace saarcor::memif {
 
+class Cache;
+
+// What a traced run observes of a cache's misses (the Perfetto timeline, units/perfetto_trace.h):
+// a miss accepted with its MSHR and the label of the request that caused it, and the fill that
+// answers it. Null in a run that traces nothing (one pointer test on the miss path only).
+class CacheObserver {
+ public:
+  virtual ~CacheObserver() = default;
+  virtual void miss(std::uint64_t cycle, const Cache& cache, std::uint32_t item, int mshr,
+                    const Label& label) = 0;
+  virtual void filled(std::uint64_t cycle, const Cache& cache, int mshr) = 0;
+};
+
 class Cache : public hw::Module {
  public:
   // `image` gives the item layout (MemoryImage::locate, item_words); the data come from memory.
@@ -73,6 +86,8 @@ class Cache : public hw::Module {
   // Test hook: appends the index of every accepted request, in acceptance order (the sequence a
   // reference cache simulation must see). nullptr switches it off.
   void set_accept_log(std::vector<std::uint32_t>* log) { accept_log_ = log; }
+  // Every miss and fill reports to `o` (null: none, the default). Timing does not change.
+  void set_observer(CacheObserver* o) { observer_ = o; }
 
   int evaluate() override;
   std::string dump_state() const override;
@@ -143,6 +158,7 @@ class Cache : public hw::Module {
   int next_port_ = 0;  // round-robin among request ports
   hw::Counter *requests_stat_, *hits_, *misses_, *merges_;
   std::vector<std::uint32_t>* accept_log_ = nullptr;
+  CacheObserver* observer_ = nullptr;
   ItemType type_;
   const MemoryImage& image_;
   std::uint16_t client_;

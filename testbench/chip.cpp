@@ -16,6 +16,7 @@
 #include "memif/memory_system.h"
 #include "units/dynrtc_units.h"
 #include "units/dynrtp.h"
+#include "units/perfetto_trace.h"
 #include "units/recorded_threads.h"
 
 namespace saarcor {
@@ -97,6 +98,43 @@ class Chip {
   memif::MemorySystem mi_;
   RayGenerationController rgc_;
   std::vector<std::unique_ptr<DynRtp>> pipes_;
+};
+
+// The run's traces (units/run_trace.h, units/perfetto_trace.h), all fed by one fan of hooks; none
+// when the run traces nothing.
+class Tracers {
+ public:
+  Tracers(const RunTraceOptions& o, const ThreadTable& threads, Chip& chip, const CycleParams& p) {
+    if (o.trace != nullptr || o.konata != nullptr) {
+      run_ = std::make_unique<RunTracer>(o, threads, p.threads);
+      fan_.add(run_.get());
+    }
+    if (o.perfetto != nullptr) {
+      PerfettoChip pc{p.pipelines, p.threads, p.clock_mhz, p.cache_misses, {}};
+      for (int i = 0; i < p.pipelines; ++i) {
+        std::array<const memif::Cache*, kCacheUnits> row{};
+        for (int c = 0; c < kCacheUnits; ++c)
+          row[static_cast<std::size_t>(c)] = &chip.memory().cache(i, kCacheItem[c]);
+        pc.caches.push_back(row);
+      }
+      timeline_ = std::make_unique<PerfettoTracer>(o, threads, std::move(pc));
+      fan_.add(timeline_.get());
+      for (int i = 0; i < p.pipelines; ++i)
+        for (int c = 0; c < kCacheUnits; ++c)
+          chip.memory().cache(i, kCacheItem[c]).set_observer(timeline_.get());
+    }
+    if (o.any()) chip.observe(&fan_);
+  }
+  // Writes the files; `cycles`: the frame's length (a timeline window after it is an error).
+  void finish(std::uint64_t cycles) {
+    if (run_) run_->finish();
+    if (timeline_) timeline_->finish(cycles);
+  }
+
+ private:
+  ObserverFan fan_;
+  std::unique_ptr<RunTracer> run_;
+  std::unique_ptr<PerfettoTracer> timeline_;
 };
 
 // The chip's counters the frame reads, per DynRTP: references into the hw/ registry taken once
@@ -362,11 +400,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   hw::Kernel k(kernel_config(p, opt));
   Chip chip(k, image, p, threads);
   if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
-  std::unique_ptr<RunTracer> tracer;
-  if (opt.trace.any()) {
-    tracer = std::make_unique<RunTracer>(opt.trace, threads, p.threads);
-    chip.observe(tracer.get());
-  }
+  Tracers tracers(opt.trace, threads, chip, p);
 
   CycleFrame out;
   out.params = p;
@@ -376,7 +410,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
   simulate(k, chip, threads, p, opt);
   if (opt.vcd != nullptr) k.finish_trace();
-  if (tracer) tracer->finish();
+  tracers.finish(k.now());
   const FigureCounts end = snapshot(k, counters);
   if (opt.interval != 0)
     out.series = interval_figures(k, counters, start, opt.interval, p.clock_mhz);

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -19,6 +21,7 @@
 #include "testbench/chip.h"
 #include "testbench/heartbeat.h"
 #include "testbench/report.h"
+#include "testbench/run_journal.h"
 #include "units/functional_model.h"
 
 namespace saarcor {
@@ -280,6 +283,7 @@ struct SequenceRun {
   memif::MemoryImage& board;
   Heartbeat& beat;
   const FrameSink& sink;
+  const SequenceResume& resume;
 };
 
 SequenceResult sequence_header(const std::string& spec, const ModelSpec& model,
@@ -364,17 +368,47 @@ void run_frame(SequenceRun& run, int k, SequenceFrame& cur, SequenceResult& r) {
   cur.digest = digest(frame);
   cur.host_seconds = seconds_since(t0);
   if (run.sink) run.sink(cur, image_of(frame));
+  if (run.resume.on_frame)
+    run.resume.on_frame({cur, more ? next.row.upload_cycles : 0, gap_cycles});
   run.beat.beat("frame " + std::to_string(k + 1) + " / " + std::to_string(opts.frames) + " done");
   if (more && run.cycle) place(next.row, cur, gap_cycles);
   r.frames.push_back(cur);
   if (more) cur = next.row;
 }
 
+// A frame a stopped run finished (its journal record): the host's side alone (the swap, the next
+// frame's rebuild and upload, stored into the board as the bus stored it then) and its row as it
+// was, so the next frame starts from the state it had. The record must be this frame's.
+void replay_frame(SequenceRun& run, int k, SequenceFrame& cur, SequenceResult& r,
+                  const FrameRecord& rec) {
+  host::BuiltImage& host = run.host;
+  memif::MemoryImage& board = run.board;
+  cur.frame_bank = k % 2 == 0 ? memif::kFrameBank0 : memif::kFrameBank1;
+  cur.top_copy = static_cast<int>(host.top_buffer);
+  if (rec.row.index != k || rec.row.time != cur.time || rec.row.top_copy != cur.top_copy ||
+      rec.row.frame_bank != cur.frame_bank || rec.row.upload_bytes != cur.upload_bytes)
+    throw std::runtime_error("--resume: the journal's frame " + std::to_string(k) +
+                             " is not the frame this scene and these options give");
+  host.image.registers().frame_bank = static_cast<std::uint32_t>(cur.frame_bank);
+  board.registers() = host.image.registers();
+  board.regions() = host.image.regions();
+  const std::vector<memif::BankRange> reads = host::frame_reads(host, cur.frame_bank);
+  r.frames.push_back(rec.row);
+  if (k + 1 >= run.opts.frames) return;
+  NextFrame next =
+      prepare_next(run.scene, host, board, reads, k + 1, run.opts.start + (k + 1) * r.dt);
+  apply_runs(board, next.upload.runs);
+  require_same_data(board, host.image, k + 1);
+  next.row.upload_cycles = rec.next_upload_cycles;
+  if (run.cycle) place(next.row, rec.row, rec.gap_cycles);
+  cur = next.row;
+}
+
 }  // namespace
 
 SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
                             const RenderSettings& settings, const SequenceOptions& opts,
-                            const FrameSink& sink) {
+                            const FrameSink& sink, const SequenceResume& resume) {
   check_options(model, opts);
   const bool cycle = model.kind == ModelKind::kCycle;
   units::CycleParams cp;
@@ -399,11 +433,101 @@ SequenceResult run_sequence(const std::string& spec, const ModelSpec& model,
   cur.top_level_builds = host.stats.top_level_builds;
   cur.bottom_level_builds = host.stats.bottom_level_builds;
   cur.host_rebuild_seconds = host.stats.top_build_seconds;
-  SequenceRun run{opts, s, cp, fparams, cycle, scene, host, board, beat, sink};
-  for (int k = 0; k < opts.frames; ++k)
+  SequenceRun run{opts, s, cp, fparams, cycle, scene, host, board, beat, sink, resume};
+  const auto kept = static_cast<int>(std::min<std::size_t>(resume.finished.size(), opts.frames));
+  for (int k = 0; k < opts.frames; ++k) {
+    if (k < kept) {
+      replay_frame(run, k, cur, r, resume.finished[static_cast<std::size_t>(k)]);
+      continue;
+    }
+    if (stop_signal() != 0) break;  // stopped: the frames so far are kept
     run_frame(run, k, cur, r);
-  beat.finish("frames " + std::to_string(opts.frames) + " / " + std::to_string(opts.frames));
+  }
+  const std::string done = std::to_string(r.frames.size()) + " / " + std::to_string(opts.frames);
+  beat.finish(stop_signal() != 0
+                  ? "stopped by " + signal_name(stop_signal()) + ": frames " + done + " kept"
+                  : "frames " + done);
   return r;
+}
+
+// ---- the journal's frame records ---------------------------------------------------------------
+
+std::string frame_record_text(const FrameRecord& rec) {
+  const SequenceFrame& f = rec.row;
+  nlohmann::json j;
+  j["index"] = f.index;
+  j["time"] = double_bits(f.time);
+  j["frame_bank"] = f.frame_bank;
+  j["top_copy"] = f.top_copy;
+  j["top_rebuilt"] = f.top_rebuilt;
+  j["counts"] = {f.moved_instances,
+                 f.top_level_builds,
+                 f.bottom_level_builds,
+                 f.upload_bytes,
+                 f.upload_words,
+                 f.upload_runs,
+                 f.upload_cycles,
+                 f.stall_cycles,
+                 f.start_cycle,
+                 f.cycles,
+                 f.rays,
+                 f.digest};
+  j["flags"] = {f.gap, f.hidden, f.checked};
+  j["doubles"] = {double_bits(f.fps), double_bits(f.shading_bytes_per_pixel),
+                  double_bits(f.cycles_per_packet)};
+  j["figures_cycle"] = f.figures.cycle;
+  for (const double v : f.figures.value)
+    j["figures"].push_back(double_bits(v));
+  j["next_upload_cycles"] = rec.next_upload_cycles;
+  j["gap_cycles"] = rec.gap_cycles;
+  return j.dump();
+}
+
+FrameRecord parse_frame_record(const std::string& text) {
+  FrameRecord rec;
+  SequenceFrame& f = rec.row;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    f.index = j.at("index").get<int>();
+    f.time = bits_double(j.at("time").get<std::string>());
+    f.frame_bank = j.at("frame_bank").get<int>();
+    f.top_copy = j.at("top_copy").get<int>();
+    f.top_rebuilt = j.at("top_rebuilt").get<bool>();
+    const auto c = j.at("counts").get<std::vector<std::uint64_t>>();
+    const auto b = j.at("flags").get<std::vector<bool>>();
+    const auto d = j.at("doubles").get<std::vector<std::string>>();
+    const auto fig = j.at("figures").get<std::vector<std::string>>();
+    if (c.size() != 12 || b.size() != 3 || d.size() != 3 || fig.size() != f.figures.value.size())
+      throw std::runtime_error("fields missing");
+    f.moved_instances = static_cast<std::uint32_t>(c[0]);
+    std::uint64_t* counts[] = {&f.top_level_builds,
+                               &f.bottom_level_builds,
+                               &f.upload_bytes,
+                               &f.upload_words,
+                               &f.upload_runs,
+                               &f.upload_cycles,
+                               &f.stall_cycles,
+                               &f.start_cycle,
+                               &f.cycles,
+                               &f.rays,
+                               &f.digest};
+    for (std::size_t i = 0; i < std::size(counts); ++i)
+      *counts[i] = c[i + 1];
+    f.gap = b[0];
+    f.hidden = b[1];
+    f.checked = b[2];
+    f.fps = bits_double(d[0]);
+    f.shading_bytes_per_pixel = bits_double(d[1]);
+    f.cycles_per_packet = bits_double(d[2]);
+    f.figures.cycle = j.at("figures_cycle").get<std::uint64_t>();
+    for (std::size_t i = 0; i < fig.size(); ++i)
+      f.figures.value[i] = bits_double(fig[i]);
+    rec.next_upload_cycles = j.at("next_upload_cycles").get<std::uint64_t>();
+    rec.gap_cycles = j.at("gap_cycles").get<std::uint64_t>();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("a frame record of the journal is damaged: ") + e.what());
+  }
+  return rec;
 }
 
 // ---- bus sweep ------------------------------------------------------------------------------
@@ -507,27 +631,91 @@ std::string numbered(const std::string& prefix, int index) {
   return prefix + buf + ".png";
 }
 
-// What a sequence (or a bus sweep) leaves: its report, host times, printout, statistics and CSV.
+// What a sequence (or a bus sweep) leaves: its report, host times, printout, statistics and CSV;
+// in a run folder, its journal and the command line that began it.
 struct SequenceOutput {
   nlohmann::json report;
   nlohmann::json host = nlohmann::json::object();
   std::string printout, stats, csv;
+  std::unique_ptr<RunJournal> journal;
+  std::vector<std::string> argv;
 };
+
+// What a sequence's journal must agree on to be resumed: everything that changes a frame.
+nlohmann::json frames_identity(const RenderOptions& o, const SequenceOptions& so) {
+  return {{"command", "render --frames"},
+          {"scene", o.scene},
+          {"model", o.model},
+          {"res", o.res},
+          {"time", o.time},
+          {"shadows", o.shadows},
+          {"depth", o.depth},
+          {"bank_mb", o.bank_mb},
+          {"preset", o.cycle.preset},
+          {"set", o.cycle.set},
+          {"frames", so.frames},
+          {"dt", so.dt},
+          {"frame_gap", so.frame_gap}};
+}
+
+std::string frame_key(int index) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "frame%05d", index);
+  return buf;
+}
+
+// --out-dir: the folder's journal, new or (--resume) with the frames it holds; each frame is
+// appended as it finishes.
+std::unique_ptr<RunJournal> open_frames_journal(const RenderOptions& opts,
+                                                const SequenceOptions& so, SequenceResume& resume) {
+  const nlohmann::json id = frames_identity(opts, so);
+  auto journal = opts.resume.empty()
+                     ? std::make_unique<RunJournal>(opts.out_dir, id, opts.argv)
+                     : std::make_unique<RunJournal>(RunJournal::resume(opts.out_dir, id));
+  for (const JournalRecord& rec : journal->records()) {
+    if (rec.key != frame_key(static_cast<int>(resume.finished.size())))
+      throw std::runtime_error("--resume '" + opts.out_dir + "': journal.txt has " + rec.key +
+                               " where " + frame_key(static_cast<int>(resume.finished.size())) +
+                               " belongs");
+    resume.finished.push_back(parse_frame_record(rec.payload));
+  }
+  RunJournal* j = journal.get();
+  resume.on_frame = [j](const FrameRecord& f) {
+    j->append(frame_key(f.row.index), frame_record_text(f));
+  };
+  return journal;
+}
 
 SequenceOutput sequence_output(const RenderOptions& opts, const ModelSpec& model,
                                const RenderSettings& settings, const SequenceOptions& so,
                                const std::string& prefix,
                                std::vector<std::pair<std::string, std::string>>& outputs) {
-  int written = 0;
   const FrameSink sink = [&](const SequenceFrame& f, const Rgb8Image& image) {
     write_rgb8(numbered(prefix, f.index), image);
-    ++written;
   };
-  const SequenceResult r = run_sequence(opts.scene, model, settings, so, sink);
   SequenceOutput out;
+  out.argv = opts.argv;
+  SequenceResume resume;
+  std::optional<StopOnSignal> stop;
+  if (!opts.out_dir.empty()) {
+    out.journal = open_frames_journal(opts, so, resume);
+    out.argv = out.journal->argv();  // command.txt: the command that began the run
+    stop.emplace();                  // SIGINT, SIGTERM: start no frame, keep the finished ones
+  }
+  const SequenceResult r = run_sequence(opts.scene, model, settings, so, sink, resume);
+  if (stop_signal() != 0)
+    throw Interrupted(stop_signal(), "render --frames stopped by " + signal_name(stop_signal()) +
+                                         ": " + std::to_string(r.frames.size()) + " of " +
+                                         std::to_string(so.frames) + " frames kept in " +
+                                         opts.out_dir + "/journal.txt; go on with: saarcor " +
+                                         "render ... --resume " + opts.out_dir);
+  if (!resume.finished.empty())
+    out.printout = "resumed: " + std::to_string(resume.finished.size()) + " frames from " +
+                   opts.out_dir + "/journal.txt, " +
+                   std::to_string(r.frames.size() - resume.finished.size()) + " rendered now\n";
   // A run folder keeps host times in host.json.
   out.report = sequence_json(r, opts.out_dir.empty());
-  out.printout = sequence_table(r);
+  out.printout += sequence_table(r);
   out.csv = sequence_csv(r);
   out.stats = stats_text(sequence_stat_lines(r));
   out.host = sequence_host_json(r);
@@ -542,7 +730,8 @@ SequenceOutput sequence_output(const RenderOptions& opts, const ModelSpec& model
     out.printout += buf;
   }
   out.printout += ")\n";
-  outputs.push_back({"images", numbered(prefix, 0) + " .. " + numbered(prefix, written - 1)});
+  outputs.push_back({"images", numbered(prefix, 0) + " .. " +
+                                   numbered(prefix, static_cast<int>(r.frames.size()) - 1)});
   return out;
 }
 
@@ -564,6 +753,20 @@ SequenceOutput bus_sweep_output(const RenderOptions& opts, const ModelSpec& mode
 }  // namespace
 
 namespace {
+
+// --resume DIR names the run folder (--out-dir beside it must name the same one); one sequence
+// only: a bus sweep reruns its sequence per bandwidth and keeps no journal.
+RenderOptions resolve_frames_resume(const RenderOptions& opts) {
+  RenderOptions o = opts;
+  if (o.resume.empty()) return o;
+  if (!o.bus_sweep.empty())
+    throw std::runtime_error("--resume goes on with one sequence; --bus-sweep keeps no journal");
+  if (!o.out_dir.empty() && o.out_dir != o.resume)
+    throw std::runtime_error("--resume '" + o.resume + "' and --out-dir '" + o.out_dir +
+                             "' name two folders: give one");
+  o.out_dir = o.resume;
+  return o;
+}
 
 // The options a sequence refuses or needs, checked before any frame runs; the bus sweep's
 // bandwidths.
@@ -595,7 +798,8 @@ std::vector<double> check_sequence(const RenderOptions& opts, const ModelSpec& m
 
 }  // namespace
 
-int run_frame_sequence(const RenderOptions& opts) {
+int run_frame_sequence(const RenderOptions& options) {
+  const RenderOptions opts = resolve_frames_resume(options);
   const ModelSpec model = parse_model(opts.model);
   refuse_single_frame_options(opts);
   SequenceOptions so = sequence_options(opts);
@@ -617,7 +821,7 @@ int run_frame_sequence(const RenderOptions& opts) {
                 {},
                 std::move(out.host),
                 std::move(out.stats),
-                opts.argv,
+                out.argv.empty() ? opts.argv : out.argv,
                 {}};
     f.config = f.report["configuration"];
     if (!out.csv.empty()) {
@@ -625,6 +829,7 @@ int run_frame_sequence(const RenderOptions& opts) {
       outputs.push_back({"csv", run_file(opts.out_dir, "frames.csv")});
     }
     write_run_folder(f);
+    if (out.journal) out.journal->seal();
     for (const char* name : {"report.json", "config.json", "command.txt", "host.json"})
       outputs.push_back({name, run_file(opts.out_dir, name)});
   } else if (!opts.report.empty()) {

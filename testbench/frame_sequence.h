@@ -100,14 +100,37 @@ struct SequenceResult {
 // Called once per frame, in order, with its row and its image.
 using FrameSink = std::function<void(const SequenceFrame&, const Rgb8Image&)>;
 
+// A finished frame as a run folder's journal keeps it (testbench/run_journal.h): its row without
+// host seconds, and what its render measured of the next frame's upload (the bus cycles it took
+// beside this frame; with a frame gap, the cycles it took alone after it).
+struct FrameRecord {
+  SequenceFrame row;
+  std::uint64_t next_upload_cycles = 0;
+  std::uint64_t gap_cycles = 0;
+};
+// One line (every double as its bits: exact) and back; throws one line on a damaged record.
+std::string frame_record_text(const FrameRecord& r);
+FrameRecord parse_frame_record(const std::string& text);
+
+// A sequence that goes on from frames a stopped run finished, and tells of each frame it finishes.
+struct SequenceResume {
+  // Frames 0..K-1 of a stopped run: not rendered again; the host replays their rebuilds and
+  // uploads, so frame K starts from the state it had, and their rows are taken as they were.
+  std::vector<FrameRecord> finished;
+  // Called with each frame rendered now, after the sink has its image.
+  std::function<void(const FrameRecord&)> on_frame;
+};
+
 // Runs the sequence: loads `scene`, builds its image at opts.start with two top-level copies (one
 // with frame_gap), then frame after frame as above. `model` is the cycle model or a functional
 // model (no timing: upload bytes, rebuilds and images only). Throws std::runtime_error with one
 // line on bad input, on a frame whose results differ from the functional model's, and on an upload
 // the host bus refuses.
+// After SIGINT or SIGTERM (testbench/run_journal.h stop_signal) no frame starts: the result holds
+// the frames that finished.
 SequenceResult run_sequence(const std::string& scene, const ModelSpec& model,
                             const RenderSettings& settings, const SequenceOptions& opts,
-                            const FrameSink& sink = {});
+                            const FrameSink& sink = {}, const SequenceResume& resume = {});
 
 // --bus-sweep: the sequence once per host-bus bandwidth (MB/s); every point's frames must have
 // the first point's digests. Returns one result per bandwidth (printed by testbench/report.h's

@@ -475,18 +475,25 @@ void check_trace_options(const TraceOptions& t, const ModelSpec& model, bool pix
         "the float reference has none");
   if (!t.konata.empty() && !cycle)
     throw std::runtime_error("--konata needs --model cycle (the functional model has no cycles)");
+  if (!t.perfetto.empty() && !cycle)
+    throw std::runtime_error("--perfetto needs --model cycle (the functional model has no cycles)");
+  if (!t.perfetto.empty() && !t.perfetto.ends_with(".json"))
+    throw std::runtime_error("bad --perfetto '" + t.perfetto +
+                             "': the trace-event file name ends in .json");
   if ((t.window_given || !t.konata_threads.empty()) && !cycle)
     throw std::runtime_error(
         "--trace-from, --trace-to and --konata-threads apply to --model cycle");
   if (t.window_given && !t.any())
-    throw std::runtime_error("--trace-from and --trace-to limit --trace or --konata: give one");
+    throw std::runtime_error(
+        "--trace-from and --trace-to limit --trace, --konata or --perfetto: give one");
   if (!t.konata_threads.empty() && t.konata.empty())
     throw std::runtime_error("--konata-threads chooses the threads of --konata: give it");
   if (t.to < t.from)
     throw std::runtime_error("bad --trace-to " + std::to_string(t.to) + ": before --trace-from " +
                              std::to_string(t.from));
   if (pixel && t.any())
-    throw std::runtime_error("--pixel prints its packet's requests itself: drop --trace, --konata");
+    throw std::runtime_error(
+        "--pixel prints its packet's requests itself: drop --trace, --konata, --perfetto");
 }
 
 std::vector<std::uint32_t> parse_thread_list(const std::string& text, int threads) {
@@ -533,12 +540,13 @@ class TraceFiles {
       run.konata_threads = parse_thread_list(t.konata_threads, threads);
     open(t.file, "--trace", trace_, run.trace);
     open(t.konata, "--konata", konata_, run.konata);
+    open(t.perfetto, "--perfetto", perfetto_, run.perfetto);
   }
   TraceFiles(const TraceFiles&) = delete;
   TraceFiles& operator=(const TraceFiles&) = delete;
   ~TraceFiles() {
     if (done_) return;
-    for (const std::string* f : {&t_.file, &t_.konata})
+    for (const std::string* f : {&t_.file, &t_.konata, &t_.perfetto})
       if (!f->empty()) {
         std::error_code ec;
         std::filesystem::remove(*f, ec);
@@ -548,6 +556,7 @@ class TraceFiles {
   void finish(std::vector<std::pair<std::string, std::string>>& outputs) {
     close(t_.file, "--trace", trace_, "trace", outputs);
     close(t_.konata, "--konata", konata_, "konata", outputs);
+    close(t_.perfetto, "--perfetto", perfetto_, "perfetto", outputs);
     done_ = true;
   }
   units::RunTraceOptions run;
@@ -567,7 +576,7 @@ class TraceFiles {
     outputs.push_back({key, file});
   }
   const TraceOptions& t_;
-  std::ofstream trace_, konata_;
+  std::ofstream trace_, konata_, perfetto_;
   bool done_ = false;
 };
 
@@ -694,8 +703,9 @@ void write_frame_outputs(const RenderOptions& opts, const ModelSpec& model,
 
 int run_render(const RenderOptions& opts) {
   if (opts.frames_given) return run_frame_sequence(opts);
-  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty())
-    throw std::runtime_error("--fps, --dt, --frame-gap and --bus-sweep need --frames N");
+  if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty() ||
+      !opts.resume.empty())
+    throw std::runtime_error("--fps, --dt, --frame-gap, --bus-sweep and --resume need --frames N");
   const ModelSpec model = parse_model(opts.model);
   RenderSettings settings =
       frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);

@@ -127,16 +127,17 @@ std::string join_words(const std::vector<std::string>& words);
 RenderSettings frame_settings(const std::string& res, double time, bool shadows, int depth,
                               double bank_mb);
 
-// --trace FILE [--trace-from N --trace-to M] and --konata FILE [--konata-threads LIST]
-// (docs/traces.md).
+// --trace FILE [--trace-from N --trace-to M], --konata FILE [--konata-threads LIST] and
+// --perfetto FILE.json (docs/traces.md).
 struct TraceOptions {
-  std::string file;    // the request trace (models fp24, e7mM, cycle, cycle-e7m23)
-  std::string konata;  // the Kanata log (cycle models)
+  std::string file;      // the request trace (models fp24, e7mM, cycle, cycle-e7m23)
+  std::string konata;    // the Kanata log (cycle models)
+  std::string perfetto;  // the Chrome trace-event timeline (cycle models; units/perfetto_trace.h)
   std::uint64_t from = 0;
   std::uint64_t to = std::numeric_limits<std::uint64_t>::max();
   bool window_given = false;   // --trace-from or --trace-to on the command line
   std::string konata_threads;  // "0,3,8-11": the Kanata log's threads (default: every thread)
-  bool any() const { return !file.empty() || !konata.empty(); }
+  bool any() const { return !file.empty() || !konata.empty() || !perfetto.empty(); }
 };
 // Checks the trace options against the model (one line naming the option on misuse).
 void check_trace_options(const TraceOptions& t, const ModelSpec& model, bool pixel);
@@ -175,6 +176,9 @@ struct RenderOptions {
   double dt = 0.0;
   bool frame_gap = false;
   std::string bus_sweep;
+  // --resume DIR: the run folder of a sequence that was stopped (testbench/run_journal.h): only
+  // the frames its journal lacks are rendered. Implies --out-dir DIR.
+  std::string resume;
   bool frames_given = false, fps_given = false, dt_given = false;
 };
 

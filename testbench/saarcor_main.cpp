@@ -15,6 +15,7 @@
 #include "testbench/paper_cmd.h"
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
+#include "testbench/run_journal.h"
 #include "testbench/scene_cmd.h"
 #include "testbench/sweep_cmd.h"
 #include "testbench/vectors_cmd.h"
@@ -138,13 +139,15 @@ void add_render_trace_options(CLI::App* sub, saarcor::RenderOptions& render_opts
                   "write the request trace: a line per unit request with its transactions "
                   "(fp24, e7mM and cycle models)");
   given.trace_from = sub->add_option("--trace-from", render_opts.trace.from,
-                                     "cycle model: first cycle of --trace and --konata");
+                                     "cycle model: first cycle of --trace, --konata, --perfetto");
   given.trace_to = sub->add_option("--trace-to", render_opts.trace.to,
-                                   "cycle model: last cycle of --trace and --konata");
+                                   "cycle model: last cycle of --trace, --konata, --perfetto");
   sub->add_option("--konata", render_opts.trace.konata,
                   "cycle model: write a Kanata pipeline log (opens in Konata)");
   sub->add_option("--konata-threads", render_opts.trace.konata_threads,
                   "cycle model: the threads of --konata, e.g. 0,3,8-11 (default: all)");
+  sub->add_option("--perfetto", render_opts.trace.perfetto,
+                  "cycle model: write a Perfetto / chrome://tracing timeline (trace-event JSON)");
 }
 
 // Frame sequences (testbench/frame_sequence.h, docs/frames.md)
@@ -157,6 +160,9 @@ void add_render_sequence_options(CLI::App* sub, saarcor::RenderOptions& render_o
                               "frames: frames per animation second (default: the animation's "
                               "length spread over the frames)");
   given.dt = sub->add_option("--dt", render_opts.dt, "frames: animation seconds between frames");
+  sub->add_option("--resume", render_opts.resume,
+                  "frames: go on with the stopped sequence in run folder DIR, rendering only the "
+                  "frames its journal lacks (implies --out-dir DIR)");
   sub->add_flag("--frame-gap", render_opts.frame_gap,
                 "frames: one top-level copy, every upload after the frame in flight (instead "
                 "of two copies and uploads during it)");
@@ -234,7 +240,10 @@ void add_sweep(CLI::App& app, saarcor::SweepOptions& sweep_opts, int& status,
                   "K/N: only shard K of N (every N-th point; merge with sweep-merge)");
   sub->add_option("--out-dir", sweep_opts.out_dir,
                   "write sweep.csv, report.json, stats.txt, config.json, command.txt, host.json "
-                  "into DIR");
+                  "into DIR (and each point to DIR/journal.txt as it finishes)");
+  sub->add_option("--resume", sweep_opts.resume,
+                  "go on with the stopped sweep in run folder DIR: run only the points its "
+                  "journal lacks (implies --out-dir DIR)");
   sub->add_flag("--pareto", sweep_opts.pareto,
                 "mark the points no other point beats in both frame rate and cost (the LUT "
                 "estimate unless --pareto-cost says)");
@@ -357,6 +366,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const saarcor::Interrupted& e) {
+    // SIGINT or SIGTERM stopped a run that kept what finished: one line, 128 + the signal.
+    std::fprintf(stderr, "saarcor: %s\n", e.what());
+    return 128 + e.signo();
   } catch (const std::exception& e) {
     // Every bad input ends here: one line naming the problem, non-zero exit.
     std::fprintf(stderr, "saarcor: error: %s\n", e.what());

@@ -9,6 +9,7 @@
 #include <exception>
 #include <fstream>
 #include <future>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -22,6 +23,7 @@
 #include "testbench/image_io.h"
 #include "testbench/mpi_ranks.h"
 #include "testbench/report.h"
+#include "testbench/run_journal.h"
 #include "testbench/task_pool.h"
 #include "units/cost.h"
 #include "units/cycle_params.h"
@@ -158,6 +160,7 @@ std::vector<Group> group_by_trees(const std::vector<std::vector<std::string>>& p
                                   const SweepRun& run) {
   std::vector<Group> groups = {{"", {}}};
   for (std::size_t i = run.shard; i < points.size(); i += run.shards) {
+    if (run.finished.contains(i)) continue;  // kept from a run that was stopped
     std::string trees;
     for (const std::string& kv : points[i])
       if (host::is_tree_setting(kv)) trees += kv + " ";
@@ -179,6 +182,7 @@ struct SweepContext {
   const ModelSpec& cycle;
   const ModelSpec& functional;
   int jobs;
+  const std::function<void(const SweepPoint&)>& on_point;
   Heartbeat& beat;
   std::atomic<std::size_t>& done;
   std::size_t selected;
@@ -214,6 +218,7 @@ std::vector<SweepPoint> run_group(const Group& g, const SweepContext& cx, SweepR
       }
       return;
     }
+    if (stop_signal() != 0) return;  // stopped: the point stays missing
     const std::size_t i = g.points[task - 1];
     RenderSettings s = cx.settings;
     s.heartbeat = group_settings.heartbeat;
@@ -230,10 +235,12 @@ std::vector<SweepPoint> run_group(const Group& g, const SweepContext& cx, SweepR
     // The configuration's cost, the light table at the preset's capacity (units/cost.h).
     p.cost =
         sweep_cost_json({resolve_cycle_params(s.cycle), units::cost_preset(s.cycle.preset).lights});
+    if (cx.on_point) cx.on_point(p);
     cx.beat.beat("points " + std::to_string(++cx.done) + " / " + std::to_string(cx.selected) +
                  (cx.jobs > 1 ? ", " + std::to_string(cx.jobs) + " at once" : ""));
   });
   if (g.trees.empty()) r.functional_rays = reference.get().rays;
+  std::erase_if(group_points, [](const SweepPoint& p) { return p.cycle.is_null(); });
   return group_points;
 }
 
@@ -256,17 +263,25 @@ SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedS
   const std::vector<Group> groups = group_by_trees(points, run);
 
   Heartbeat beat("sweep", run.heartbeat && heartbeat_enabled());
-  std::atomic<std::size_t> done{0};
-  std::size_t selected = 0;
+  std::atomic<std::size_t> done{run.finished.size()};
+  std::size_t selected = run.finished.size();
   for (const Group& g : groups)
     selected += g.points.size();
-  const SweepContext cx{points, prepared, settings, cycle, functional, jobs, beat, done, selected};
+  const SweepContext cx{points, prepared,     settings, cycle, functional,
+                        jobs,   run.on_point, beat,     done,  selected};
   std::vector<SweepPoint> results;
+  for (const auto& [index, point] : run.finished)
+    results.push_back(point);
   for (const Group& g : groups) {
+    if (stop_signal() != 0) break;
     for (SweepPoint& p : run_group(g, cx, r))
       results.push_back(std::move(p));
   }
-  beat.finish();
+  if (stop_signal() != 0)
+    beat.finish("stopped by " + signal_name(stop_signal()) + ": points " +
+                std::to_string(results.size()) + " / " + std::to_string(selected) + " kept");
+  else
+    beat.finish();
   std::ranges::sort(results, {}, &SweepPoint::index);
   r.points = std::move(results);
   set_speedups(r);
@@ -496,6 +511,60 @@ void check_sweep_outputs(const SweepOptions& opts) {
   }
 }
 
+// What a sweep's journal must agree on to be resumed: everything that changes a point's result or
+// which points there are (not --jobs, --host-threads or the outputs).
+nlohmann::json sweep_identity(const SweepOptions& o) {
+  return {{"command", "sweep"}, {"scene", o.scene},     {"model", o.model}, {"res", o.res},
+          {"time", o.time},     {"shadows", o.shadows}, {"depth", o.depth}, {"bank_mb", o.bank_mb},
+          {"preset", o.preset}, {"set", o.set},         {"vary", o.vary},   {"shard", o.shard}};
+}
+
+std::string point_key(std::size_t index) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "point%04zu", index);
+  return buf;
+}
+
+// A finished point as its journal record: its report without host timing (host.json's alone).
+std::string point_record(const SweepPoint& p) {
+  nlohmann::json cycle = p.cycle;
+  take_cycle_host(cycle);
+  return nlohmann::json{
+      {"index", p.index}, {"settings", p.settings}, {"cycle", cycle}, {"cost", p.cost}}
+      .dump();
+}
+
+// --out-dir (and --resume, which names it): the folder's journal, new or resumed, with the points
+// it holds in `run.finished`; none under mpirun (the ranks' points reach rank 0 only at the end).
+std::unique_ptr<RunJournal> open_sweep_journal(SweepOptions& o, int ranks, SweepRun& run) {
+  if (o.out_dir.empty()) return nullptr;
+  if (ranks > 1) {
+    if (!o.resume.empty())
+      throw std::runtime_error("--resume runs in one process: drop mpirun (or resume --shard K/N)");
+    return nullptr;
+  }
+  if (o.resume.empty()) return std::make_unique<RunJournal>(o.out_dir, sweep_identity(o), o.argv);
+  auto j = std::make_unique<RunJournal>(RunJournal::resume(o.out_dir, sweep_identity(o)));
+  for (const JournalRecord& r : j->records()) {
+    const nlohmann::json e = nlohmann::json::parse(r.payload);
+    SweepPoint p = sweep_points_from_json(nlohmann::json::array({e})).front();
+    run.finished.emplace(p.index, std::move(p));
+  }
+  o.argv = j->argv();  // command.txt: the command that began the run
+  return j;
+}
+
+// --resume DIR names the folder; --out-dir beside it must name the same one.
+SweepOptions resolve_resume(const SweepOptions& opts) {
+  SweepOptions o = opts;
+  if (o.resume.empty()) return o;
+  if (!o.out_dir.empty() && o.out_dir != o.resume)
+    throw std::runtime_error("--resume '" + o.resume + "' and --out-dir '" + o.out_dir +
+                             "' name two folders: give one");
+  o.out_dir = o.resume;
+  return o;
+}
+
 // --out-dir, --report and --csv, from the whole sweep (rank 0's) with its front marked.
 void write_sweep_outputs(const SweepOptions& opts, const SweepResult& sweep,
                          const RenderSettings& settings, int jobs, int ranks) {
@@ -535,7 +604,58 @@ void print_sweep(const SweepOptions& opts, const SweepResult& sweep, const Rende
 
 }  // namespace
 
-int run_sweep(const SweepOptions& opts) {
+namespace {
+
+// The sweep's frame settings, axes and run (jobs, shard or rank), every option checked before the
+// scene loads; returns the points' count.
+std::size_t plan_sweep(const SweepOptions& opts, const MpiRanks& ranks, RenderSettings& settings,
+                       std::vector<SweepAxis>& axes, SweepRun& run, int& jobs) {
+  settings = frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
+  settings.cycle.preset = opts.preset;
+  settings.cycle.set = opts.set;
+  settings.cycle.host_threads = opts.host_threads;
+  const ModelSpec model = parse_model(opts.model);
+  if (model.kind != ModelKind::kCycle) {
+    throw std::runtime_error("bad --model " + opts.model + ": a sweep runs cycle or cycle-e7m23");
+  }
+  for (const std::string& v : opts.vary) {
+    axes.push_back(parse_sweep_axis(v));
+  }
+  // Every bad input fails here, before the scene loads and before any frame runs.
+  const std::size_t count = sweep_points(axes, settings.cycle).size();
+  check_sweep_outputs(opts);
+  pareto_cost_name(opts.pareto_cost);
+  const bool per_core = jobs == 0;
+  jobs = resolve_jobs(jobs);
+  if (!opts.shard.empty()) std::tie(run.shard, run.shards) = parse_shard(opts.shard);
+  if (ranks.size() > 1) {
+    if (!opts.shard.empty())
+      throw std::runtime_error("--shard and mpirun both split the sweep: give one of them");
+    run.shard = static_cast<std::size_t>(ranks.rank());
+    run.shards = static_cast<std::size_t>(ranks.size());
+  }
+  if (per_core) {
+    jobs = std::max(1, jobs / ranks.local_size());  // the host's cores, shared by its ranks
+  }
+  run.jobs = jobs;
+  run.heartbeat = ranks.rank() == 0;
+  return count;
+}
+
+// A sweep a signal stopped: what it kept and how to go on (one line).
+Interrupted sweep_stopped(const SweepOptions& o, const SweepResult& sweep, std::size_t count,
+                          const SweepRun& run) {
+  const std::size_t mine = (count - run.shard + run.shards - 1) / run.shards;
+  return Interrupted(stop_signal(), "sweep stopped by " + signal_name(stop_signal()) + ": " +
+                                        std::to_string(sweep.points.size()) + " of " +
+                                        std::to_string(mine) + " points kept in " + o.out_dir +
+                                        "/journal.txt; go on with: saarcor sweep ... --resume " +
+                                        o.out_dir);
+}
+
+}  // namespace
+
+int run_sweep(const SweepOptions& options) {
   // Under mpirun every rank runs this; rank 0 gathers and alone prints and writes. Every failure
   // of any rank, bad input included, reaches rank 0 as text, so no rank waits for a dead one and
   // the error is printed once.
@@ -543,42 +663,30 @@ int run_sweep(const SweepOptions& opts) {
   std::string error;
   SweepResult sweep;
   RenderSettings settings;
-  std::size_t count = 0;
-  int jobs = opts.jobs;
+  std::size_t count = 0, resumed = 0;
+  int jobs = options.jobs;
+  SweepOptions opts;
+  std::unique_ptr<RunJournal> journal;
+  std::optional<StopOnSignal> stop;
+  SweepRun run;
   try {
-    settings = frame_settings(opts.res, opts.time, opts.shadows, opts.depth, opts.bank_mb);
-    settings.cycle.preset = opts.preset;
-    settings.cycle.set = opts.set;
-    settings.cycle.host_threads = opts.host_threads;
-    const ModelSpec model = parse_model(opts.model);
-    if (model.kind != ModelKind::kCycle) {
-      throw std::runtime_error("bad --model " + opts.model + ": a sweep runs cycle or cycle-e7m23");
-    }
+    opts = resolve_resume(options);
     std::vector<SweepAxis> axes;
-    for (const std::string& v : opts.vary) {
-      axes.push_back(parse_sweep_axis(v));
+    count = plan_sweep(opts, ranks, settings, axes, run, jobs);
+    journal = open_sweep_journal(opts, ranks.size(), run);
+    resumed = run.finished.size();
+    if (journal) {
+      stop.emplace();  // SIGINT, SIGTERM: stop starting points, keep the finished ones
+      run.on_point = [&journal](const SweepPoint& p) {
+        journal->append(point_key(p.index), point_record(p));
+      };
     }
-    // Every bad input fails here, before the scene loads and before any frame runs.
-    count = sweep_points(axes, settings.cycle).size();
-    check_sweep_outputs(opts);
-    pareto_cost_name(opts.pareto_cost);
-    const bool per_core = jobs == 0;
-    jobs = resolve_jobs(jobs);
-    SweepRun run;
-    if (!opts.shard.empty()) std::tie(run.shard, run.shards) = parse_shard(opts.shard);
-    if (ranks.size() > 1) {
-      if (!opts.shard.empty())
-        throw std::runtime_error("--shard and mpirun both split the sweep: give one of them");
-      run.shard = static_cast<std::size_t>(ranks.rank());
-      run.shards = static_cast<std::size_t>(ranks.size());
-    }
-    if (per_core) {
-      jobs = std::max(1, jobs / ranks.local_size());  // the host's cores, shared by its ranks
-    }
-    run.jobs = jobs;
-    run.heartbeat = ranks.rank() == 0;
+    const ModelSpec model = parse_model(opts.model);
     const PreparedScene prep = prepare_scene(opts.scene, settings, ff::Format{7, model.mantissa});
     sweep = run_sweep_points(axes, prep, settings, run);
+    if (stop_signal() != 0) throw sweep_stopped(opts, sweep, count, run);
+  } catch (const Interrupted&) {
+    throw;
   } catch (const std::exception& e) {
     error = e.what();
   }
@@ -587,7 +695,11 @@ int run_sweep(const SweepOptions& opts) {
   if (opts.pareto || !opts.pareto_cost.empty())
     mark_pareto(sweep, pareto_cost_name(opts.pareto_cost));
   write_sweep_outputs(opts, sweep, settings, jobs, ranks.size());
+  if (journal) journal->seal();
   print_sweep(opts, sweep, settings, count);
+  if (resumed != 0)
+    std::printf("  resumed:   %zu points from %s/journal.txt, %zu run now\n", resumed,
+                opts.out_dir.c_str(), sweep.points.size() - resumed);
   return 0;
 }
 

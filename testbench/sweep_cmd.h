@@ -8,6 +8,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -55,6 +57,10 @@ struct SweepOptions {
   // config.json, command.txt, host.json; --csv and --report are refused with it.
   std::string out_dir;
   std::vector<std::string> argv;  // the command line, for command.txt
+  // --resume DIR: the run folder of a sweep that was stopped (testbench/run_journal.h): only the
+  // points its journal lacks run, and the folder ends as an uninterrupted run leaves it. Implies
+  // --out-dir DIR.
+  std::string resume;
   // --pareto: mark the points no other point beats in both frame rate (higher is better) and
   // cost (lower is better); --pareto-cost names the cost (a cost column: luts, the default,
   // block_rams, memory_kb, fp_units) and implies --pareto.
@@ -92,6 +98,11 @@ struct SweepRun {
   std::size_t shard = 0;
   std::size_t shards = 1;
   bool heartbeat = true;  // points done / total on the terminal (testbench/heartbeat.h)
+  // Points already finished (a resumed run's journal), by index: not run again, returned as they
+  // are. A group of points with other trees whose points are all here builds no image.
+  std::map<std::size_t, SweepPoint> finished;
+  // Called with each point as it finishes (from the worker that ran it; serialised by the callee).
+  std::function<void(const SweepPoint&)> on_point;
 };
 // "K/N" with 1 <= K <= N <= kMaxSweepPoints -> {K - 1, N}; throws "bad --shard 'TEXT': ...".
 std::pair<std::size_t, std::size_t> parse_shard(const std::string& text);
@@ -106,7 +117,8 @@ void check_sweep_point(const FrameResult& frame, const FrameResult& reference,
 // each frame's thread programs run on its worker's thread (--host-threads 1) unless --host-threads
 // says otherwise. The points come back in sweep order whatever finishes first; throws naming the
 // first point (in sweep order) whose hit records or image differ from the functional fp24
-// model's, as a serial run would.
+// model's, as a serial run would. After SIGINT or SIGTERM (testbench/run_journal.h stop_signal)
+// no point starts: the result holds the points that finished.
 SweepResult run_sweep_points(const std::vector<SweepAxis>& axes, const PreparedScene& prepared,
                              const RenderSettings& settings, const SweepRun& run = {});
 // Every point's speed-up over the first point held (the sweep's first point in a whole sweep).

@@ -461,7 +461,7 @@ TEST(TraceCommand, MisuseIsOneErrorLine) {
       run_saarcor(base + "--model fp24 --trace " + (d / "t").string() + " --trace-to 5"),
       "apply to --model cycle");
   expect_one_line_error(run_saarcor(base + "--model cycle --trace-to 5"),
-                        "limit --trace or --konata");
+                        "limit --trace, --konata or --perfetto");
   expect_one_line_error(
       run_saarcor(base + "--model cycle --konata " + (d / "k").string() + " --konata-threads 0,64"),
       "bad --konata-threads '0,64': thread 64 does not exist (64 threads)");

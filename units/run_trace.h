@@ -16,15 +16,17 @@
 namespace saarcor::units {
 
 struct RunTraceOptions {
-  std::ostream* trace = nullptr;   // request trace lines
-  std::ostream* konata = nullptr;  // Kanata log
+  std::ostream* trace = nullptr;     // request trace lines
+  std::ostream* konata = nullptr;    // Kanata log
+  std::ostream* perfetto = nullptr;  // Chrome trace-event JSON (units/perfetto_trace.h)
   // The cycle window: trace lines of requests issued in [from, to]; Kanata records of requests
-  // that entered their unit (queued or, chained, issued) in [from, to].
+  // that entered their unit (queued or, chained, issued) in [from, to]; the Perfetto timeline's
+  // slices of requests issued and misses accepted in [from, to], its counters sampled in it.
   std::uint64_t from = 0;
   std::uint64_t to = std::numeric_limits<std::uint64_t>::max();
   std::vector<std::uint32_t> konata_threads;  // the Kanata log's threads; empty: every thread
   int packet = -1;  // >= 0: only this primary packet's requests (both outputs)
-  bool any() const { return trace != nullptr || konata != nullptr; }
+  bool any() const { return trace != nullptr || konata != nullptr || perfetto != nullptr; }
 };
 
 // The stage names of a Kanata record, in order (a zero-length stage is left out).
