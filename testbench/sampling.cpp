@@ -97,10 +97,12 @@ SamplePlan plan_sample(int packets, const SampleSpec& s) {
 }
 
 double student_t975(int df) {
-  // Exact for small df; above, the Cornish-Fisher expansion around z (error < 1e-4 for df >= 8).
-  static constexpr double kSmall[] = {12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469, 2.3646};
+  // The table for small df; above, the Cornish-Fisher expansion around z (error < 1e-4 for
+  // df >= 13).
+  static constexpr double kSmall[] = {12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469,
+                                      2.3646,  2.3060, 2.2622, 2.2281, 2.2010, 2.1788};
   if (df < 1) throw std::logic_error("student_t975: df < 1");
-  if (df <= 7) return kSmall[df - 1];
+  if (df <= 12) return kSmall[df - 1];
   const double z = 1.959964, n = df;
   const double z3 = z * z * z, z5 = z3 * z * z, z7 = z5 * z * z;
   return z + (z3 + z) / (4 * n) + (5 * z5 + 16 * z3 + 3 * z) / (96 * n * n) +
@@ -276,6 +278,8 @@ void estimate_frame(const units::CycleParams& p, const SamplePlan& plan, std::ui
     s.figures[static_cast<std::size_t>(k)] = e.ci;
   }
   c.figures.cycle = c.cycles;
+  // The RGS's bytes per pixel: the simulated packets' bytes over their pixels.
+  c.shading_bytes_per_pixel *= static_cast<double>(packets) / static_cast<double>(c.packets);
   s.cycles_per_packet_cov = coefficient_of_variation(cpp);
   s.defeated = defeated_because(plan.windows, s.cycles_per_packet_cov);
 }

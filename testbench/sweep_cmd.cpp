@@ -22,6 +22,7 @@
 #include "testbench/image_io.h"
 #include "testbench/mpi_ranks.h"
 #include "testbench/report.h"
+#include "testbench/sampling.h"
 #include "testbench/task_pool.h"
 #include "units/cost.h"
 #include "units/cycle_params.h"
@@ -519,6 +520,12 @@ void print_sweep(const SweepOptions& opts, const SweepResult& sweep, const Rende
       "functional %s model (hit records and image, %" PRIu64 " rays)\n",
       opts.scene.c_str(), opts.model.c_str(), settings.res.width, settings.res.height, count,
       shard.c_str(), sweep.functional_model.c_str(), sweep.functional_rays);
+  // A sampled point's figures are estimates; its simulated packets were checked (docs/sampling.md).
+  if (opts.sample)
+    std::printf(
+        "  sampled (--sample %s): each point's simulated packets checked, its figures "
+        "estimated with 95 %% intervals in the report\n",
+        sample_spec_text(parse_sample_spec(opts.sample_spec)).c_str());
   if (!opts.out_dir.empty()) {
     std::printf(
         "  run folder: %s (sweep.csv, report.json, stats.txt, config.json, command.txt, "
