@@ -87,6 +87,7 @@ class Chip {
     return n;
   }
   int pipelines() const { return static_cast<int>(pipes_.size()); }
+  int handed_out() const { return rgc_.handed_out(); }
   DynRtp& pipeline(int i) { return *pipes_[static_cast<std::size_t>(i)]; }
   void observe(UnitObserver* o) {
     for (auto& d : pipes_)
@@ -271,6 +272,22 @@ void simulate(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads, co
   }
 }
 
+// simulate() until the frame's end, reading the chip's counts at each of opt.marks (the cycle
+// after which that many packets were handed out) into `marks`.
+template <class F, int kLanes>
+void simulate_marked(hw::Kernel& k, Chip& chip, RecordedThreads<F, kLanes>& threads,
+                     const CycleParams& p, const CycleRunOptions& opt, const ChipCounters& cc,
+                     std::vector<FigureCounts>& marks) {
+  for (int m : opt.marks) {
+    simulate(k, chip, threads, p, opt, [&] { return chip.finished() || chip.handed_out() >= m; });
+    if (chip.handed_out() < m)
+      throw std::logic_error("cycle model: mark " + std::to_string(m) + " beyond the " +
+                             std::to_string(chip.handed_out()) + " packets handed out");
+    marks.push_back(snapshot(k, cc));
+  }
+  simulate(k, chip, threads, p, opt);
+}
+
 // Queues the host's upload (refused here when it writes what the frame reads) and runs the frame
 // until it or the upload is done, whichever comes first. Returns true when the upload is not.
 template <class F, int kLanes>
@@ -396,7 +413,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   const int frame_bank = static_cast<int>(image.registers().frame_bank);
   RecordedThreads<F, kLanes> threads(image, functional_params(p, opt.shading),
                                      p.pipelines * p.threads, opt.programs, opt.ahead_packets,
-                                     opt.trace);
+                                     opt.trace, opt.packet_order);
   hw::Kernel k(kernel_config(p, opt));
   Chip chip(k, image, p, threads);
   if (opt.vcd != nullptr) k.trace_vcd(*opt.vcd, opt.vcd_from, opt.vcd_to);
@@ -408,7 +425,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   const ChipCounters counters(chip);
   const FigureCounts start = snapshot(k, counters);
   const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
-  simulate(k, chip, threads, p, opt);
+  simulate_marked(k, chip, threads, p, opt, counters, out.marks);
   if (opt.vcd != nullptr) k.finish_trace();
   tracers.finish(k.now());
   const FigureCounts end = snapshot(k, counters);

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -23,6 +24,8 @@
 #include "units/run_trace.h"
 
 namespace saarcor {
+
+struct SampleSummary;  // testbench/sampling.h
 
 struct CycleRunOptions {
   units::FunctionalParams shading;  // shade / shadows / secondary / max_depth (packet, stack,
@@ -44,6 +47,11 @@ struct CycleRunOptions {
   // kAhead: how many finished packets the program thread may hold ahead of the simulation (>= 1).
   int ahead_packets = 192;
   std::function<void(std::uint64_t cycles, int packets_done, int packets)> progress;
+  // A sampled frame (testbench/sampling.h): the packets the RGC hands out, in its order (empty:
+  // the whole frame in tiling order), and the hand-out counts (ascending) at which the chip's
+  // counts are read into CycleFrame::marks: mark m is read once m packets have been handed out.
+  std::vector<int> packet_order;
+  std::vector<int> marks;
 };
 
 struct CycleFrame {
@@ -79,7 +87,11 @@ struct CycleFrame {
   std::uint64_t skipped_cycles = 0;
   std::uint64_t module_evaluations = 0;     // host work: evaluate() calls (sleeping modules skip)
   std::vector<units::CycleFigures> series;  // with interval != 0: the figures of each interval
-  std::string stats_json;                   // the hw/ statistics registry
+  std::vector<units::FigureCounts> marks;   // the counts at CycleRunOptions::marks
+  // A sampled frame (testbench/sampling.h): how it was sampled and each estimate's interval; the
+  // figures above are then the estimates. Null for a frame simulated whole.
+  std::shared_ptr<const SampleSummary> sampling;
+  std::string stats_json;  // the hw/ statistics registry
   // With a host upload (run_cycle with a memif::HostUpload): the bytes it sent over the host bus
   // (SRAM words and registers) and the cycle by which its last word was stored, counted from the
   // frame's start like `cycles`; it exceeds `cycles` when the upload outlasts the frame, and the

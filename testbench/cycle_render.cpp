@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "testbench/heartbeat.h"
+#include "testbench/sampling.h"
 
 namespace saarcor {
 
@@ -24,6 +25,11 @@ units::CycleParams resolve_cycle_params(const CycleRenderOptions& opts) {
     throw std::runtime_error("bad --host-threads " + std::to_string(opts.host_threads) +
                              ": 1 (thread programs on the simulation's thread) or 2 (thread "
                              "programs ahead on a second thread)");
+  if (opts.sample) {
+    parse_sample_spec(opts.sample_spec);  // a bad SPEC fails before anything is built
+    if (!opts.vcd.empty() || opts.interval != 0)
+      throw std::runtime_error("--sample runs the frame's windows only: no --vcd or --interval");
+  }
   if (!opts.vcd.empty() && opts.vcd_to < opts.vcd_from)
     throw std::runtime_error("bad --vcd-to " + std::to_string(opts.vcd_to) +
                              ": before --vcd-from " + std::to_string(opts.vcd_from));
@@ -57,7 +63,9 @@ CycleFrame run_cycle_render(const memif::MemoryImage& image, const units::Functi
     ro.vcd_to = opts.vcd_to;
   }
   try {
-    CycleFrame f = run_cycle(image, p, ro);
+    CycleFrame f = opts.sample ? run_sampled(image, p, ro, parse_sample_spec(opts.sample_spec))
+                               : run_cycle(image, p, ro);
+    if (opts.sample_check && f.sampling) check_sampled_packets(image, p, shading, f);
     if (!opts.vcd.empty()) {
       vcd.close();
       if (!vcd) throw std::runtime_error("cannot write --vcd '" + opts.vcd + "'");
@@ -164,6 +172,7 @@ std::string table4_text(const CycleFrame& c, const std::string& scene) {
     s += buf;
   }
   s += rgs_text(c, paper_row_for(scene));
+  s += sampling_text(c);
   const units::UnitStats& u = c.frame.units;
   std::snprintf(buf, sizeof buf,
                 "per ray: %.2f traversal steps, %.2f list entries, %.2f mailbox skips, %.2f "

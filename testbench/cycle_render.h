@@ -24,13 +24,20 @@ struct CycleRenderOptions {
   // 2: the thread programs run on a second host thread ahead of the simulation; 1: inline. 0: 2
   // where the machine has two cores or more. The results are the same.
   int host_threads = 0;
+  // --sample [SPEC] (testbench/sampling.h): the frame sampled, its figures estimated with 95 %
+  // intervals; `sample_spec` "" is the default.
+  bool sample = false;
+  std::string sample_spec;
+  // A sampled frame's simulated packets checked against the functional model (a sweep checks
+  // every point; a render checks none, sampled or not).
+  bool sample_check = false;
   // Any option of the cycle model's own (the kd.* keys of --set build the trees of every model).
   bool any_given() const {
     bool cycle_keys = false;
     for (const std::string& kv : set)
       cycle_keys = cycle_keys || !host::is_tree_setting(kv);
     return preset != "prototype" || cycle_keys || interval != 0 || !vcd.empty() ||
-           host_threads != 0;
+           host_threads != 0 || sample;
   }
 };
 

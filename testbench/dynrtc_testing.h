@@ -13,6 +13,7 @@
 #include "host/image_builder.h"
 #include "host/scene.h"
 #include "testbench/chip.h"
+#include "testbench/covering_design.h"
 
 namespace saarcor::units::testing {
 
@@ -37,62 +38,11 @@ inline std::string shared(const std::string& rel) {
   return std::string(SAARCOR_SHARED_SCENES) + "/" + rel;
 }
 
-// A configuration of the covering design.
-struct Config {
-  const char* name;
-  std::vector<std::string> set;
-  bool shadows_and_secondary = false;
-  std::uint64_t random_latencies = 0;  // != 0: seed for random lat.* and mem.latency
-};
-
-inline const std::vector<Config>& configs() {
-  static const std::vector<Config> c = {
-      {"prototype", {}},
-      {"t1-p1-tiny",
-       {"threads=1", "packet=1", "cache.traversal.items=8", "cache.list.items=8",
-        "cache.transformation.items=8"}},
-      {"t4x3-p16-tiny-2way",
-       {"pipelines=3", "threads=4", "packet=16", "cache.traversal.items=8",
-        "cache.traversal.ways=2", "cache.list.items=8", "cache.list.ways=2",
-        "cache.transformation.items=8", "cache.transformation.ways=2"}},
-      {"t16x2-p4-random-lat-1path", {"pipelines=2", "threads=16", "mem.scene_paths=1"}, false, 7},
-      {"t64-p16-tiny",
-       {"packet=16", "cache.traversal.items=8", "cache.list.items=8",
-        "cache.transformation.items=8", "mailbox=2"}},
-      {"t4x4-p1-random-lat-shadows", {"pipelines=4", "threads=4", "packet=1"}, true, 11},
-      {"t64-p4-shadows-secondary", {"stack=48", "cache.misses=2"}, true},
-      {"t16-p16-random-lat-tiny",
-       {"threads=16", "packet=16", "cache.traversal.items=8", "cache.list.items=8",
-        "cache.transformation.items=8", "shared_origin=0"},
-       false,
-       23},
-  };
-  return c;
-}
-
-inline CycleParams params_of(const Config& c) {
-  CycleParams p = prototype_params();
-  for (const auto& kv : c.set)
-    apply_cycle_setting(p, kv);
-  if (c.random_latencies != 0) {
-    std::mt19937 rng(static_cast<unsigned>(c.random_latencies));
-    std::uniform_int_distribution<int> d(1, 12), m(1, 40);
-    p.lat_add = d(rng);
-    p.lat_mul = d(rng);
-    p.lat_div = d(rng);
-    p.lat_cmp = d(rng);
-    p.mem_latency = m(rng);
-    p.cache_hit_latency = 2 + d(rng) % 4;
-  }
-  return p;
-}
-
-inline FunctionalParams shading_of(const Config& c) {
-  FunctionalParams f;
-  f.shadows = c.shadows_and_secondary;
-  f.secondary = c.shadows_and_secondary;
-  return f;
-}
+// The covering design's configurations (testbench/covering_design.h).
+using saarcor::covering::Config;
+using saarcor::covering::configs;
+using saarcor::covering::params_of;
+using saarcor::covering::shading_of;
 
 inline FunctionalParams functional_of(const Config& c, const CycleParams& p) {
   return functional_params(p, shading_of(c));

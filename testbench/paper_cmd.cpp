@@ -45,6 +45,8 @@ void check_options(const PaperOptions& opts) {
   (void)resolve_jobs(opts.jobs);
   CycleRenderOptions c;
   c.set = opts.set;
+  c.sample = opts.sample;
+  c.sample_spec = opts.sample_spec;
   resolve_cycle_params(c);  // bad --set keys fail before any scene loads
 }
 
@@ -168,6 +170,8 @@ nlohmann::json run_paper_tables(const PaperOptions& opts) {
     const PaperScene& ps = scenes[i];
     RenderSettings s = frame_settings("512x384", 0.0, false, 0, ps.bank_mb);
     s.cycle.set = paper_settings(opts, ps.paper);
+    s.cycle.sample = opts.sample;
+    s.cycle.sample_spec = opts.sample_spec;
     s.res = tables.front() == 3 ? Resolution{512 / opts.scale, 384 / opts.scale}
                                 : Resolution{1024 / opts.scale, 768 / opts.scale};
     pool.prepare(s);
@@ -298,6 +302,8 @@ nlohmann::json run_thread_curve(const PaperOptions& opts) {
   RenderSettings s = frame_settings("512x384", 0.0, false, 0, 4.0);
   s.res = {512 / opts.scale, 384 / opts.scale};
   s.cycle.set = paper_settings(opts, "Scene6");
+  s.cycle.sample = opts.sample;
+  s.cycle.sample_spec = opts.sample_spec;
   progress("thread curve: loading builtin:room");
   const PreparedScene prep = prepare_scene("builtin:room", s);
   const std::vector<int> counts = {1, 2, 4, 8, 16, 32, 64};

@@ -49,6 +49,8 @@ struct PaperOptions {
   std::string references = "../shared/scenes";  // folder of the reference models ("" = none)
   std::vector<std::string> scenes;              // only these paper names (empty = all)
   std::vector<std::string> set;                 // cycle model --set keys for every run
+  bool sample = false;                          // --sample [SPEC]: frames sampled (sampling.h)
+  std::string sample_spec;
   std::string csv;
   std::string json;
   // Scenes (tables) or thread counts (--threads) rendered at once on this host: 0 = its cores.

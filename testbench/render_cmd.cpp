@@ -702,6 +702,9 @@ void write_frame_outputs(const RenderOptions& opts, const ModelSpec& model,
 }  // namespace
 
 int run_render(const RenderOptions& opts) {
+  if (opts.cycle.sample && (opts.frames_given || !opts.pixel.empty()))
+    throw std::runtime_error(
+        "--sample estimates one frame's figures: not with --frames or --pixel");
   if (opts.frames_given) return run_frame_sequence(opts);
   if (opts.fps_given || opts.dt_given || opts.frame_gap || !opts.bus_sweep.empty() ||
       !opts.resume.empty())

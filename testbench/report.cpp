@@ -19,6 +19,7 @@
 #include "testbench/paper_cmd.h"
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
+#include "testbench/sampling.h"
 #include "testbench/scene_cmd.h"
 #include "testbench/sweep_cmd.h"
 
@@ -299,12 +300,14 @@ const std::vector<CycleStatDecl>& cycle_decls() {
 // Per DynRTP (one in the prototype): the packets the RGC handed it, its units' usage.
 nlohmann::json pipelines_json(const CycleFrame& c) {
   nlohmann::json pipes = nlohmann::json::array();
+  // A sampled frame's counts are those of the packets it simulated, over the cycles it ran.
+  const std::uint64_t cycles = c.sampling ? c.sampling->cycles_simulated : c.cycles;
   for (const CycleFrame::PipelineCount& pc : c.per_pipeline) {
     nlohmann::json e;
     e["packets"] = pc.packets;
     for (int i = 0; i < units::kTable4Units; ++i)
       e["usage"][units::kTable4UnitNames[i]] =
-          100.0 * per(pc.issue_cycles[static_cast<std::size_t>(i)], c.cycles);
+          100.0 * per(pc.issue_cycles[static_cast<std::size_t>(i)], cycles);
     pipes.push_back(e);
   }
   return pipes;
@@ -331,6 +334,45 @@ std::vector<ReportStat> cycle_stats(const CycleFrame& c) {
   return out;
 }
 
+namespace {
+
+// A sampled frame's `sampling` object (testbench/sampling.h): how it was sampled and, beside each
+// estimated figure's usual key, its 95 % interval as ci95.<key> = [low, high].
+nlohmann::json sampling_json(const CycleFrame& c) {
+  const SampleSummary& s = *c.sampling;
+  nlohmann::json j = {{"window", s.spec.window},
+                      {"period", s.spec.period},
+                      {"warmup", s.spec.warmup},
+                      {"windows", s.windows},
+                      {"packets", s.packets},
+                      {"packets_simulated", s.packets_simulated},
+                      {"cycles_simulated", s.cycles_simulated},
+                      {"cycles_per_packet_cov", s.cycles_per_packet_cov},
+                      {"trusted", s.defeated.empty()}};
+  // A frame that defeats the sampling says why, and gives no interval to read as a narrow one.
+  if (!s.defeated.empty()) {
+    j["defeated"] = s.defeated;
+    return j;
+  }
+  nlohmann::json ci;
+  const auto put = [&ci](const std::string& key, const SampleInterval& i) {
+    ci[nlohmann::json::json_pointer("/" + key)] = {i.low, i.high};
+  };
+  put("cycles", s.cycles);
+  put("fps", s.fps);
+  put("rays_per_s", s.rays_per_s);
+  for (int k = 0; k < units::kFigureCount; ++k) {
+    if (!units::kFigures[k].in_report) continue;
+    std::string key = units::kFigures[k].name;
+    std::replace(key.begin(), key.end(), '.', '/');
+    put(key, s.figures[static_cast<std::size_t>(k)]);
+  }
+  j["ci95"] = ci;
+  return j;
+}
+
+}  // namespace
+
 nlohmann::json cycle_report_json(const CycleFrame& c, const host::ImageParams* trees) {
   nlohmann::json j = nest(cycle_stats(c));
   j["host"] = {{"seconds", c.host_seconds},
@@ -342,6 +384,7 @@ nlohmann::json cycle_report_json(const CycleFrame& c, const host::ImageParams* t
   j["configuration"] = parameters_json(&c.params, trees);
   // The hw/ statistics registry in full: per unit, cache, path and memory client.
   j["stats"] = nlohmann::json::parse(c.stats_json);
+  if (c.sampling) j["sampling"] = sampling_json(c);
   if (!c.series.empty()) {
     nlohmann::json s = nlohmann::json::array();
     for (const units::CycleFigures& f : c.series) {

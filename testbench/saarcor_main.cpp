@@ -16,6 +16,8 @@
 #include "testbench/precision_cmd.h"
 #include "testbench/render_cmd.h"
 #include "testbench/run_journal.h"
+#include "testbench/sample_check.h"
+#include "testbench/sampling.h"
 #include "testbench/scene_cmd.h"
 #include "testbench/sweep_cmd.h"
 #include "testbench/vectors_cmd.h"
@@ -114,6 +116,20 @@ void add_render_frame_options(CLI::App* sub, saarcor::RenderOptions& render_opts
   sub->add_option("--bank-mb", render_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
 }
 
+// --sample [SPEC] (testbench/sampling.h): given without SPEC, the default; whether it was given is
+// read from the option's count (sample_given).
+CLI::Option* add_sample_option(CLI::App* sub, std::string& spec) {
+  return sub
+      ->add_option("--sample", spec,
+                   "cycle model: sample the frame (SMARTS windows) and give each figure a 95 % "
+                   "interval; SPEC window=W,period=K,warmup=U in packets (default " +
+                       saarcor::sample_spec_text({}) + ")")
+      ->expected(0, 1);
+}
+bool sample_given(CLI::App* sub) {
+  return sub->get_option("--sample")->count() > 0;
+}
+
 // --model cycle (testbench/cycle_render.h)
 void add_render_cycle_options(CLI::App* sub, saarcor::RenderOptions& render_opts) {
   sub->add_option("--preset", render_opts.cycle.preset,
@@ -126,6 +142,7 @@ void add_render_cycle_options(CLI::App* sub, saarcor::RenderOptions& render_opts
   sub->add_option("--host-threads", render_opts.cycle.host_threads,
                   "cycle model: 2 = thread programs on a second host thread, 1 = on the "
                   "simulation's thread (default: 2 on a multi-core host; same results)");
+  add_sample_option(sub, render_opts.cycle.sample_spec);
   sub->add_option("--vcd", render_opts.cycle.vcd, "cycle model: write a VCD trace");
   sub->add_option("--vcd-from", render_opts.cycle.vcd_from, "first cycle of the VCD trace");
   sub->add_option("--vcd-to", render_opts.cycle.vcd_to, "last cycle of the VCD trace")
@@ -180,7 +197,8 @@ void add_render(CLI::App& app, saarcor::RenderOptions& render_opts, int& status,
   add_render_cycle_options(sub, render_opts);
   add_render_trace_options(sub, render_opts, given);
   add_render_sequence_options(sub, render_opts, given);
-  sub->callback([&, given] {
+  sub->callback([&, given, sub] {
+    render_opts.cycle.sample = sample_given(sub);
     render_opts.out_given = given.out->count() > 0;
     render_opts.hits_asked = given.hits->count() > 0;
     render_opts.trace.window_given = given.trace_from->count() > 0 || given.trace_to->count() > 0;
@@ -205,12 +223,16 @@ void add_paper(CLI::App& app, saarcor::PaperOptions& paper_opts, int& status) {
                   "folder of the reference glTF models ('' = none)")
       ->capture_default_str();
   sub->add_option("--set", paper_opts.set, "cycle model or kd.* key KEY=VALUE (repeatable)");
+  add_sample_option(sub, paper_opts.sample_spec);
   sub->add_option("--csv", paper_opts.csv, "write the rows as CSV");
   sub->add_option("--json", paper_opts.json, "write the rows and every cycle report as JSON");
   sub->add_option("--jobs", paper_opts.jobs,
                   "scenes (or thread counts) rendered at once (default: the host's cores; same "
                   "rows)");
-  sub->callback([&] { status = saarcor::run_paper(paper_opts); });
+  sub->callback([&, sub] {
+    paper_opts.sample = sample_given(sub);
+    status = saarcor::run_paper(paper_opts);
+  });
 }
 
 void add_sweep(CLI::App& app, saarcor::SweepOptions& sweep_opts, int& status,
@@ -232,6 +254,7 @@ void add_sweep(CLI::App& app, saarcor::SweepOptions& sweep_opts, int& status,
   sub->add_option("--set", sweep_opts.set, "cycle model parameter KEY=VALUE for every point");
   sub->add_option("--host-threads", sweep_opts.host_threads,
                   "2 = thread programs on a second host thread, 1 = on the simulation's thread");
+  add_sample_option(sub, sweep_opts.sample_spec);
   sub->add_option("--report", sweep_opts.report, "write every point's report as JSON");
   sub->add_option("--csv", sweep_opts.csv, "write the table as CSV");
   sub->add_option("--jobs", sweep_opts.jobs,
@@ -250,8 +273,9 @@ void add_sweep(CLI::App& app, saarcor::SweepOptions& sweep_opts, int& status,
   sub->add_option("--pareto-cost", sweep_opts.pareto_cost,
                   "the cost of --pareto: luts, block_rams, memory_kb or fp_units (implies "
                   "--pareto)");
-  sub->callback([&] {
+  sub->callback([&, sub] {
     sweep_opts.argv = command;
+    sweep_opts.sample = sample_given(sub);
     status = saarcor::run_sweep(sweep_opts);
   });
 }
@@ -323,6 +347,27 @@ void add_compare(CLI::App& app, saarcor::CompareOptions& compare_opts, int& stat
   sub->callback([&] { status = saarcor::run_compare(compare_opts); });
 }
 
+void add_sample_check(CLI::App& app, saarcor::SampleCheckOptions& opts, int& status) {
+  auto* sub = app.add_subcommand(
+      "sample-check",
+      "sampled against full cycle runs: every built-in and 10 reference models under the "
+      "covering design's 8 configurations; per figure mean and max error, interval coverage, "
+      "host-time ratio");
+  sub->add_option("--scene", opts.scenes, "only this scene (repeatable; default: all)");
+  sub->add_option("--references", opts.references, "folder of the reference glTF models")
+      ->capture_default_str();
+  sub->add_option("--models", opts.models, "reference models to take (without --scene)")
+      ->capture_default_str();
+  sub->add_option("--res", opts.res, "resolutions WxH (repeatable)")->capture_default_str();
+  sub->add_option("--config", opts.configs, "only this covering-design configuration (repeatable)");
+  sub->add_option(
+      "--sample", opts.sample_spec,
+      "SPEC window=W,period=K,warmup=U (default " + saarcor::sample_spec_text({}) + ")");
+  sub->add_option("--json", opts.json, "write every case and the summary as JSON");
+  sub->add_flag("--quiet", opts.quiet, "no line per case");
+  sub->callback([&] { status = saarcor::run_sample_check(opts); });
+}
+
 }  // namespace
 
 // The main is thin, as pbrt-v4's cmd/ mains: each subcommand's options are set up by its add_*
@@ -361,6 +406,8 @@ int main(int argc, char** argv) {
   add_precision(app, precision_opts, status, command);
   saarcor::CompareOptions compare_opts;
   add_compare(app, compare_opts, status);
+  saarcor::SampleCheckOptions sample_check_opts;
+  add_sample_check(app, sample_check_opts, status);
 
   try {
     app.parse(argc, argv);

@@ -47,6 +47,10 @@ struct SweepOptions {
   std::string preset = "prototype";
   std::vector<std::string> set;
   int host_threads = 0;
+  // --sample [SPEC]: every point sampled (testbench/sampling.h), its simulated packets checked
+  // against the functional model instead of the whole frame.
+  bool sample = false;
+  std::string sample_spec;
   std::string report;  // JSON path, optional
   std::string csv;     // CSV path, optional
   // Frames at once on this host (worker threads); 0 = the hardware's cores (under MPI: the cores

@@ -101,6 +101,7 @@ class RayGenerationController {
     return next_++;
   }
   bool all_handed_out() const { return next_ == packets_; }
+  int handed_out() const { return next_; }  // packets taken so far (the next one's ordinal)
   int packets() const { return packets_; }
 
  private:

@@ -67,10 +67,12 @@ std::uint64_t run_traced(ThreadProgram<F, kMaxPacket, D>& thread, PipelineUnits<
   return n;
 }
 
-// run_functional's frame with datapath D (see there).
+// run_functional's frame with datapath D (see there). `packets`: only these packets, in this
+// order (a sampled frame's, testbench/sampling.h); null: every packet in tiling order.
 template <class F, class D>
 FunctionalFrame run_frame(const memif::MemoryImage& image, const FunctionalParams& params,
-                          const ProgressFn& progress, UnitTap<F>* tap, std::ostream* trace) {
+                          const ProgressFn& progress, UnitTap<F>* tap, std::ostream* trace,
+                          const std::vector<int>* packets = nullptr) {
   if (tap != nullptr && trace != nullptr)
     throw std::logic_error("functional model: a tap and a trace at once");
   const auto t0 = std::chrono::steady_clock::now();
@@ -88,15 +90,19 @@ FunctionalFrame run_frame(const memif::MemoryImage& image, const FunctionalParam
   frame.width = w;
   frame.height = h;
   frame.params = params;
-  const int total = tiling.count();
+  const int total = packets != nullptr ? static_cast<int>(packets->size()) : tiling.count();
   std::vector<std::uint32_t> pixels;  // reused: no allocation per packet
   TraceTap<F> trace_tap;
   if (trace != nullptr) *trace << kTraceHeader << '\n';
   for (int p = 0; p < total; ++p) {
-    fill_packet_pixels(tiling, w, h, p, pixels);
+    const int index = packets != nullptr ? (*packets)[static_cast<std::size_t>(p)] : p;
+    if (index < 0 || index >= tiling.count())
+      throw std::runtime_error("functional model: packet " + std::to_string(index) + " of " +
+                               std::to_string(tiling.count()));
+    fill_packet_pixels(tiling, w, h, index, pixels);
     thread.start_primary(pixels);
     frame.units.requests +=
-        trace != nullptr ? run_traced(thread, units, trace_tap, p, *trace) : thread.run();
+        trace != nullptr ? run_traced(thread, units, trace_tap, index, *trace) : thread.run();
     if (progress && ((p + 1) % 1024 == 0 || p + 1 == total)) progress(p + 1, total);
   }
   frame.units.packets = static_cast<std::uint64_t>(total);

@@ -97,6 +97,14 @@ FunctionalFrame run_functional(const memif::MemoryImage& image, const Functional
                      [&](auto f) { return run_functional<decltype(f)>(image, params, progress); });
 }
 
+FunctionalFrame run_functional_packets(const memif::MemoryImage& image,
+                                       const FunctionalParams& params,
+                                       const std::vector<int>& packets) {
+  return with_format(image.format(), [&](auto f) {
+    return run_frame<decltype(f), FastDatapath>(image, params, {}, nullptr, nullptr, &packets);
+  });
+}
+
 PixelTrace trace_pixel(const memif::MemoryImage& image, const FunctionalParams& params, int x,
                        int y) {
   check_image(image);

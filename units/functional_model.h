@@ -104,6 +104,11 @@ FunctionalFrame run_functional(const memif::MemoryImage& image, const Functional
 // The same, choosing F from image.format() (the formats above; others throw).
 FunctionalFrame run_functional(const memif::MemoryImage& image, const FunctionalParams& params,
                                const ProgressFn& progress = {});
+// Only the listed packets (indices of packet_tiling, in this order): a sampled frame's check
+// (testbench/sampling.h). The other pixels keep the sink's reset records.
+FunctionalFrame run_functional_packets(const memif::MemoryImage& image,
+                                       const FunctionalParams& params,
+                                       const std::vector<int>& packets);
 
 // Replays the packet holding pixel (x, y) (`--pixel x,y`): that pixel's record, and one log line
 // per thread-program request (unit, phase, item, mask) in execution order.

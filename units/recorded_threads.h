@@ -41,10 +41,14 @@ namespace saarcor::units {
 template <class F, int kLanes>
 class RecordedThreads final : public ThreadTable {
  public:
-  // kAhead: at most `ahead` finished packets ahead of the simulation.
+  // kAhead: at most `ahead` finished packets ahead of the simulation. `order`: the frame's
+  // packets the RGC hands out, in its order (a sampled run's windows, testbench/sampling.h); empty:
+  // every packet of the frame, in tiling order.
   RecordedThreads(const memif::MemoryImage& image, const FunctionalParams& params, int threads,
-                  ProgramMode mode, int ahead, const RunTraceOptions& trace = {})
+                  ProgramMode mode, int ahead, const RunTraceOptions& trace = {},
+                  std::vector<int> order = {})
       : params_(params),
+        order_(std::move(order)),
         units_(params.mode),
         mode_(mode),
         recorded_(mode != ProgramMode::kPerStep),
@@ -52,6 +56,10 @@ class RecordedThreads final : public ThreadTable {
     w_ = static_cast<int>(image.registers().width);
     h_ = static_cast<int>(image.registers().height);
     tiling_ = packet_tiling(w_, h_, params.packet);
+    for (int p : order_)
+      if (p < 0 || p >= tiling_.count())
+        throw std::logic_error("cycle model: packet " + std::to_string(p) + " of " +
+                               std::to_string(tiling_.count()) + " in the RGC's order");
     sink_.reset(w_, h_);
     requests_.resize(static_cast<std::size_t>(threads));
     if (trace.any()) {
@@ -111,7 +119,9 @@ class RecordedThreads final : public ThreadTable {
     // would reload a struct the callee has just written field by field (a store-forward stall).
     ::new (static_cast<void*>(&requests_[t])) Request(p.request());
   }
-  void start_primary(std::uint32_t t, int packet) override {
+  // `ordinal`: the RGC's hand-out count, the packet order_ names there.
+  void start_primary(std::uint32_t t, int ordinal) override {
+    const int packet = packet_at(ordinal);
     if (mode_ == ProgramMode::kPacketFirst) {
       Cursor& c = cursor_[t];
       c = {free_.back(), 0, 0};
@@ -142,7 +152,13 @@ class RecordedThreads final : public ThreadTable {
   const std::vector<RgsAccess>& rgs_memory(std::uint32_t t) const override {
     return recorded_ ? rgs_mem_[t] : programs_[t]->rgs_memory();
   }
-  int packets() const override { return tiling_.count(); }
+  int packets() const override {
+    return order_.empty() ? tiling_.count() : static_cast<int>(order_.size());
+  }
+  // The packet the RGC hands out `ordinal`-th.
+  int packet_at(int ordinal) const {
+    return order_.empty() ? ordinal : order_[static_cast<std::size_t>(ordinal)];
+  }
   // The rays thread `t`'s current request concerns (for the watchdog's thread report; the units
   // never read it, so a replayed request carries it only in its slot).
   std::uint64_t mask(std::uint32_t t) const {
@@ -302,7 +318,7 @@ class RecordedThreads final : public ThreadTable {
   void run_ahead() {
     try {
       ThreadProgram<F, kLanes, FastDatapath>& p = *programs_[0];
-      const int total = tiling_.count();
+      const int total = packets();
       for (int k = 0; k < total; ++k) {
         std::size_t id;
         {
@@ -319,7 +335,7 @@ class RecordedThreads final : public ThreadTable {
           id = free_.back();
           free_.pop_back();
         }
-        record(slots_[id], p, k);
+        record(slots_[id], p, packet_at(k));
         {
           const std::lock_guard<std::mutex> lock(mutex_);
           finished_.push_back(id);
@@ -379,6 +395,7 @@ class RecordedThreads final : public ThreadTable {
   }
 
   FunctionalParams params_;
+  std::vector<int> order_;  // the RGC's packets in order; empty: all, in tiling order
   PipelineUnits<F> units_;
   FrameSink sink_;
   PacketTiling tiling_;
