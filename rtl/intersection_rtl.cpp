@@ -11,7 +11,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
-#include "rtl/waveform.h"
+#include "rtl/verilated_top.h"
 #include "rtl_intersection_builds.h"
 #include "units/boundary_intersection.h"
 #include "verilated.h"
@@ -29,35 +29,14 @@ template <class V>
 class IntersectionRtlOf final : public UnitRtl {
  public:
   explicit IntersectionRtlOf(const IntersectionBuild& b)
-      : tw_(thread_bits(b.threads)), p_(b.packet), ctx_(std::make_unique<VerilatedContext>()) {
-    ctx_->traceEverOn(true);
-    v_ = std::make_unique<V>(ctx_.get());
-  }
-  // The context goes with the model; Verilator's thread context (which the models built without
-  // one of their own use) must not be left pointing at it.
-  ~IntersectionRtlOf() override {
-    stop_trace();
-    v_.reset();
-    ctx_.reset();
-    Verilated::threadContextp(Verilated::defaultContextp());
-  }
+      : tw_(thread_bits(b.threads)), p_(b.packet) {}
 
   UnitId unit() const override { return UnitId::kIntersection; }
-  void reset() override {
-    v_->rst = 1;
-    for (int i = 0; i < 2; ++i) {
-      v_->clk = 0;
-      v_->eval();
-      v_->clk = 1;
-      v_->eval();
-    }
-    v_->rst = 0;
-    cycle_ = 0;
-  }
+  void reset() override { top_.reset(); }
 
   void cycle(std::uint64_t cycle, const std::vector<BoundaryEvent>& inputs,
              std::vector<BoundaryEvent>& outputs) override {
-    V& v = *v_;
+    V& v = *top_;
     v.in_valid = 0;
     v.st_valid = 0;
     int starts = 0;
@@ -74,23 +53,18 @@ class IntersectionRtlOf final : public UnitRtl {
                                units::boundary_port_name(e.port) + " input");
       }
     }
-    v.clk = 0;
-    v.eval();
-    wave_.dump(2 * cycle_);
+    top_.fall();
     if (v.out_valid) leaving(outputs, cycle);
-    v.clk = 1;
-    v.eval();
-    wave_.dump(2 * cycle_ + 1);
-    ++cycle_;
+    top_.rise();
   }
 
-  void start_trace(const std::string& path) override { wave_.start(*v_, path); }
-  void stop_trace() override { wave_.stop(); }
+  void start_trace(const std::string& path) override { top_.start_trace(path); }
+  void stop_trace() override { top_.stop_trace(); }
 
  private:
   // A thread on path e with the triangle's rays in unit-triangle space.
   void arrive(const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     if (e.path != UnitId::kTransformation)
       throw std::logic_error(std::string("lockstep: a thread reached the intersection unit from "
                                          "the ") +
@@ -117,7 +91,7 @@ class IntersectionRtlOf final : public UnitRtl {
 
   // The thread leaving on path f with every lane's closest hit.
   void leaving(std::vector<BoundaryEvent>& out, std::uint64_t cycle) const {
-    V& v = *v_;
+    V& v = *top_;
     BoundaryEvent& e = out.emplace_back();
     e.cycle = cycle;
     e.unit = UnitId::kIntersection;
@@ -140,10 +114,7 @@ class IntersectionRtlOf final : public UnitRtl {
   }
 
   int tw_, p_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> v_;
-  Waveform wave_;
-  std::uint64_t cycle_ = 0;
+  VerilatedTop<V> top_;
 };
 
 }  // namespace

@@ -10,7 +10,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
-#include "rtl/waveform.h"
+#include "rtl/verilated_top.h"
 #include "rtl_list_builds.h"
 #include "units/boundary_list.h"
 #include "verilated.h"
@@ -21,30 +21,12 @@ namespace {
 template <class V>
 class ListRtlOf final : public ListRtl {
  public:
-  explicit ListRtlOf(const ListBuild& b)
-      : tw_(thread_bits(b.threads)), p_(b.packet), ctx_(std::make_unique<VerilatedContext>()) {
-    ctx_->traceEverOn(true);
-    v_ = std::make_unique<V>(ctx_.get());
-  }
-  // The context goes with the model; Verilator's thread context (which the models built without
-  // one of their own use) must not be left pointing at it.
-  ~ListRtlOf() override {
-    stop_trace();
-    v_.reset();
-    ctx_.reset();
-    Verilated::threadContextp(Verilated::defaultContextp());
-  }
+  explicit ListRtlOf(const ListBuild& b) : tw_(thread_bits(b.threads)), p_(b.packet) {}
 
-  void reset() override {
-    v_->rst = 1;
-    for (int i = 0; i < 2; ++i)
-      clock();
-    v_->rst = 0;
-    cycle_ = 0;
-  }
+  void reset() override { top_.reset(); }
 
   ListOutputs cycle(const ListInputs& in) override {
-    V& v = *v_;
+    V& v = *top_;
     v.in_valid = 0;
     v.in_start = 0;
     v.in_level = 0;
@@ -67,9 +49,7 @@ class ListRtlOf final : public ListRtl {
     v.resp_valid = in.resp;
     v.resp_thread = static_cast<std::remove_reference_t<decltype(v.resp_thread)>>(in.resp_thread);
     v.resp_word = in.resp_word;
-    v.clk = 0;
-    v.eval();
-    wave_.dump(2 * cycle_);
+    top_.fall();
     ListOutputs o;
     o.req = v.req_valid && in.req_ready;
     o.req_item = v.req_item;
@@ -81,29 +61,16 @@ class ListRtlOf final : public ListRtl {
     o.next = v.out_next;
     o.entry = v.out_entry;
     o.mask = get_bits(v.out_mask, 0, p_);
-    v.clk = 1;
-    v.eval();
-    wave_.dump(2 * cycle_ + 1);
-    ++cycle_;
+    top_.rise();
     return o;
   }
 
-  void start_trace(const std::string& path) override { wave_.start(*v_, path); }
-  void stop_trace() override { wave_.stop(); }
+  void start_trace(const std::string& path) override { top_.start_trace(path); }
+  void stop_trace() override { top_.stop_trace(); }
 
  private:
-  void clock() {
-    v_->clk = 0;
-    v_->eval();
-    v_->clk = 1;
-    v_->eval();
-  }
-
   int tw_, p_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> v_;
-  Waveform wave_;
-  std::uint64_t cycle_ = 0;
+  VerilatedTop<V> top_;
 };
 
 // The list unit's input path (priority order, units/dynrtp.cpp) of a sending unit.

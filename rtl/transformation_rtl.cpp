@@ -11,7 +11,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
-#include "rtl/waveform.h"
+#include "rtl/verilated_top.h"
 #include "rtl_transformation_builds.h"
 #include "units/boundary_transformation.h"
 #include "verilated.h"
@@ -29,45 +29,23 @@ template <class V>
 class TransformationRtlOf final : public UnitRtl {
  public:
   TransformationRtlOf(const TransformationBuild& b, const memif::FrameRegisters& frame)
-      : p_(b.packet), ctx_(std::make_unique<VerilatedContext>()) {
-    ctx_->traceEverOn(true);
-    v_ = std::make_unique<V>(ctx_.get());
-    v_->instance_row_base = frame.instance_row_base;
-  }
-  // The context goes with the model; Verilator's thread context (which the models built without
-  // one of their own use) must not be left pointing at it.
-  ~TransformationRtlOf() override {
-    stop_trace();
-    v_.reset();
-    ctx_.reset();
-    Verilated::threadContextp(Verilated::defaultContextp());
+      : p_(b.packet) {
+    top_->instance_row_base = frame.instance_row_base;
   }
 
   UnitId unit() const override { return UnitId::kTransformation; }
-  void reset() override {
-    v_->rst = 1;
-    for (int i = 0; i < 2; ++i) {
-      v_->clk = 0;
-      v_->eval();
-      v_->clk = 1;
-      v_->eval();
-    }
-    v_->rst = 0;
-    cycle_ = 0;
-  }
+  void reset() override { top_.reset(); }
 
   void cycle(std::uint64_t cycle, const std::vector<BoundaryEvent>& inputs,
              std::vector<BoundaryEvent>& outputs) override {
-    V& v = *v_;
+    V& v = *top_;
     v.d_valid = 0;
     v.a_valid = 0;
     v.resp_valid = 0;
     v.req_ready = 1;
     for (const BoundaryEvent& e : inputs)
       drive(e);
-    v.clk = 0;
-    v.eval();
-    wave_.dump(2 * cycle_);
+    top_.fall();
     if (v.req_valid && v.req_ready) {
       BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, v.req_thread);
       e.fields = 3;
@@ -77,18 +55,15 @@ class TransformationRtlOf final : public UnitRtl {
       e.field[2] = v.req_thread;
     }
     if (v.out_valid) leaving(outputs, cycle);
-    v.clk = 1;
-    v.eval();
-    wave_.dump(2 * cycle_ + 1);
-    ++cycle_;
+    top_.rise();
   }
 
-  void start_trace(const std::string& path) override { wave_.start(*v_, path); }
-  void stop_trace() override { wave_.stop(); }
+  void start_trace(const std::string& path) override { top_.start_trace(path); }
+  void stop_trace() override { top_.stop_trace(); }
 
  private:
   void drive(const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     switch (e.port) {
       case BoundaryPort::kInput:
         return e.path == UnitId::kList ? entry(e) : generate(e);
@@ -111,7 +86,7 @@ class TransformationRtlOf final : public UnitRtl {
 
   // Path d: an object or a triangle.
   void entry(const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     if (v.d_valid) throw std::logic_error("lockstep: two threads on path d in a cycle");
     if (e.fields != 6 || e.field[0] != 0)
       throw std::logic_error("lockstep: a list entry without its fields on path d");
@@ -124,7 +99,7 @@ class TransformationRtlOf final : public UnitRtl {
 
   // Path a: a packet to generate, per lane T, R'o, R'd.
   void generate(const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     if (e.path != UnitId::kRgs)
       throw std::logic_error(std::string("lockstep: a thread reached the transformation unit "
                                          "from the ") +
@@ -152,7 +127,7 @@ class TransformationRtlOf final : public UnitRtl {
 
   // The thread leaving with its transformed rays (an object's box after them).
   void leaving(std::vector<BoundaryEvent>& out, std::uint64_t cycle) const {
-    V& v = *v_;
+    V& v = *top_;
     constexpr UnitId kTo[] = {UnitId::kTraversal, UnitId::kIntersection, UnitId::kRgs,
                               UnitId::kRgs};
     BoundaryEvent& e = event(out, cycle, BoundaryPort::kOutput, v.out_thread);
@@ -188,10 +163,7 @@ class TransformationRtlOf final : public UnitRtl {
   }
 
   int p_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> v_;
-  Waveform wave_;
-  std::uint64_t cycle_ = 0;
+  VerilatedTop<V> top_;
 };
 
 }  // namespace

@@ -10,7 +10,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
-#include "rtl/waveform.h"
+#include "rtl/verilated_top.h"
 #include "rtl_traversal_builds.h"
 #include "units/boundary_traversal.h"
 #include "verilated.h"
@@ -52,48 +52,26 @@ template <class V>
 class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
  public:
   TraversalRtlOf(const TraversalBuild& b, const memif::FrameRegisters& frame)
-      : tw_(thread_bits(b.threads)), p_(b.packet), ctx_(std::make_unique<VerilatedContext>()) {
-    ctx_->traceEverOn(true);
-    v_ = std::make_unique<V>(ctx_.get());
+      : tw_(thread_bits(b.threads)), p_(b.packet) {
     for (int k = 0; k < 3; ++k) {
       const auto a = static_cast<std::size_t>(k);
-      put_bits(v_->scene_lo, k * kW, kW, frame.scene_min[a]);
-      put_bits(v_->scene_hi, k * kW, kW, frame.scene_max[a]);
+      put_bits(top_->scene_lo, k * kW, kW, frame.scene_min[a]);
+      put_bits(top_->scene_hi, k * kW, kW, frame.scene_max[a]);
     }
-    v_->top_root = frame.top_root;
-  }
-  // The context goes with the model; Verilator's thread context (which the models built without
-  // one of their own use) must not be left pointing at it.
-  ~TraversalRtlOf() override {
-    stop_trace();
-    v_.reset();
-    ctx_.reset();
-    Verilated::threadContextp(Verilated::defaultContextp());
+    top_->top_root = frame.top_root;
   }
 
   UnitId unit() const override { return UnitId::kTraversal; }
 
-  void reset() override {
-    v_->rst = 1;
-    for (int i = 0; i < 2; ++i) {
-      v_->clk = 0;
-      v_->eval();
-      v_->clk = 1;
-      v_->eval();
-    }
-    v_->rst = 0;
-    cycle_ = 0;
-  }
+  void reset() override { top_.reset(); }
 
   void cycle(std::uint64_t cycle, const std::vector<BoundaryEvent>& inputs,
              std::vector<BoundaryEvent>& outputs) override {
-    V& v = *v_;
+    V& v = *top_;
     clear_inputs();
     for (const BoundaryEvent& e : inputs)
       drive(e);
-    v.clk = 0;
-    v.eval();
-    wave_.dump(2 * cycle_);
+    top_.fall();
     if (v.req_valid && v.req_ready) {
       BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, v.req_thread);
       e.fields = 3;
@@ -108,24 +86,21 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
     if (v.out2_valid)
       leaving(outputs, cycle, v.out2_thread, v.out2_dest,
               {v.out2_node, 0, 0, get_bits(v.out2_mask, 0, p_), v.out2_level});
-    v.clk = 1;
-    v.eval();
-    wave_.dump(2 * cycle_ + 1);
-    ++cycle_;
+    top_.rise();
   }
 
   int stack_size(std::uint32_t thread) override {
-    v_->dbg_thread = static_cast<std::remove_reference_t<decltype(v_->dbg_thread)>>(thread);
-    v_->eval();
-    return static_cast<int>(v_->dbg_size);
+    top_->dbg_thread = static_cast<std::remove_reference_t<decltype(top_->dbg_thread)>>(thread);
+    top_->eval();
+    return static_cast<int>(top_->dbg_size);
   }
 
-  void start_trace(const std::string& path) override { wave_.start(*v_, path); }
-  void stop_trace() override { wave_.stop(); }
+  void start_trace(const std::string& path) override { top_.start_trace(path); }
+  void stop_trace() override { top_.stop_trace(); }
 
  private:
   void clear_inputs() {
-    V& v = *v_;
+    V& v = *top_;
     v.ld_valid = 0;
     v.hu_valid = 0;
     v.f_valid = 0;
@@ -138,7 +113,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
 
   // One input event of the model's traversal unit onto the ports.
   void drive(const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     switch (e.port) {
       case BoundaryPort::kInput:
         return arrive(e);
@@ -160,7 +135,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
 
   // A thread pushed on one of the input paths (with its level start on b and RGS -> traversal).
   void arrive(const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     const int path = input_path(e.path);
     if (path < 0) return;  // the unit's own loop: the RTL takes its thread back itself
     const auto t = static_cast<std::uint32_t>(e.thread);
@@ -192,7 +167,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
 
   // Load port k: the level start's fields and the lanes' rays (units/boundary_traversal.h).
   void load(int k, const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     const bool bottom = e.field[1] != 0;
     const std::size_t words =
         static_cast<std::size_t>(p_ * units::kTraversalLaneWords) + (bottom ? 6u : 0u);
@@ -226,7 +201,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
 
   // The hit update: every lane's t_best and done.
   void hit_update(const BoundaryEvent& e) {
-    V& v = *v_;
+    V& v = *top_;
     if (v.hu_valid) throw std::logic_error("lockstep: two hit updates in one cycle");
     if (e.fields != 1 || e.wide.size() != static_cast<std::size_t>(p_))
       throw std::logic_error("lockstep: a hit update without its " + std::to_string(p_) +
@@ -260,10 +235,7 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
   }
 
   int tw_, p_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> v_;
-  Waveform wave_;
-  std::uint64_t cycle_ = 0;
+  VerilatedTop<V> top_;
 };
 
 }  // namespace
