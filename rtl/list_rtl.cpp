@@ -134,16 +134,11 @@ class ListUnitRtl final : public UnitRtl {
       }
     }
     const ListOutputs out = rtl_->cycle(in);
-    if (out.req) {
-      units::BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, out.req_thread);
-      e.fields = 3;
-      e.names = units::kCacheRequestFields;
-      e.field[0] = out.req_item;
-      e.field[1] = static_cast<std::uint64_t>(units::unit_index(units::UnitId::kList));
-      e.field[2] = out.req_thread;
-    }
+    if (out.req)
+      add_cache_request(outputs, cycle, units::UnitId::kList, out.req_item, out.req_thread);
     if (out.out) {
-      units::BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kOutput, out.out_thread);
+      units::BoundaryEvent& e = add_event(outputs, cycle, units::UnitId::kList,
+                                          units::BoundaryPort::kOutput, out.out_thread);
       constexpr units::UnitId kTo[] = {units::UnitId::kTransformation, units::UnitId::kList,
                                        units::UnitId::kTraversal};
       e.path = kTo[std::min<std::uint32_t>(out.kind, 2)];
@@ -154,16 +149,6 @@ class ListUnitRtl final : public UnitRtl {
   }
 
  private:
-  static units::BoundaryEvent& event(std::vector<units::BoundaryEvent>& v, std::uint64_t cycle,
-                                     units::BoundaryPort port, std::uint32_t thread) {
-    units::BoundaryEvent& e = v.emplace_back();
-    e.cycle = cycle;
-    e.unit = units::UnitId::kList;
-    e.port = port;
-    e.thread = thread;
-    return e;
-  }
-
   std::unique_ptr<ListRtl> rtl_;
 };
 

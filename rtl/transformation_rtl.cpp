@@ -46,14 +46,9 @@ class TransformationRtlOf final : public UnitRtl {
     for (const BoundaryEvent& e : inputs)
       drive(e);
     top_.fall();
-    if (v.req_valid && v.req_ready) {
-      BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, v.req_thread);
-      e.fields = 3;
-      e.names = units::kCacheRequestFields;
-      e.field[0] = v.req_item;
-      e.field[1] = static_cast<std::uint64_t>(units::unit_index(UnitId::kTransformation));
-      e.field[2] = v.req_thread;
-    }
+    if (v.req_valid && v.req_ready)
+      add_cache_request(outputs, cycle, UnitId::kTransformation, v.req_item,
+                        static_cast<std::uint32_t>(v.req_thread));
     if (v.out_valid) leaving(outputs, cycle);
     top_.rise();
   }
@@ -130,7 +125,8 @@ class TransformationRtlOf final : public UnitRtl {
     V& v = *top_;
     constexpr UnitId kTo[] = {UnitId::kTraversal, UnitId::kIntersection, UnitId::kRgs,
                               UnitId::kRgs};
-    BoundaryEvent& e = event(out, cycle, BoundaryPort::kOutput, v.out_thread);
+    BoundaryEvent& e =
+        add_event(out, cycle, UnitId::kTransformation, BoundaryPort::kOutput, v.out_thread);
     e.path = kTo[v.out_dest & 3u];
     e.fields = 5;
     e.names = units::kTransformationOutputFields;
@@ -150,16 +146,6 @@ class TransformationRtlOf final : public UnitRtl {
       e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_lo, a * kW, kW)));
     for (int a = 0; a < 3; ++a)
       e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_hi, a * kW, kW)));
-  }
-
-  static BoundaryEvent& event(std::vector<BoundaryEvent>& v, std::uint64_t cycle, BoundaryPort port,
-                              std::uint32_t thread) {
-    BoundaryEvent& e = v.emplace_back();
-    e.cycle = cycle;
-    e.unit = UnitId::kTransformation;
-    e.port = port;
-    e.thread = thread;
-    return e;
   }
 
   int p_;

@@ -72,14 +72,9 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
     for (const BoundaryEvent& e : inputs)
       drive(e);
     top_.fall();
-    if (v.req_valid && v.req_ready) {
-      BoundaryEvent& e = event(outputs, cycle, BoundaryPort::kCacheRequest, v.req_thread);
-      e.fields = 3;
-      e.names = units::kCacheRequestFields;
-      e.field[0] = v.req_item;
-      e.field[1] = static_cast<std::uint64_t>(units::unit_index(UnitId::kTraversal));
-      e.field[2] = v.req_thread;
-    }
+    if (v.req_valid && v.req_ready)
+      add_cache_request(outputs, cycle, UnitId::kTraversal, v.req_item,
+                        static_cast<std::uint32_t>(v.req_thread));
     if (v.out_valid)
       leaving(outputs, cycle, v.out_thread, v.out_dest,
               {v.out_node, v.out_first, v.out_end, get_bits(v.out_mask, 0, p_), v.out_level});
@@ -217,21 +212,11 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
   static void leaving(std::vector<BoundaryEvent>& out, std::uint64_t cycle, std::uint32_t thread,
                       std::uint32_t dest, const std::array<std::uint64_t, 5>& f) {
     constexpr UnitId kTo[] = {UnitId::kTraversal, UnitId::kList, UnitId::kList, UnitId::kRgs};
-    BoundaryEvent& e = event(out, cycle, BoundaryPort::kOutput, thread);
+    BoundaryEvent& e = add_event(out, cycle, UnitId::kTraversal, BoundaryPort::kOutput, thread);
     e.path = kTo[dest & 3u];
     e.fields = 6;
     e.names = units::kTraversalOutputFields;
     e.field = {dest, f[0], f[1], f[2], f[3], f[4]};
-  }
-
-  static BoundaryEvent& event(std::vector<BoundaryEvent>& v, std::uint64_t cycle, BoundaryPort port,
-                              std::uint32_t thread) {
-    BoundaryEvent& e = v.emplace_back();
-    e.cycle = cycle;
-    e.unit = UnitId::kTraversal;
-    e.port = port;
-    e.thread = thread;
-    return e;
   }
 
   int tw_, p_;

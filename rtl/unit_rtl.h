@@ -29,4 +29,28 @@ class UnitRtl {
   virtual void stop_trace() = 0;
 };
 
+// A port event of `unit` appended to an adapter's outputs.
+inline units::BoundaryEvent& add_event(std::vector<units::BoundaryEvent>& events,
+                                       std::uint64_t cycle, units::UnitId unit,
+                                       units::BoundaryPort port, std::uint32_t thread) {
+  units::BoundaryEvent& e = events.emplace_back();
+  e.cycle = cycle;
+  e.unit = unit;
+  e.port = port;
+  e.thread = thread;
+  return e;
+}
+
+// A cache request leaving `unit`: the item, and the unit as the request's label.
+inline void add_cache_request(std::vector<units::BoundaryEvent>& events, std::uint64_t cycle,
+                              units::UnitId unit, std::uint64_t item, std::uint32_t thread) {
+  units::BoundaryEvent& e =
+      add_event(events, cycle, unit, units::BoundaryPort::kCacheRequest, thread);
+  e.fields = 3;
+  e.names = units::kCacheRequestFields;
+  e.field[0] = item;
+  e.field[1] = static_cast<std::uint64_t>(units::unit_index(unit));
+  e.field[2] = thread;
+}
+
 }  // namespace saarcor::rtl
