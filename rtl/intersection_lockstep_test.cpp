@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fixedfloat/float.h"
+#include "rtl/builds_testing.h"
 #include "rtl/lockstep.h"
 #include "units/boundary_intersection.h"
 #include "units/cycle_params.h"
@@ -52,6 +53,7 @@ bool edge_hit(const units::RawFp<F>& fp, const Triangle& in, const BoundaryEvent
 }
 
 TEST(IntersectionLockstep, StrictUvIsCaughtAtTheFirstEdgeHit) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   LockstepOptions o;
   o.units = {"intersection"};
   o.scene = "builtin:room";

@@ -10,7 +10,10 @@
 #include <vector>
 
 #include "Visect_proto.h"
+#include "rtl/builds_testing.h"
+#if SAARCOR_RTL_VARIANT_BUILDS
 #include "Visect_proto_fault_strict_uv.h"
+#endif
 #include "rtl/port_bits.h"
 #include "units/cycle_params.h"
 #include "verilated.h"
@@ -201,6 +204,7 @@ TEST(IntersectionThreads, ClosestHitAndAnyHit) {
 }
 
 // The fault build accepts on u + v < 1: lane 3's edge hit is lost.
+#if SAARCOR_RTL_VARIANT_BUILDS
 TEST(IntersectionThreads, StrictUvFaultLosesTheEdgeHit) {
   Rig<Visect_proto_fault_strict_uv> rig;
   rig.start(2, false);
@@ -211,6 +215,7 @@ TEST(IntersectionThreads, StrictUvFaultLosesTheEdgeHit) {
   EXPECT_EQ(rig.out[0].hits[0].t, kOne);
   EXPECT_EQ(rig.out[0].hits[3], kNoHit);
 }
+#endif
 
 }  // namespace
 }  // namespace saarcor::rtl

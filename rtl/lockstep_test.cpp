@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "rtl/builds_testing.h"
 #include "rtl/intersection_rtl.h"
 #include "rtl/list_rtl.h"
 #include "rtl/transformation_rtl.h"
@@ -94,15 +95,18 @@ TEST(Lockstep, RoomPrototype) {
   expect_agreement(run("builtin:room"));
 }
 TEST(Lockstep, RoomP1ThirteenThreadsMailbox1Cache8) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   expect_agreement(run("builtin:room", kP1));
 }
 TEST(Lockstep, RoomP16Cache8) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   expect_agreement(run("builtin:room", kP16, 32, 32));
 }
 TEST(Lockstep, DynamicShadowsDepth2) {
   expect_agreement(run("builtin:dynamic", {}, 24, 18, true, 2));
 }
 TEST(Lockstep, DynamicShadowsDepth2P1) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   expect_agreement(run("builtin:dynamic", kP1, 16, 12, true, 2));
 }
 TEST(Lockstep, SunCorTwoLevels) {
@@ -111,12 +115,14 @@ TEST(Lockstep, SunCorTwoLevels) {
 // A small stack (16 entries: the traversal unit's proto_stack16 build beside the list unit's
 // proto).
 TEST(Lockstep, SunCorStack16) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   expect_agreement(run("builtin:suncor", {"stack=16"}, 24, 18));
 }
 TEST(Lockstep, DuckGltf) {
   expect_agreement(run(shared("Duck/Duck.gltf")));
 }
 TEST(Lockstep, TwoCylinderEngineGltfP16) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   expect_agreement(run(shared("2CylinderEngine/2CylinderEngine.gltf"), kP16, 32, 24));
 }
 
@@ -124,6 +130,7 @@ TEST(Lockstep, TwoCylinderEngineGltfP16) {
 // at the first event the mailbox decides: the model's first list output whose rays the mailbox
 // reduced (a skip, or an entry for fewer rays than the list holds).
 TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   LockstepOptions o;
   o.units = {"list"};
   o.scene = "builtin:room";
@@ -166,6 +173,7 @@ TEST(ListLockstep, MailboxThatNeverHitsIsCaughtAtItsFirstWrongEvent) {
 // (unit_threads.sv FAULT_PRIORITY_SWAP) is caught at the first accept where both held a thread:
 // the model's cache request for the loop's thread, the RTL's for the other (class order).
 TEST(ListLockstep, SwappedPrioritiesAreCaughtAtTheirFirstWrongEvent) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   LockstepOptions o;
   o.units = {"list"};
   o.scene = "builtin:dynamic";
@@ -428,6 +436,7 @@ class DeepPopProbe final : public UnitRtl {
 // room's first such pop decides (it pops, no drop): the faulty unit lets the thread go in the
 // same cycle with the entry below, whose node is another: class payload.
 TEST(TraversalLockstep, StackPopOneEntryOffIsCaughtAtTheFirstDeepPop) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   LockstepOptions o;
   o.units = {"traversal"};
   o.scene = "builtin:room";

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "rtl/builds_testing.h"
 #include "rtl/lockstep.h"
 #include "units/boundary_transformation.h"
 #include "units/cycle_params.h"
@@ -19,6 +20,7 @@ using units::BoundaryEvent;
 using units::BoundaryPort;
 
 TEST(TransformationLockstep, NPlusOneOffIsCaughtAtTheFirstSharedOriginPacket) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
   LockstepOptions o;
   o.units = {"transformation"};
   o.scene = "builtin:room";

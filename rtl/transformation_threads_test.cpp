@@ -14,7 +14,10 @@
 #include <vector>
 
 #include "Vxf_proto.h"
+#include "rtl/builds_testing.h"
+#if SAARCOR_RTL_VARIANT_BUILDS
 #include "Vxf_proto_fault_n_plus_one_off.h"
+#endif
 #include "rtl/port_bits.h"
 #include "units/cycle_params.h"
 #include "verilated.h"
@@ -245,12 +248,14 @@ TEST(TransformationThreads, TwoNStepsWithoutASharedOriginOrWithTheFault) {
   ASSERT_EQ(separate.out.size(), 1u);
   EXPECT_EQ(separate.out[0].cycle, issue + 2 * kLanes - 1 + depth);
   EXPECT_EQ(separate.out[0].o[3], (Vec{kOneHalf, kQuarter, kOne}));
+#if SAARCOR_RTL_VARIANT_BUILDS
   Rig<Vxf_proto_fault_n_plus_one_off> faulty;
   faulty.run_to(5);
   faulty.generate(1, true, shift_x(kOne), kOrigin, kDirs);
   faulty.run_to(60);
   ASSERT_EQ(faulty.out.size(), 1u);
   EXPECT_EQ(faulty.out[0].cycle, issue + 2 * kLanes - 1 + depth);
+#endif
 }
 
 }  // namespace

@@ -11,8 +11,11 @@
 #include <vector>
 
 #include "Vtraversal_ctrl.h"
+#include "rtl/builds_testing.h"
+#if SAARCOR_RTL_VARIANT_BUILDS
 #include "Vtraversal_ctrl_p1.h"
 #include "Vtraversal_ctrl_p16.h"
+#endif
 #include "host/image_builder.h"
 #include "host/scene.h"
 #include "rtl/traversal_ctrl_testing.h"
@@ -100,6 +103,7 @@ TEST(RtlTraversal, DynamicSceneTwoLevels) {
 }
 
 // Other packet widths: the Verilated builds with P = 16 and P = 1.
+#if SAARCOR_RTL_VARIANT_BUILDS
 TEST(RtlTraversal, RoomWithSixteenRayPackets) {
   const TravRun r = run_scene<Vtraversal_ctrl_p16, 16>("builtin:room", 80, depth(), 16);
   EXPECT_FALSE(r.first.found) << describe(r);
@@ -113,6 +117,7 @@ TEST(RtlTraversal, DynamicSceneWithSingleRayPackets) {
   EXPECT_EQ(r.packets, 200u) << describe(r);
   std::printf("RtlTraversal dynamic P=1: %s\n", describe(r).c_str());
 }
+#endif
 
 // Shadow packets (docs/shading.md 6.4): the RGS hands them to the traversal unit directly, their
 // rays finish at any hit (done), and entries whose rays are all done are dropped at a pop.
