@@ -82,9 +82,9 @@ package unit_tb_pkg;
     endfunction
   endclass
 
-  // The stimulus: rays in unit-triangle space around the unit triangle (so about a third hit),
-  // best hits that are closer, farther, absent or tied in t (the id tie rule), and the corner
-  // cases no random draw finds: u + v exactly 1, D'z = +-0, an origin on the plane.
+  // The stimulus: rays in unit-triangle space around the unit triangle, a third of them aimed at a
+  // point inside it; best hits that are closer, farther, absent or tied in t (the id tie rule);
+  // and the corner cases no random draw finds: u + v exactly 1, D'z = +-0.
   class sequencer;
     int unsigned made_isect = 0, made_xf = 0;
 
@@ -98,6 +98,17 @@ package unit_tb_pkg;
       tr.dx = operand(-1.0, 1.0);
       tr.dy = operand(-1.0, 1.0);
       tr.dz = operand(-1.0, 1.0);
+      if (k % 3 == 1) begin
+        // aimed at a point (a, b) of the triangle from t in (0, 3] away: o = (a, b, 0) - t d
+        real a = uniform(0.0, 1.0), b = uniform(0.0, 1.0), t = uniform(0.01, 3.0);
+        real d[3] = '{uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)};
+        if (a + b > 1.0) begin
+          a = 1.0 - a;
+          b = 1.0 - b;
+        end
+        {tr.dx, tr.dy, tr.dz} = {fp24(d[0]), fp24(d[1]), fp24(d[2])};
+        {tr.ox, tr.oy, tr.oz} = {fp24(a - t * d[0]), fp24(b - t * d[1]), fp24(-t * d[2])};
+      end
       if (k % 16 == 5) begin
         // o = (a, 1 - a, -1), d = (0, 0, 1): t = 1, u = a, v = 1 - a, u + v = 1 exactly, the
         // edge the acceptance keeps (u + v <= 1)
