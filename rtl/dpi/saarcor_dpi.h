@@ -80,6 +80,13 @@ int saarcor_dpi_trace_pixel(int x, int y, int packet, unsigned int* instance,
 int saarcor_dpi_core_transform(unsigned int row, int translate, unsigned int x, unsigned int y,
                                unsigned int z, unsigned int* rx, unsigned int* ry,
                                unsigned int* rz);
+/* The traversal unit's lane on inner kd-node `node` of the image (either level): the node's axis
+ * (0, 1, 2) and split plane from the image, the ray's origin and direction in the node's space,
+ * the ray's segment [tn, tf]; as saarcor_dpi_traversal_lane (fp24 images; a leaf is an error). */
+int saarcor_dpi_core_traversal(unsigned int node, unsigned int ox, unsigned int oy, unsigned int oz,
+                               unsigned int dx, unsigned int dy, unsigned int dz, unsigned int tn,
+                               unsigned int tf, int* axis, int* go_near, int* go_far,
+                               unsigned int* near_tf, unsigned int* far_tn);
 /* The intersection unit on triangle `triangle` of instance `instance`'s object: the object-space
  * ray moved into unit-triangle space by the triangle's T_delta (two transformation steps), then
  * intersected and accepted as saarcor_dpi_intersect does (fp24 images). */

@@ -118,6 +118,31 @@ extern "C" int saarcor_dpi_core_transform(unsigned int row, int translate, unsig
   });
 }
 
+extern "C" int saarcor_dpi_core_traversal(unsigned int node, unsigned int ox, unsigned int oy,
+                                          unsigned int oz, unsigned int dx, unsigned int dy,
+                                          unsigned int dz, unsigned int tn, unsigned int tf,
+                                          int* axis, int* go_near, int* go_far,
+                                          unsigned int* near_tf, unsigned int* far_tn) {
+  return guarded("saarcor_dpi_core_traversal", [&] {
+    const memif::MemoryImage& im = saarcor::dpi::fp24_image();
+    const std::uint32_t nodes = im.regions().count[static_cast<int>(memif::ItemType::kNode)];
+    if (node >= nodes)
+      throw std::out_of_range("node " + std::to_string(node) + " of " + std::to_string(nodes));
+    const memif::KdNode n = im.node(node);
+    if (n.leaf) throw std::invalid_argument("node " + std::to_string(node) + " is a leaf");
+    const ff::fp24 o[3] = {enc(ox, "ox"), enc(oy, "oy"), enc(oz, "oz")};
+    const ff::fp24 d[3] = {enc(dx, "dx"), enc(dy, "dy"), enc(dz, "dz")};
+    const units::UnitFp<ff::fp24> fp;  // the prototype's mode: nearest even, subnormals flushed
+    const units::TraversalLane<ff::fp24> r = units::traversal_lane(
+        fp, ff::fp24::from_bits(n.split), o[n.axis], d[n.axis], enc(tn, "tn"), enc(tf, "tf"));
+    out(axis, "axis") = static_cast<int>(n.axis);
+    out(go_near, "go_near") = r.go_near ? 1 : 0;
+    out(go_far, "go_far") = r.go_far ? 1 : 0;
+    out(near_tf, "near_tf") = r.near_tf.bits;
+    out(far_tn, "far_tn") = r.far_tn.bits;
+  });
+}
+
 extern "C" int saarcor_dpi_core_intersect(unsigned int instance, unsigned int triangle,
                                           unsigned int ox, unsigned int oy, unsigned int oz,
                                           unsigned int dx, unsigned int dy, unsigned int dz,

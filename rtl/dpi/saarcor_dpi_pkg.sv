@@ -61,6 +61,11 @@ package saarcor_dpi_pkg;
       input int unsigned row, input int translate, input int unsigned x, input int unsigned y,
       input int unsigned z, output int unsigned rx, output int unsigned ry,
       output int unsigned rz);
+  import "DPI-C" function int saarcor_dpi_core_traversal(
+      input int unsigned node, input int unsigned ox, input int unsigned oy, input int unsigned oz,
+      input int unsigned dx, input int unsigned dy, input int unsigned dz, input int unsigned tn,
+      input int unsigned tf, output int axis, output int go_near, output int go_far,
+      output int unsigned near_tf, output int unsigned far_tn);
   import "DPI-C" function int saarcor_dpi_core_intersect(
       input int unsigned instance_id, input int unsigned triangle_id, input int unsigned ox,
       input int unsigned oy, input int unsigned oz, input int unsigned dx, input int unsigned dy,

@@ -285,5 +285,53 @@ TEST_F(DpiRoom, UnitPredictionsReproduceTheCentreHit) {
       SAARCOR_DPI_ERROR);
 }
 
+// The traversal unit on the root of the room's object tree (the top level is a single leaf: one
+// instance) with the centre pixel's ray in object space over [0, inf): the node's axis and split
+// from the image (read here through memif), the lane as saarcor_dpi_traversal_lane computes it; a
+// leaf and a node beyond the image are errors.
+TEST_F(DpiRoom, CoreTraversalStepsTheObjectRootWithItsSplit) {
+  ASSERT_EQ(saarcor_dpi_load_image(path_->c_str()), SAARCOR_DPI_OK) << saarcor_dpi_last_error();
+  const auto& p = frame_->at(256, 192);
+  const memif::MemoryImage& im = built_->image;
+  ASSERT_TRUE(im.node(im.registers().top_root).leaf);
+  const std::uint32_t root = im.instance_header(p.instance).root;
+  const memif::KdNode n = im.node(root);
+  ASSERT_FALSE(n.leaf);
+  const unsigned row = im.registers().instance_row_base + 6 * p.instance;
+  unsigned o[3], d[3];
+  ASSERT_EQ(saarcor_dpi_core_transform(row, 1, p.o[0], p.o[1], p.o[2], &o[0], &o[1], &o[2]), 0);
+  ASSERT_EQ(saarcor_dpi_core_transform(row, 0, p.d[0], p.d[1], p.d[2], &d[0], &d[1], &d[2]), 0);
+  int axis, gn, gf, want_gn, want_gf;
+  unsigned ntf, ftn, want_ntf, want_ftn;
+  ASSERT_EQ(saarcor_dpi_core_traversal(root, o[0], o[1], o[2], d[0], d[1], d[2], 0, kInf, &axis,
+                                       &gn, &gf, &ntf, &ftn),
+            SAARCOR_DPI_OK)
+      << saarcor_dpi_last_error();
+  EXPECT_EQ(axis, static_cast<int>(n.axis));
+  ASSERT_EQ(saarcor_dpi_traversal_lane("rne", "flush", n.split, o[n.axis], d[n.axis], 0, kInf,
+                                       &want_gn, &want_gf, &want_ntf, &want_ftn),
+            SAARCOR_DPI_OK);
+  EXPECT_EQ(gn, want_gn);
+  EXPECT_EQ(gf, want_gf);
+  EXPECT_EQ(ntf, want_ntf);
+  EXPECT_EQ(ftn, want_ftn);
+  EXPECT_EQ(gn + gf >= 1, true);  // a ray from inside the room's box needs at least one child
+  std::uint32_t leaf = 0;
+  while (!im.node(leaf).leaf)
+    ++leaf;
+  EXPECT_EQ(
+      saarcor_dpi_core_traversal(leaf, 0, 0, 0, 0, 0, 0, 0, kInf, &axis, &gn, &gf, &ntf, &ftn),
+      SAARCOR_DPI_ERROR);
+  EXPECT_EQ(std::string(saarcor_dpi_last_error()),
+            "saarcor_dpi_core_traversal: node " + std::to_string(leaf) + " is a leaf");
+  const std::uint32_t nodes = im.regions().count[0];
+  EXPECT_EQ(
+      saarcor_dpi_core_traversal(nodes, 0, 0, 0, 0, 0, 0, 0, kInf, &axis, &gn, &gf, &ntf, &ftn),
+      SAARCOR_DPI_ERROR);
+  EXPECT_EQ(
+      std::string(saarcor_dpi_last_error()),
+      "saarcor_dpi_core_traversal: node " + std::to_string(nodes) + " of " + std::to_string(nodes));
+}
+
 }  // namespace
 }  // namespace saarcor
