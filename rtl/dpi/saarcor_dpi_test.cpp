@@ -5,6 +5,7 @@
 #include "rtl/dpi/saarcor_dpi.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -173,8 +174,9 @@ std::string run(const std::string& args) {
   return std::system(cmd.c_str()) == 0 ? "" : "failed: " + cmd;
 }
 
+// Per process: CTest runs each test as its own process, two at a time.
 std::string temp_path(const std::string& name) {
-  return testing::TempDir() + "dpi_" + name;
+  return testing::TempDir() + "dpi_" + std::to_string(::getpid()) + "_" + name;
 }
 
 TEST(DpiCore, CallsWithoutAnImageFailWithOneLine) {
@@ -201,6 +203,7 @@ TEST(DpiCore, ForeignAndCorruptFilesFailWithOneLine) {
                "saarcor_dpi_load_image: memory image file /nonexistent.img: cannot open");
   int w = 0, h, e, m, n;
   EXPECT_EQ(saarcor_dpi_image_info(&w, &h, &e, &m, &n), SAARCOR_DPI_ERROR);
+  std::remove(foreign.c_str());
 }
 
 // The room as `saarcor scene --write-image` writes it, traced through the library, against the
@@ -218,6 +221,7 @@ class DpiRoom : public testing::Test {
     frame_ = new units::FunctionalFrame(units::run_functional(built_->image, {}));
   }
   static void TearDownTestSuite() {
+    std::remove(path_->c_str());
     delete frame_;
     delete built_;
     delete path_;
