@@ -7,8 +7,9 @@
  * encodings (bit patterns) in the low bits of an unsigned int.
  *
  * Every function returns SAARCOR_DPI_OK (0) or SAARCOR_DPI_ERROR (-1); after an error,
- * saarcor_dpi_last_error() gives one line saying why (outputs are then left unchanged). Calls are
- * not thread-safe: one simulator thread calls them, as DPI imports are called.
+ * saarcor_dpi_last_error() gives one line saying why, and the outputs are not written (unless
+ * an output pointer is null, which no simulator passes: outputs before it may be). Calls are not
+ * thread-safe: one simulator thread calls them, as DPI imports are called.
  */
 #ifndef SAARCOR_DPI_H
 #define SAARCOR_DPI_H
