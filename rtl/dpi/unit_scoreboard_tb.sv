@@ -81,7 +81,7 @@ module unit_scoreboard_tb;
   int unsigned sent_isect = 0, sent_xf = 0;
   always @(posedge clk) begin
     if (!rst && sent_isect < vectors && $urandom_range(7) != 0) begin
-      isect_txn tr = seq.next_isect();
+      automatic isect_txn tr = seq.next_isect();
       sb.isect_expected.push_back(tr);
       {i_ox, i_oy, i_oz, i_dx, i_dy, i_dz} <= {tr.ox[W-1:0], tr.oy[W-1:0], tr.oz[W-1:0],
                                                tr.dx[W-1:0], tr.dy[W-1:0], tr.dz[W-1:0]};
@@ -96,7 +96,7 @@ module unit_scoreboard_tb;
 
   always @(posedge clk) begin
     if (!rst && sent_xf < vectors && $urandom_range(7) != 0) begin
-      xf_txn tr = seq.next_xf();
+      automatic xf_txn tr = seq.next_xf();
       sb.xf_expected.push_back(tr);
       for (int k = 0; k < 12; k++) x_m[k] <= tr.m[k][W-1:0];
       {x_x, x_y, x_z} <= {tr.x[W-1:0], tr.y[W-1:0], tr.z[W-1:0]};
