@@ -35,6 +35,8 @@ void add_scene(CLI::App& app, saarcor::SceneOptions& scene_opts, int& status) {
   sub->add_flag("--json", scene_opts.json, "print one JSON object");
   sub->add_option("--export", scene_opts.export_path, "write the scene as glTF (.glb or .gltf)");
   sub->add_option("--bank-mb", scene_opts.bank_mb, "SRAM bank size in MB")->capture_default_str();
+  sub->add_option("--write-image", scene_opts.image_path,
+                  "write the memory image as a file (versioned header and the SRAM banks)");
   sub->add_option("--set", scene_opts.set, "kd-tree builder key kd.KEY=VALUE (repeatable)");
   sub->callback([&] { status = saarcor::run_scene(scene_opts); });
 }

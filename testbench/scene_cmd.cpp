@@ -16,6 +16,7 @@
 #include "host/scene.h"
 #include "host/tree_objective.h"
 #include "host/tree_settings.h"
+#include "memif/image_file.h"
 #include "testbench/report.h"
 
 namespace saarcor {
@@ -220,6 +221,11 @@ int run_scene(const SceneOptions& options) {
   if (!options.export_path.empty()) host::export_gltf(scene, options.export_path);
 
   const SceneImage img = build_scene_image(scene, options);
+  if (!options.image_path.empty()) {
+    if (!img.built)
+      throw std::runtime_error("--write-image: the memory image does not build: " + img.error);
+    memif::write_image_file(img.built->image, options.image_path);
+  }
   const json j = scene_report_json(options, scene, load_seconds, img);
   if (options.json) {
     std::printf("%s\n", j.dump(2).c_str());
@@ -232,6 +238,8 @@ int run_scene(const SceneOptions& options) {
     std::printf("warning             %s\n", w.c_str());
   if (!options.export_path.empty())
     std::printf("exported            %s\n", options.export_path.c_str());
+  if (!options.image_path.empty())
+    std::printf("image file          %s\n", options.image_path.c_str());
   return 0;
 }
 

@@ -1,6 +1,7 @@
-// `saarcor scene SCENE [--time T] [--json] [--export FILE] [--bank-mb MB]`: what a scene holds
-// and what the host makes of it (counts, both kd-tree levels' statistics and build
-// times, bytes per SRAM bank; docs/memory-image.md).
+// `saarcor scene SCENE [--time T] [--json] [--export FILE] [--bank-mb MB] [--write-image FILE]`:
+// what a scene holds and what the host makes of it (counts, both kd-tree levels' statistics and
+// build times, bytes per SRAM bank; docs/memory-image.md), and the memory image as a file for a
+// reference outside the process (memif/image_file.h: the DPI-C library of rtl/dpi/ loads it).
 #pragma once
 
 #include <cstdint>
@@ -19,6 +20,7 @@ struct SceneOptions {
   double time = 0.0;             // seconds; animated transforms are evaluated here
   bool json = false;             // one JSON object on stdout instead of text
   std::string export_path;       // write the scene as glTF (.glb or .gltf) when set
+  std::string image_path;        // write the memory image file (memif/image_file.h) when set
   double bank_mb = 4.0;          // SRAM bank size for the memory image (the prototype: 4 MB)
   std::vector<std::string> set;  // kd.KEY=VALUE: the tree builder's keys (host/tree_settings.h)
 };

@@ -15,7 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "host/image_builder.h"
+#include "host/scene.h"
 #include "host/tree_objective.h"
+#include "memif/image_file.h"
 
 namespace {
 
@@ -229,6 +232,27 @@ TEST_F(SceneCmd, ImageThatDoesNotFitStillReportsTheTrees) {
   EXPECT_NE(j["image_error"].get<std::string>().find("does not fit"), std::string::npos)
       << j["image_error"];
   EXPECT_GT(j["kdtree"]["bottom"]["nodes"].get<int>(), 1);
+}
+
+// --write-image: the file holds the image build_image makes of the same scene, word for word;
+// an image that does not build or a path that cannot be written is one line.
+TEST_F(SceneCmd, WriteImageHoldsTheBuiltImage) {
+  const std::string path = (dir_ / "room.img").string();
+  const CmdResult r = run("builtin:room --write-image " + path);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("image file          " + path), std::string::npos) << r.out;
+  const saarcor::memif::MemoryImage read = saarcor::memif::read_image_file(path);
+  const saarcor::host::BuiltImage built =
+      saarcor::host::build_image(saarcor::host::load_scene("builtin:room"));
+  for (int b = 0; b < saarcor::memif::kNumBanks; ++b)
+    EXPECT_EQ(read.bank(b), built.image.bank(b)) << "bank " << b;
+  EXPECT_EQ(read.regions().count, built.image.regions().count);
+  EXPECT_EQ(read.registers().cam_d, built.image.registers().cam_d);
+  EXPECT_EQ(read.registers().instance_count, built.image.registers().instance_count);
+  expect_one_line_error("builtin:room --bank-mb 0.01 --write-image " + path,
+                        "--write-image: the memory image does not build");
+  expect_one_line_error("builtin:room --write-image " + (dir_ / "absent" / "x.img").string(),
+                        "cannot open for writing");
 }
 
 TEST_F(SceneCmd, BadInputsExitNonZeroWithOneLine) {
