@@ -177,9 +177,11 @@ module cache #(
   logic victim_pend;
   logic [LW-1:0] touched;  // the line whose LRU rank the lookup refreshes
   assign touched = do_miss ? victim : l_line;
-  logic [ITEMS*WB-1:0] rank_reset;  // each set's ways in way order
-  always_comb
-    for (int i = 0; i < ITEMS; i++) rank_reset[i*WB+:WB] = WB'(i) & WB'(ways_mask);
+  // The ranks after reset: each set's ways in way order (a function of the configuration, called
+  // only in reset: as a combinational block it would be evaluated with every input change).
+  function automatic logic [ITEMS*WB-1:0] ranks_at_reset(input logic [WB-1:0] mask);
+    for (int i = 0; i < ITEMS; i++) ranks_at_reset[i*WB+:WB] = WB'(i) & mask;
+  endfunction
   assign head_any = rq_count != '0;
   assign l_index = rq_index[rq_head];
   assign ways = (WB + 1)'(1) << cfg_ways_log2;
@@ -360,7 +362,7 @@ module cache #(
         tgt_head[m] <= '0;
         tgt_count[m] <= '0;
       end
-      rank <= rank_reset;
+      rank <= ranks_at_reset(WB'(ways_mask));
     end else begin
       rs_valid[0] <= deliver || do_hit;
       for (int s = 1; s < RS; s++) rs_valid[s] <= rs_valid[s-1];
