@@ -353,7 +353,8 @@ int fault_of(const std::string& unit, const std::string& fault) {
   if (fault.empty()) return 0;
   if (unit.ends_with("-cache")) return fault == "merge-wrong-target" ? 1 : 0;
   if (unit == "intersection") return fault == "strict-uv" ? 1 : 0;
-  if (unit == "transformation") return fault == "n-plus-one-off" ? 1 : 0;
+  if (unit == "transformation")
+    return fault == "n-plus-one-off" ? 1 : fault == "row-out-of-order" ? 2 : 0;
   if (unit == "list")
     return fault == "mailbox-never-hits" ? 1 : fault == "priorities-swapped" ? 2 : 0;
   if (fault == "pop-off") return 1;
@@ -645,11 +646,12 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
       x.build = (c.traversal = &choose_traversal_build(p, fault))->name;
   }
   if (!fault_used)
-    throw std::runtime_error("lockstep: no unit of the run has the fault '" + o.fault +
-                             "' (list: mailbox-never-hits, priorities-swapped; traversal: "
-                             "pop-off, short-pipeline, priorities-swapped; intersection: "
-                             "strict-uv; transformation: n-plus-one-off; the caches: "
-                             "merge-wrong-target)");
+    throw std::runtime_error(
+        "lockstep: no unit of the run has the fault '" + o.fault +
+        "' (list: mailbox-never-hits, priorities-swapped; traversal: "
+        "pop-off, short-pipeline, priorities-swapped; intersection: "
+        "strict-uv; transformation: n-plus-one-off, row-out-of-order; the caches: "
+        "merge-wrong-target)");
   return chosen;
 }
 

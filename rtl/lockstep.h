@@ -38,8 +38,8 @@ struct LockstepOptions {
   int depth = 0;  // secondary-ray depth (0: none)
   // "" or an injected fault (tests): mailbox-never-hits (list), pop-off, short-pipeline
   // (traversal), priorities-swapped (both), strict-uv (intersection), n-plus-one-off
-  // (transformation), merge-wrong-target (the caches); each unit that has it runs its fault
-  // build.
+  // and row-out-of-order (transformation), merge-wrong-target (the caches); each unit that has
+  // it runs its fault build.
   std::string fault;
   // The RTL waveform around a divergence (with several units: one file per unit, the unit's name
   // before the extension; wave_file).
