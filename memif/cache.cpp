@@ -196,6 +196,8 @@ int Cache::hit(const CacheRequest& req, int port, std::size_t li, bool port_free
   r.count = words_;
   if (ways_ > 1) lru_[li] = ++use_clock_;
   ++*hits_;
+  if (observer_ != nullptr) [[unlikely]]
+    observer_->hit(now(), *this, req);
   return 1;
 }
 
@@ -208,6 +210,8 @@ int Cache::merge(const CacheRequest& req, int port, std::size_t li) {
   target.port = port;
   if (ways_ > 1) lru_[li] = ++use_clock_;
   ++*merges_;
+  if (observer_ != nullptr) [[unlikely]]
+    observer_->merged(now(), *this, req, lines_[li].state);
   return 1;
 }
 

@@ -44,15 +44,19 @@ namespace saarcor::memif {
 
 class Cache;
 
-// What a traced run observes of a cache's misses (the Perfetto timeline, units/perfetto_trace.h):
-// a miss accepted with its MSHR and the label of the request that caused it, and the fill that
-// answers it. Null in a run that traces nothing (one pointer test on the miss path only).
+// What a traced run observes of a cache's lookups (the Perfetto timeline, units/perfetto_trace.h;
+// the lockstep's cache record, units/boundary_cache.h): a miss accepted with its MSHR and the
+// label of the request that caused it, and the fill that answers it; a hit, and a request merged
+// into MSHR `mshr`. Null in a run that traces nothing (one pointer test per lookup).
 class CacheObserver {
  public:
   virtual ~CacheObserver() = default;
   virtual void miss(std::uint64_t cycle, const Cache& cache, std::uint32_t item, int mshr,
                     const Label& label) = 0;
   virtual void filled(std::uint64_t cycle, const Cache& cache, int mshr) = 0;
+  virtual void hit(std::uint64_t /*cycle*/, const Cache& /*cache*/, const CacheRequest& /*r*/) {}
+  virtual void merged(std::uint64_t /*cycle*/, const Cache& /*cache*/, const CacheRequest& /*r*/,
+                      int /*mshr*/) {}
 };
 
 class Cache : public hw::Module {
@@ -86,7 +90,7 @@ class Cache : public hw::Module {
   // Test hook: appends the index of every accepted request, in acceptance order (the sequence a
   // reference cache simulation must see). nullptr switches it off.
   void set_accept_log(std::vector<std::uint32_t>* log) { accept_log_ = log; }
-  // Every miss and fill reports to `o` (null: none, the default). Timing does not change.
+  // Every lookup and fill reports to `o` (null: none, the default). Timing does not change.
   void set_observer(CacheObserver* o) { observer_ = o; }
 
   int evaluate() override;

@@ -55,7 +55,9 @@ int SimpleRouting::broadcast() {
       stall();
       break;
     }
-    fills.push(port_.responses.pop());
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->delivered(now(), r);
+    fills.push(port_.responses.pop());  // last: `r` refers to the channel's slot
     ++moved;
   }
   return moved;
@@ -74,6 +76,8 @@ int SimpleRouting::arbitrate() {
     MemRequest r = in.pop();
     r.client = clients_[static_cast<std::size_t>(c)].id;  // the label is the routing's to set
     port_.requests.push(r);
+    if (observer_ != nullptr) [[unlikely]]
+      observer_->forwarded(now(), r);
     rr_.set((c + 1) % n);
     ++*forwarded_;
     return 1;

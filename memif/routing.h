@@ -21,6 +21,16 @@
 
 namespace saarcor::memif {
 
+// What a traced run observes of the routing (the lockstep's cache record, units/boundary_cache.h):
+// a client's request taken towards the controller, and a response pushed to its client's fill
+// channel. Null in a run that traces nothing (one pointer test per request and per response).
+class RoutingObserver {
+ public:
+  virtual ~RoutingObserver() = default;
+  virtual void forwarded(std::uint64_t cycle, const MemRequest& r) = 0;  // r.client set
+  virtual void delivered(std::uint64_t cycle, const MemResponse& r) = 0;
+};
+
 class SimpleRouting : public hw::Module {
  public:
   SimpleRouting(hw::Kernel& kernel, std::string name, MemoryController::Port& port,
@@ -33,6 +43,9 @@ class SimpleRouting : public hw::Module {
   // `requests` and whose responses it pushes into `fills`.
   void add_client(std::uint16_t client, hw::Channel<MemRequest>& requests,
                   hw::Channel<MemResponse>& fills);
+
+  // Every forwarded request and delivered response reports to `o` (null: none, the default).
+  void set_observer(RoutingObserver* o) { observer_ = o; }
 
   int evaluate() override;
   void commit() override { rr_.commit(); }
@@ -54,6 +67,7 @@ class SimpleRouting : public hw::Module {
   std::vector<int> by_id_;  // controller client id -> index in clients_, -1 if not ours
   hw::Reg<int> rr_{0};      // next client to be offered the request bus
   hw::Counter* forwarded_;
+  RoutingObserver* observer_ = nullptr;
 };
 
 }  // namespace saarcor::memif

@@ -25,10 +25,12 @@
 #include "host/tree_settings.h"
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
+#include "rtl/cache_rtl.h"
 #include "rtl/intersection_rtl.h"
 #include "rtl/list_rtl.h"
 #include "rtl/transformation_rtl.h"
 #include "rtl/traversal_rtl.h"
+#include "units/boundary_cache.h"
 #include "units/boundary_intersection.h"
 #include "units/boundary_list.h"
 #include "units/boundary_transformation.h"
@@ -109,7 +111,7 @@ class Lockstep {
     std::vector<BoundaryEvent> inputs, outputs;
     for (BoundaryEvent& e : pending_) {
       remember(model_hist_, e);
-      if (e.port == BoundaryPort::kCacheRequest || e.port == BoundaryPort::kOutput) {
+      if (is_output(e)) {
         outputs.push_back(std::move(e));
         continue;
       }
@@ -121,8 +123,7 @@ class Lockstep {
     in_port_order(outputs);
     for (BoundaryEvent& e : outputs)
       model_out_.push_back(std::move(e));
-    if (o_.write_wave && cur == o_.wave_from)
-      rtl_.start_trace(wave_file(o_, units::unit_name(rtl_.unit())));
+    if (o_.write_wave && cur == o_.wave_from) rtl_.start_trace(wave_file(o_, rtl_.name()));
     outputs.clear();
     const auto t0 = Clock::now();
     rtl_.cycle(cur, inputs, outputs);
@@ -168,7 +169,7 @@ class Lockstep {
   bool diverged() const { return diverged_; }
   const Divergence& divergence() const { return div_; }
   const std::string& screen() const { return screen_; }
-  const std::array<std::uint64_t, 6>& events() const { return events_; }
+  const std::array<std::uint64_t, units::kBoundaryPorts>& events() const { return events_; }
   double rtl_seconds() const { return rtl_seconds_; }
 
  private:
@@ -178,6 +179,15 @@ class Lockstep {
     const std::uint64_t keep = 2 * static_cast<std::uint64_t>(o_.window) + 64;
     while (h.size() > 16 && h.front().cycle + keep < e.cycle)
       h.pop_front();
+  }
+
+  // What the RTL computes (compared), as opposed to what it is given: a unit's cache requests
+  // and threads leaving; a cache's lookups, replies and line requests.
+  static bool is_output(const BoundaryEvent& e) {
+    if (e.cache)
+      return e.port == BoundaryPort::kCacheAccept || e.port == BoundaryPort::kCacheReply ||
+             e.port == BoundaryPort::kMemRequest;
+    return e.port == BoundaryPort::kCacheRequest || e.port == BoundaryPort::kOutput;
   }
 
   static bool before(const BoundaryEvent& a, const BoundaryEvent& b) {
@@ -233,7 +243,7 @@ class Lockstep {
                             std::uint64_t other) {
     const BoundaryEvent& e = model != nullptr ? *model : *rtl;
     div_.cycle = e.cycle;
-    div_.unit = units::unit_name(rtl_.unit());
+    div_.unit = rtl_.name();
     div_.port = units::boundary_port_name(e.port);
     div_.kind = kind;
     div_.other_cycle = other;
@@ -261,8 +271,8 @@ class Lockstep {
     std::vector<const BoundaryEvent*> last;
     for (auto it = h.rbegin(); it != h.rend() && last.size() < 16; ++it)
       if (it->cycle <= cycle) last.push_back(&*it);
-    s << "  the last " << last.size() << " events of the " << units::unit_name(rtl_.unit())
-      << " unit, " << side << ":\n";
+    s << "  the last " << last.size() << " events of the " << rtl_.name() << " unit, " << side
+      << ":\n";
     for (auto it = last.rbegin(); it != last.rend(); ++it)
       s << "    " << units::format_boundary(**it) << "\n";
   }
@@ -272,7 +282,7 @@ class Lockstep {
   std::vector<BoundaryEvent> pending_;
   std::deque<BoundaryEvent> model_out_, rtl_out_;
   std::deque<BoundaryEvent> model_hist_, rtl_hist_;
-  std::array<std::uint64_t, 6> events_{};
+  std::array<std::uint64_t, units::kBoundaryPorts> events_{};
   double rtl_seconds_ = 0;
   bool diverged_ = false;
   Divergence div_;
@@ -286,12 +296,13 @@ class Cosim {
  public:
   explicit Cosim(const LockstepOptions& o) : o_(o) {}
   void add(UnitRtl& rtl) {
-    units_[static_cast<std::size_t>(units::unit_index(rtl.unit()))] = &steps_.emplace_back(rtl, o_);
+    (rtl.cache() ? caches_ : units_)[static_cast<std::size_t>(units::unit_index(rtl.unit()))] =
+        &steps_.emplace_back(rtl, o_);
   }
 
   void model_event(const BoundaryEvent& e) {
     if (o_.model_events) o_.model_events(e);
-    Lockstep* u = units_[static_cast<std::size_t>(units::unit_index(e.unit))];
+    Lockstep* u = (e.cache ? caches_ : units_)[static_cast<std::size_t>(units::unit_index(e.unit))];
     if (u == nullptr) return;
     if (e.cycle > cur_) advance_to(e.cycle);
     u->model_event(e);
@@ -332,16 +343,18 @@ class Cosim {
 
   const LockstepOptions& o_;
   std::deque<Lockstep> steps_;  // (a deque: the pointers below stay valid)
-  std::array<Lockstep*, units::kMaxUnits> units_{};
-  std::uint64_t cur_ = 0;  // the RTL's next cycle
+  std::array<Lockstep*, units::kMaxUnits> units_{}, caches_{};  // by the (served) unit
+  std::uint64_t cur_ = 0;                                       // the RTL's next cycle
   std::uint64_t model_cycles_ = 0;
 };
 
 // The fault builds (LockstepOptions::fault) of a unit: its fault number, 0 for none.
 int fault_of(const std::string& unit, const std::string& fault) {
   if (fault.empty()) return 0;
+  if (unit.ends_with("-cache")) return fault == "merge-wrong-target" ? 1 : 0;
   if (unit == "intersection") return fault == "strict-uv" ? 1 : 0;
-  if (unit == "transformation") return fault == "n-plus-one-off" ? 1 : 0;
+  if (unit == "transformation")
+    return fault == "n-plus-one-off" ? 1 : fault == "row-out-of-order" ? 2 : 0;
   if (unit == "list")
     return fault == "mailbox-never-hits" ? 1 : fault == "priorities-swapped" ? 2 : 0;
   if (fault == "pop-off") return 1;
@@ -438,10 +451,15 @@ const TraversalBuild& choose_traversal_build(const units::CycleParams& p, int fa
       "; built:" + built);
 }
 
+// What the model records: the units' events and the caches' (units/boundary_cache.h).
+struct Recorded {
+  std::vector<UnitId> units;
+  std::vector<memif::ItemType> caches;
+};
+
 template <class F, int kLanes>
 void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
-               const units::FunctionalParams& shading, const std::vector<UnitId>& recorded,
-               Cosim* cs) {
+               const units::FunctionalParams& shading, const Recorded& recorded, Cosim* cs) {
   using State = units::PacketState<F, kLanes, units::FastDatapath>;
   memif::MemoryImage image = image_in;
   LockstepThreads<F, kLanes> threads(image, units::functional_params(p, shading), p.threads);
@@ -461,9 +479,13 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   payloads.set(UnitId::kIntersection, intersection);
   payloads.set(UnitId::kList, list);
   payloads.set(UnitId::kTraversal, traversal);
-  units::BoundaryRecorder rec(threads, p.threads, recorded, payloads,
-                              [&](const BoundaryEvent& e) { cs->model_event(e); });
-  if (cs != nullptr) d.observe(&rec);  // (none: the model alone, for the speed beside it)
+  const auto sink = [&](const BoundaryEvent& e) { cs->model_event(e); };
+  units::BoundaryRecorder rec(threads, p.threads, recorded.units, payloads, sink);
+  std::optional<units::CacheRecorder> caches;  // (the units' hooks through it to `rec`)
+  if (cs != nullptr && !recorded.caches.empty())
+    caches.emplace(mi, image, recorded.caches, &rec, sink);
+  if (cs != nullptr)  // (none: the model alone, for the speed beside it)
+    d.observe(caches ? static_cast<units::UnitObserver*>(&*caches) : &rec);
   const auto done = [&] {
     return rgc.all_handed_out() && d.rgs().idle() && mi.frame_writes_stored();
   };
@@ -479,7 +501,7 @@ template <class F, int kLanes>
 double model_alone(const memif::MemoryImage& image, const units::CycleParams& p,
                    const units::FunctionalParams& shading) {
   const auto t0 = Clock::now();
-  run_model<F, kLanes>(image, p, shading, {}, nullptr);
+  run_model<F, kLanes>(image, p, shading, Recorded{}, nullptr);
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
@@ -499,7 +521,7 @@ std::string lockstep_command(const LockstepOptions& o) {
 }
 
 std::string wave_file(const LockstepOptions& o, const std::string& unit) {
-  if (o.units.size() < 2) return o.wave;
+  if (o.units.size() < 2 && (o.units.empty() || o.units[0] != "caches")) return o.wave;
   const std::size_t dot = o.wave.rfind('.');
   const std::size_t slash = o.wave.rfind('/');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
@@ -530,9 +552,66 @@ units::CycleParams run_params(const LockstepOptions& o, host::ImageParams& ip) {
   return p;
 }
 
+// The unit a cache name serves (node-cache: traversal, list-cache: list, row-cache:
+// transformation), kNone for another name.
+UnitId cache_of(const std::string& name) {
+  for (UnitId u : {UnitId::kTraversal, UnitId::kList, UnitId::kTransformation})
+    if (name == units::cache_name(u)) return u;
+  return UnitId::kNone;
+}
+
+// The run's units with `caches` standing for the three caches.
+std::vector<std::string> expand_units(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  for (const std::string& n : names)
+    if (n == "caches")
+      out.insert(out.end(), {"node-cache", "list-cache", "row-cache"});
+    else
+      out.push_back(n);
+  return out;
+}
+
+std::string cache_config(int hit, int misses, int targets, int rq, int mq) {
+  return "cache.hit_latency=" + std::to_string(hit) + " cache.misses=" + std::to_string(misses) +
+         " cache.merge_targets=" + std::to_string(targets) +
+         " cache.request_queue=" + std::to_string(rq) + " cache.memory_queue=" + std::to_string(mq);
+}
+
+// The cache build whose timing parameters are the run's and whose arrays hold the run's cache
+// (its lines, its ways, a power of two, and the item words; the labels' thread bits).
+const CacheBuild& choose_cache_build(const units::CycleParams& p, UnitId unit, int faulty) {
+  const auto& c = p.cache[unit == UnitId::kTraversal ? 0 : unit == UnitId::kList ? 1 : 2];
+  const int words = unit == UnitId::kTraversal ? 2 : unit == UnitId::kList ? 1 : 3;
+  const std::string name = units::cache_name(unit);
+  if ((c.ways & (c.ways - 1)) != 0)
+    throw std::runtime_error("lockstep: the Verilated " + name +
+                             " takes a power of two of ways, not " + std::to_string(c.ways));
+  if (p.threads * p.pipelines > 4096)
+    throw std::runtime_error("lockstep: the Verilated caches label at most 4096 threads");
+  std::string built;
+  for (const CacheBuild& b : cache_builds()) {
+    if (b.fault != faulty) continue;
+    if (b.hit_latency == p.cache_hit_latency && b.misses == p.cache_misses &&
+        b.targets == p.cache_merge_targets && b.request_queue == p.cache_request_queue &&
+        b.memory_queue == p.cache_memory_queue && c.items <= b.items && c.ways <= b.ways &&
+        words <= b.words)
+      return b;
+    built += " [" +
+             cache_config(b.hit_latency, b.misses, b.targets, b.request_queue, b.memory_queue) +
+             " items<=" + std::to_string(b.items) + " ways<=" + std::to_string(b.ways) + "]";
+  }
+  throw std::runtime_error("lockstep: no Verilated " + name + " for " +
+                           cache_config(p.cache_hit_latency, p.cache_misses, p.cache_merge_targets,
+                                        p.cache_request_queue, p.cache_memory_queue) +
+                           " items=" + std::to_string(c.items) + " ways=" + std::to_string(c.ways) +
+                           "; built:" + built);
+}
+
 // The Verilated build of each unit in o.units for the run's parameters (and fault): a list, a
 // traversal or an intersection unit build.
 struct Chosen {
+  const CacheBuild* cache = nullptr;
+  UnitId served = UnitId::kNone;  // the cache's unit
   const ListBuild* list = nullptr;
   const TraversalBuild* traversal = nullptr;
   const IntersectionBuild* intersection = nullptr;
@@ -542,10 +621,12 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
                                   std::vector<LockstepUnit>& info) {
   bool fault_used = o.fault.empty();
   std::vector<Chosen> chosen;
-  for (const std::string& u : o.units) {
-    if (u != "traversal" && u != "list" && u != "intersection" && u != "transformation")
+  for (const std::string& u : expand_units(o.units)) {
+    if (u != "traversal" && u != "list" && u != "intersection" && u != "transformation" &&
+        cache_of(u) == UnitId::kNone)
       throw std::runtime_error("lockstep: unknown unit '" + u +
-                               "' (the RTL units: traversal, list, transformation, intersection)");
+                               "' (the RTL units: traversal, list, transformation, intersection, "
+                               "node-cache, list-cache, row-cache; caches: the three)");
     for (const LockstepUnit& x : info)
       if (x.unit == u) throw std::runtime_error("lockstep: unit '" + u + "' given twice");
     const int fault = fault_of(u, o.fault);
@@ -553,7 +634,9 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
     LockstepUnit& x = info.emplace_back();
     x.unit = u;
     Chosen& c = chosen.emplace_back();
-    if (u == "list")
+    if (cache_of(u) != UnitId::kNone)
+      x.build = (c.cache = &choose_cache_build(p, c.served = cache_of(u), fault))->name;
+    else if (u == "list")
       x.build = (c.list = &choose_list_build(p, fault))->name;
     else if (u == "intersection")
       x.build = (c.intersection = &choose_intersection_build(p, fault))->name;
@@ -563,11 +646,36 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
       x.build = (c.traversal = &choose_traversal_build(p, fault))->name;
   }
   if (!fault_used)
-    throw std::runtime_error("lockstep: no unit of the run has the fault '" + o.fault +
-                             "' (list: mailbox-never-hits, priorities-swapped; traversal: "
-                             "pop-off, short-pipeline, priorities-swapped; intersection: "
-                             "strict-uv; transformation: n-plus-one-off)");
+    throw std::runtime_error(
+        "lockstep: no unit of the run has the fault '" + o.fault +
+        "' (list: mailbox-never-hits, priorities-swapped; traversal: "
+        "pop-off, short-pipeline, priorities-swapped; intersection: "
+        "strict-uv; transformation: n-plus-one-off, row-out-of-order; the caches: "
+        "merge-wrong-target)");
   return chosen;
+}
+
+memif::ItemType cache_type(UnitId served) {
+  return served == UnitId::kTraversal ? memif::ItemType::kNode
+         : served == UnitId::kList    ? memif::ItemType::kList
+                                      : memif::ItemType::kRow;
+}
+
+// The Verilated unit or cache of a chosen build.
+std::unique_ptr<UnitRtl> make_rtl(const Chosen& c, const units::CycleParams& p,
+                                  const memif::MemoryImage& image) {
+  if (c.cache != nullptr) {
+    const memif::ItemType type = cache_type(c.served);
+    const auto& sizes = p.cache[static_cast<std::size_t>(type)];
+    return make_cache_unit_rtl(*c.cache, c.served,
+                               {sizes.items, sizes.ways, image.item_words(type),
+                                image.regions().base[static_cast<std::size_t>(type)]});
+  }
+  if (c.list != nullptr) return make_list_unit_rtl(*c.list);
+  if (c.intersection != nullptr) return make_intersection_unit_rtl(*c.intersection);
+  if (c.transformation != nullptr)
+    return make_transformation_unit_rtl(*c.transformation, image.registers());
+  return make_traversal_unit_rtl(*c.traversal, image.registers());
 }
 
 }  // namespace
@@ -589,19 +697,15 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   shading.max_depth = o.depth > 0 ? o.depth : -1;
 
   std::vector<std::unique_ptr<UnitRtl>> rtl;
-  std::vector<UnitId> recorded;
+  Recorded recorded;
   Cosim cs(o);
   for (const Chosen& c : chosen) {
-    if (c.list != nullptr)
-      rtl.push_back(make_list_unit_rtl(*c.list));
-    else if (c.intersection != nullptr)
-      rtl.push_back(make_intersection_unit_rtl(*c.intersection));
-    else if (c.transformation != nullptr)
-      rtl.push_back(make_transformation_unit_rtl(*c.transformation, built.image.registers()));
-    else
-      rtl.push_back(make_traversal_unit_rtl(*c.traversal, built.image.registers()));
+    rtl.push_back(make_rtl(c, p, built.image));
     if (o.wrap_rtl) rtl.back() = o.wrap_rtl(std::move(rtl.back()));
-    recorded.push_back(rtl.back()->unit());
+    if (c.cache != nullptr)
+      recorded.caches.push_back(cache_type(c.served));
+    else
+      recorded.units.push_back(rtl.back()->unit());
     cs.add(*rtl.back());
   }
   const auto t1 = Clock::now();

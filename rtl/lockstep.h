@@ -29,7 +29,8 @@ namespace saarcor::rtl {
 
 struct LockstepOptions {
   std::string scene;  // host::load_scene spec (builtin:room, a glTF path)
-  // The RTL units: traversal, list, transformation, intersection.
+  // The RTL units: traversal, list, transformation, intersection, and the caches node-cache,
+  // list-cache, row-cache (`caches`: all three).
   std::vector<std::string> units{"traversal", "list"};
   int width = 32, height = 24;
   std::vector<std::string> set;  // cycle-model KEY=VALUE (and kd.* tree keys)
@@ -37,7 +38,8 @@ struct LockstepOptions {
   int depth = 0;  // secondary-ray depth (0: none)
   // "" or an injected fault (tests): mailbox-never-hits (list), pop-off, short-pipeline
   // (traversal), priorities-swapped (both), strict-uv (intersection), n-plus-one-off
-  // (transformation); each unit that has it runs its fault build.
+  // and row-out-of-order (transformation), merge-wrong-target (the caches); each unit that has
+  // it runs its fault build.
   std::string fault;
   // The RTL waveform around a divergence (with several units: one file per unit, the unit's name
   // before the extension; wave_file).
@@ -63,10 +65,10 @@ struct Divergence {
 
 // One RTL unit's part of a run.
 struct LockstepUnit {
-  std::string unit;   // "traversal", "list", "transformation", "intersection"
+  std::string unit;   // "traversal", "list", "transformation", "intersection", "node-cache", ...
   std::string build;  // the Verilated build that ran
   // Per port (units::BoundaryPort): events given to the RTL (inputs) or compared (outputs).
-  std::array<std::uint64_t, 6> events{};
+  std::array<std::uint64_t, units::kBoundaryPorts> events{};
   std::uint64_t event(units::BoundaryPort p) const { return events[static_cast<std::size_t>(p)]; }
 };
 

@@ -38,7 +38,7 @@ std::string shared(const std::string& rel) {
 LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, int w = 24,
                    int h = 18, bool shadows = false, int depth = 0) {
   LockstepOptions o;
-  o.units = {"traversal", "list", "transformation", "intersection"};
+  o.units = {"traversal", "list", "transformation", "intersection", "caches"};
   o.scene = scene;
   o.set = std::move(set);
   o.width = w;
@@ -52,7 +52,8 @@ LockstepResult run(const std::string& scene, std::vector<std::string> set = {}, 
 // each entry leaving; the traversal unit's node fetches answered, and more threads leaving than
 // node steps (the clips and pops leave too); the transformation unit's row fetches answered and
 // every thread leaving again; the intersection unit's every triangle leaving again (one hit
-// update each), each packet start seen by the list and the intersection unit.
+// update each), each packet start seen by the list and the intersection unit; each unit's cache
+// looks up and answers every request the unit sent, and gets a fill for each line request.
 void expect_agreement(const LockstepResult& r) {
   EXPECT_FALSE(r.diverged) << r.screen;
   const LockstepUnit& list = r.unit("list");
@@ -74,6 +75,15 @@ void expect_agreement(const LockstepResult& r) {
   EXPECT_EQ(xf.event(BoundaryPort::kCacheRequest), xf.event(BoundaryPort::kCacheResponse));
   EXPECT_EQ(xf.event(BoundaryPort::kOutput), xf.event(BoundaryPort::kInput));
   EXPECT_GE(xf.event(BoundaryPort::kOutput), isect.event(BoundaryPort::kInput));
+  for (const auto& [name, unit] : {std::pair{"node-cache", &trav}, std::pair{"list-cache", &list},
+                                   std::pair{"row-cache", &xf}}) {
+    const LockstepUnit& c = r.unit(name);
+    EXPECT_EQ(c.event(BoundaryPort::kCacheRequest), unit->event(BoundaryPort::kCacheRequest));
+    EXPECT_EQ(c.event(BoundaryPort::kCacheAccept), c.event(BoundaryPort::kCacheRequest));
+    EXPECT_EQ(c.event(BoundaryPort::kCacheReply), c.event(BoundaryPort::kCacheRequest));
+    EXPECT_GT(c.event(BoundaryPort::kMemRequest), 0u);
+    EXPECT_EQ(c.event(BoundaryPort::kMemFill), c.event(BoundaryPort::kMemRequest));
+  }
   std::printf(
       "  %s/%s: %llu cycles; traversal %llu requests, %llu outputs; list %llu requests, "
       "%llu outputs; transformation %llu rows, %llu outputs; intersection %llu outputs compared\n",

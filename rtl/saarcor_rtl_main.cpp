@@ -4,7 +4,8 @@
 //
 //   saarcor-rtl check FILE [--out OUT] [--max N]
 //
-//   saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection] [--res WxH]
+//   saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection,caches]
+//                        [--res WxH]
 //                        [--set KEY=VALUE ...] [--shadows] [--depth N] [--until CYCLE]
 //                        [--wave FILE] [--bench]
 //
@@ -32,7 +33,8 @@ constexpr const char* kUsage =
     "                            [--res WxH] [--set KEY=VALUE ...] [--shadows] [--depth N]\n"
     "                            [--until CYCLE] [--wave FILE] [--bench] [--fault NAME]\n"
     "  lockstep: runs the cycle model and the Verilated units (traversal, list, transformation,\n"
-    "  intersection; default traversal,list) side by side and compares every port event of each\n"
+    "  intersection; the caches node-cache, list-cache, row-cache, or caches for the three;\n"
+    "  default traversal,list) side by side and compares every port event of each\n"
     "  in the same cycle; exit 2 at the first divergence (its screen, a VCD window of the RTL\n"
     "  around it and the replay command printed). --bench also times the cycle model alone on\n"
     "  the same frame.\n"
@@ -207,14 +209,20 @@ void report_agreement(const LockstepOptions& o, const saarcor::rtl::LockstepResu
   std::printf("saarcor-rtl lockstep: %s %dx%d: 0 divergences in %llu cycles\n", o.scene.c_str(),
               o.width, o.height, static_cast<unsigned long long>(r.model_cycles));
   using saarcor::units::BoundaryPort;
+  using Ports = std::vector<BoundaryPort>;
   for (const saarcor::rtl::LockstepUnit& u : r.units) {
-    std::printf("  %s unit (build %s): in:", u.unit.c_str(), u.build.c_str());
-    for (BoundaryPort p : {BoundaryPort::kInput, BoundaryPort::kSideBand,
-                           BoundaryPort::kCacheResponse, BoundaryPort::kCacheBlocked})
+    const bool cache = u.unit.ends_with("-cache");
+    std::printf("  %s %s(build %s): in:", u.unit.c_str(), cache ? "" : "unit ", u.build.c_str());
+    for (BoundaryPort p :
+         cache ? Ports{BoundaryPort::kCacheRequest, BoundaryPort::kMemTaken, BoundaryPort::kMemFill}
+               : Ports{BoundaryPort::kInput, BoundaryPort::kSideBand, BoundaryPort::kCacheResponse,
+                       BoundaryPort::kCacheBlocked})
       std::printf(" %s %llu", saarcor::units::boundary_port_name(p),
                   static_cast<unsigned long long>(u.event(p)));
     std::printf("; compared:");
-    for (BoundaryPort p : {BoundaryPort::kCacheRequest, BoundaryPort::kOutput})
+    for (BoundaryPort p : cache ? Ports{BoundaryPort::kCacheAccept, BoundaryPort::kCacheReply,
+                                        BoundaryPort::kMemRequest}
+                                : Ports{BoundaryPort::kCacheRequest, BoundaryPort::kOutput})
       std::printf(" %s %llu", saarcor::units::boundary_port_name(p),
                   static_cast<unsigned long long>(u.event(p)));
     std::printf("\n");

@@ -18,7 +18,8 @@ namespace saarcor::rtl {
 struct TransformationBuild {
   std::string name;
   int threads = 0, packet = 0, lat_add = 0, lat_mul = 0;
-  int fault = 0;  // tests only: 1 the n + 1 rule off (2n steps for a shared origin too)
+  int fault = 0;  // tests only: 1 the n + 1 rule off (2n steps for a shared origin too), 2 an
+                  // entry's second and third rows fetched in swapped order
 };
 const std::vector<TransformationBuild>& transformation_builds();
 

@@ -24,6 +24,7 @@ module transformation_threads #(
     parameter int LAT_ADD = 3,
     parameter int LAT_MUL = 3,
     parameter bit FAULT_N_PLUS_ONE_OFF = 1'b0,  // tests only: 2n steps for a shared origin too
+    parameter bit FAULT_ROW_ORDER = 1'b0,  // tests only: an entry's second and third rows swapped
     parameter int TW      = THREADS > 1 ? $clog2(THREADS) : 1
 ) (
     input  logic                 clk,
@@ -93,6 +94,15 @@ module transformation_threads #(
   logic [TW-1:0] acc_thread, iss_thread;
   logic [31:0] acc_first;
   logic [2:0] acc_count;
+  // The row requested (the injected fault, tests only: while fetching, i.e. not in the accept's
+  // cycle, the entry's second row is requested third and its third second).
+  logic [31:0] fetch_item, fetch_k;
+  assign fetch_k = fetch_item - first_r[req_thread];
+  always_comb begin
+    req_item = fetch_item;
+    if (FAULT_ROW_ORDER && !acc_valid && fetch_k == 32'd1) req_item = fetch_item + 32'd1;
+    if (FAULT_ROW_ORDER && !acc_valid && fetch_k == 32'd2) req_item = fetch_item - 32'd1;
+  end
   // The first row: 6 or 3 rows an entry, as shifts and adds (a constant multiply would take
   // multiplier blocks on the FPGA).
   logic [31:0] acc_entry;
@@ -118,7 +128,7 @@ module transformation_threads #(
   ) threads (
       .clk, .rst, .in_valid({a_valid, d_valid}), .in_thread({a_thread, d_thread}),
       .acc_valid, .acc_thread, .acc_first, .acc_count,
-      .req_valid, .req_item, .req_thread, .req_ready, .resp_valid, .resp_thread,
+      .req_valid, .req_item(fetch_item), .req_thread, .req_ready, .resp_valid, .resp_thread,
       .iss_valid, .iss_thread, .iss_steps(steps), .iss_chain(1'b0), .iss_payload(1'b0),
       .out_valid, .out_thread, .out_payload, .out_ready(1'b1));
   /* verilator lint_off UNUSEDSIGNAL */

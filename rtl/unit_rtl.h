@@ -16,6 +16,9 @@ class UnitRtl {
  public:
   virtual ~UnitRtl() = default;
   virtual units::UnitId unit() const = 0;
+  // A unit's cache (its events are BoundaryEvent::cache), named in the lockstep's reports.
+  virtual bool cache() const { return false; }
+  virtual std::string name() const { return units::unit_name(unit()); }
   // Resets the RTL; the next cycle() is cycle 0.
   virtual void reset() = 0;
   // Clock cycle `cycle`: `inputs` are the model's events of that cycle on the unit's input ports

@@ -81,8 +81,12 @@ SamplePlan plan_sample(int packets, const SampleSpec& s) {
   // drawn in [0, K - U - W] (stratified sampling: one window per period). A window at the same
   // place of every period would see the same columns of the image whenever K is a multiple of a
   // row's packets, and miss an object standing in the others.
-  const int slack = s.period - s.warmup - s.window;
-  for (int i = 0; (i + 1) * static_cast<std::int64_t>(s.period) <= packets; ++i) {
+  // The last period also holds the frame's remainder (the bottom rows of tiles): left out, its
+  // packets would be estimated by the others' mean, a bias wherever they cost more or less.
+  const int periods = packets / s.period;
+  for (int i = 0; i < periods; ++i) {
+    const int size = i + 1 < periods ? s.period : packets - i * s.period;
+    const int slack = size - s.warmup - s.window;
     const int first = i * s.period + static_cast<int>(period_hash(static_cast<std::uint64_t>(i)) %
                                                       static_cast<std::uint64_t>(slack + 1));
     for (int k = first; k < first + s.warmup; ++k)
@@ -91,6 +95,7 @@ SamplePlan plan_sample(int packets, const SampleSpec& s) {
     for (int k = first + s.warmup; k < first + s.warmup + s.window; ++k)
       plan.order.push_back(k);
     plan.marks.push_back(static_cast<int>(plan.order.size()));
+    plan.strata.push_back(size);
     ++plan.windows;
   }
   return plan;
@@ -109,16 +114,19 @@ double student_t975(int df) {
          (3 * z7 + 19 * z5 + 17 * z3 - 15 * z) / (384 * n * n * n);
 }
 
-FigureEstimate estimate_cycles(const std::vector<double>& cpp, double packets,
+FigureEstimate estimate_cycles(const std::vector<double>& cpp, const std::vector<double>& strata,
                                double sampled_fraction) {
   FigureEstimate e;
   const auto n = static_cast<double>(cpp.size());
   if (cpp.empty()) return e;
-  double sum = 0;
-  for (double c : cpp)
-    sum += c;
+  if (strata.size() != cpp.size()) throw std::logic_error("estimate_cycles: one stratum a window");
+  double sum = 0, packets = 0;
+  for (std::size_t i = 0; i < cpp.size(); ++i) {
+    sum += cpp[i];
+    e.value += strata[i] * cpp[i];
+    packets += strata[i];
+  }
   const double mean = sum / n;
-  e.value = mean * packets;
   if (cpp.size() < 2) return e;
   double ss = 0;
   for (double c : cpp)
@@ -260,7 +268,8 @@ void estimate_frame(const units::CycleParams& p, const SamplePlan& plan, std::ui
     cpp.push_back(static_cast<double>(spans.back().cycle) / s.spec.window);
   }
   const double f = static_cast<double>(plan.windows) * s.spec.window / static_cast<double>(packets);
-  const FigureEstimate cycles = estimate_cycles(cpp, static_cast<double>(packets), f);
+  const FigureEstimate cycles =
+      estimate_cycles(cpp, std::vector<double>(plan.strata.begin(), plan.strata.end()), f);
   const double hz = p.clock_mhz * 1e6;
   // The frame's rays from the simulated packets' rays per packet (`rays` stays theirs, as the
   // per-ray counters beside it are).

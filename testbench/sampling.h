@@ -35,10 +35,13 @@ SampleSpec parse_sample_spec(const std::string& spec);
 std::string sample_spec_text(const SampleSpec& s);  // "window=128,period=3200,warmup=128"
 
 // The RGC's order of a sampled frame of `packets` packets and the hand-out counts at which the
-// chip's counts are read: marks[2i] begins window i, marks[2i+1] ends it.
+// chip's counts are read: marks[2i] begins window i, marks[2i+1] ends it. Window i stands for the
+// packets of its period, strata[i]: `period` each, the last period holding the frame's remainder
+// too (fewer than `period` packets), so that every packet is represented.
 struct SamplePlan {
   std::vector<int> order;
   std::vector<int> marks;
+  std::vector<int> strata;
   int windows = 0;
 };
 SamplePlan plan_sample(int packets, const SampleSpec& s);
@@ -76,10 +79,11 @@ struct FigureEstimate {
 };
 FigureEstimate estimate_figure(const std::vector<units::FigureCounts>& spans, int figure,
                                double clock_mhz, double sampled_fraction);
-// The cycles of a frame of `packets` packets from the windows' cycles per packet: mean x packets,
-// the interval from their sample variance.
-FigureEstimate estimate_cycles(const std::vector<double>& cycles_per_packet, double packets,
-                               double sampled_fraction);
+// The cycles of a frame from the windows' cycles per packet, window i standing for strata[i]
+// packets (SamplePlan::strata): the sum of strata[i] x cycles_per_packet[i]; the interval from
+// their sample variance.
+FigureEstimate estimate_cycles(const std::vector<double>& cycles_per_packet,
+                               const std::vector<double>& strata, double sampled_fraction);
 // Student's t quantile 0.975 for `df` degrees of freedom (>= 1).
 double student_t975(int df);
 

@@ -41,7 +41,7 @@ TEST(Sampling, BadSpecIsOneLineNamingIt) {
 }
 
 TEST(Sampling, PlanHoldsOneWarmupAndWindowPerPeriod) {
-  // 10,500 packets, periods of 1,000: ten whole periods (the last 500 packets hold none), each
+  // 10,500 packets, periods of 1,000: ten periods, the last holding the 500 left over too, each
   // with 5 warm-up and 10 window packets in a row inside the period.
   const SamplePlan p = plan_sample(10500, parse_sample_spec("window=10,period=1000,warmup=5"));
   EXPECT_EQ(p.windows, 10);
@@ -52,8 +52,10 @@ TEST(Sampling, PlanHoldsOneWarmupAndWindowPerPeriod) {
     EXPECT_EQ(p.marks[2 * w], 15 * i + 5);
     EXPECT_EQ(p.marks[2 * w + 1], 15 * i + 15);
     const int first = p.order[15 * w];
+    const int size = i < 9 ? 1000 : 1500;
+    EXPECT_EQ(p.strata[w], size);
     EXPECT_GE(first, 1000 * i);
-    EXPECT_LE(first + 15, 1000 * (i + 1));
+    EXPECT_LE(first + 15, 1000 * i + size);
     for (std::size_t k = 1; k < 15; ++k)
       EXPECT_EQ(p.order[15 * w + k], first + static_cast<int>(k));
   }
@@ -79,13 +81,16 @@ TEST(Sampling, CyclesEstimateByHand) {
   // Windows of 10, 12 and 14 cycles per packet, 100 packets: mean 12 -> 1,200 cycles; sample
   // standard deviation 2, standard error 2 / sqrt(3) = 1.1547, t(2) = 4.3027: half-width
   // 4.3027 * 1.1547 * 100 = 496.83.
-  const FigureEstimate e = estimate_cycles({10, 12, 14}, 100, 0.0);
+  const std::vector<double> thirds(3, 100.0 / 3);
+  const FigureEstimate e = estimate_cycles({10, 12, 14}, thirds, 0.0);
   EXPECT_DOUBLE_EQ(e.value, 1200.0);
   EXPECT_NEAR(e.ci.low, 1200.0 - 496.83, 0.01);
   EXPECT_NEAR(e.ci.high, 1200.0 + 496.83, 0.01);
   // Half the frame sampled: the finite-population correction sqrt(1 - 0.5) narrows it.
-  const FigureEstimate h = estimate_cycles({10, 12, 14}, 100, 0.5);
+  const FigureEstimate h = estimate_cycles({10, 12, 14}, thirds, 0.5);
   EXPECT_NEAR(h.ci.high - 1200.0, 496.83 * std::sqrt(0.5), 0.01);
+  // A window standing for more packets weighs more: 10 x 20 + 12 x 30 + 14 x 50 = 1,260.
+  EXPECT_DOUBLE_EQ(estimate_cycles({10, 12, 14}, {20, 30, 50}, 0.0).value, 1260.0);
 }
 
 TEST(Sampling, RatioFigureEstimateByHand) {

@@ -12,15 +12,16 @@ constexpr const char* kRequestFields[] = {"phase", "item", "mask"};
 }  // namespace
 
 const char* boundary_port_name(BoundaryPort p) {
-  constexpr const char* kNames[] = {"input",          "side_band",     "cache_request",
-                                    "cache_response", "cache_blocked", "output"};
+  constexpr const char* kNames[] = {"input",         "side_band", "cache_request", "cache_response",
+                                    "cache_blocked", "output",    "cache_accept",  "cache_reply",
+                                    "mem_request",   "mem_taken", "mem_fill"};
   return kNames[static_cast<int>(p)];
 }
 
 std::string format_boundary(const BoundaryEvent& e) {
   std::ostringstream s;
-  s << "cycle " << e.cycle << " dynrtp" << e.dynrtp << " " << unit_name(e.unit) << " "
-    << boundary_port_name(e.port) << " thread " << e.thread;
+  s << "cycle " << e.cycle << " dynrtp" << e.dynrtp << " " << unit_name(e.unit)
+    << (e.cache ? " cache " : " ") << boundary_port_name(e.port) << " thread " << e.thread;
   if (e.port == BoundaryPort::kInput) s << " from " << unit_name(e.path);
   if (e.port == BoundaryPort::kOutput) s << " to " << unit_name(e.path);
   for (int k = 0; k < e.fields; ++k) {

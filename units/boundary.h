@@ -28,7 +28,16 @@ enum class BoundaryPort : std::uint8_t {
   kCacheResponse,  // the unit took a cache response (item address, the words)
   kCacheBlocked,   // the unit had a request to send and the cache's request queue was full
   kOutput,         // a thread left the unit on a path (or retired)
+  // The ports of a unit's cache (its own record, BoundaryEvent::cache; units/boundary_cache.h).
+  // The cache's inputs are kCacheRequest (the unit's push), kMemTaken and kMemFill; its outputs
+  // kCacheAccept, kCacheReply and kMemRequest.
+  kCacheAccept,  // the lookup took a request from the queue: hit, merge or miss, and the MSHR
+  kCacheReply,   // a response reached the unit (the cycle the unit takes it)
+  kMemRequest,   // a line request pushed towards the routing (a miss)
+  kMemTaken,     // the routing took the cache's oldest line request
+  kMemFill,      // the routing pushed a fill, labelled with its MSHR
 };
+inline constexpr int kBoundaryPorts = 11;
 const char* boundary_port_name(BoundaryPort p);
 
 inline constexpr int kBoundaryFields = 8;
@@ -41,7 +50,8 @@ inline constexpr const char* kCacheResponseFields[] = {"address", "word0", "word
 struct BoundaryEvent {
   std::uint64_t cycle = 0;
   int dynrtp = 0;
-  UnitId unit = UnitId::kNone;
+  UnitId unit = UnitId::kNone;  // (a cache's event: the unit the cache serves)
+  bool cache = false;           // an event of the unit's cache, not of the unit
   BoundaryPort port = BoundaryPort::kInput;
   std::uint32_t thread = 0;
   // Input: the sending unit; output: the unit the thread's next request names (kNone: retired).
