@@ -154,7 +154,7 @@ struct Simulation {
   Seen seen;
   std::vector<ChipFrame> frames;
   std::string last_error;
-  sc_core::sc_time cycle_90;  // 90 cycles at the chip's clock
+  sc_core::sc_time cycle_1, cycle_90;  // 1 and 90 cycles at the chip's clock
 };
 
 // The platform, once per process (SystemC elaborates once).
@@ -169,6 +169,7 @@ const Simulation& simulation() {
     sim.seen = script.seen;
     sim.frames = chip.frames();
     sim.last_error = chip.last_error();
+    sim.cycle_1 = chip.cycles_time(1);
     sim.cycle_90 = chip.cycles_time(90);
     return sim;
   }();
@@ -239,7 +240,9 @@ TEST(ChipTlm, FrameEqualsTheCycleModelOnTheSameImageAtTheModelledTime) {
   for (std::size_t i = 0; i < s.frame_buffer.size(); ++i)
     for (std::size_t k = 0; k < 3; ++k)
       ASSERT_EQ((s.frame_buffer[i] >> (8 * k)) & 255u, direct.frame.rgb[3 * i + k]) << i;
-  // Times at 90 MHz: 90 cycles are 1 us; the load then the frame, each rounded to 1 ps.
+  // Times at 90 MHz: a cycle is 1e6 / 90 = 11,111.1 ps, rounded to the 1 ps resolution 11,111 ps;
+  // 90 cycles are 1 us. The load, then the frame, each rounded so.
+  EXPECT_EQ(sim.cycle_1.value(), 11111u);
   EXPECT_EQ(sim.cycle_90, sc_core::sc_time(1, sc_core::SC_US));
   const auto ps = [](std::uint64_t cycles) {
     return static_cast<sc_dt::uint64>(std::llround(static_cast<double>(cycles) * 1e6 / 90.0));
