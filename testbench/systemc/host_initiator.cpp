@@ -37,6 +37,12 @@ void store_runs(memif::MemoryImage& image, const std::vector<memif::UploadRun>& 
 HostInitiator::HostInitiator(sc_core::sc_module_name name, PlatformSpec spec,
                              const sc_core::sc_event& frame_end)
     : sc_core::sc_module(name), socket("socket"), spec_(std::move(spec)), frame_end_(frame_end) {
+  // The scene is loaded and its image built before the simulation starts, so a bad scene is an
+  // error of the platform's elaboration, not of a running process.
+  RenderSettings s = spec_.settings;
+  s.time = spec_.start;
+  s.top_level_buffers = 2;  // the next frame's top level goes into the copy in flight's twin
+  prep_ = prepare_scene(spec_.scene, s, ff::kFp24);
   SC_HAS_PROCESS(HostInitiator);
   SC_THREAD(run);
 }
@@ -155,10 +161,7 @@ HostFrame HostInitiator::prepare(PreparedScene& prep, const memif::MemoryImage& 
 }
 
 void HostInitiator::sequence() {
-  RenderSettings s = spec_.settings;
-  s.time = spec_.start;
-  s.top_level_buffers = 2;  // the next frame's top level goes into the copy in flight's twin
-  PreparedScene prep = prepare_scene(spec_.scene, s, ff::kFp24);
+  PreparedScene& prep = prep_;
   const memif::FrameRegisters& regs = prep.built.image.registers();
   const int width = static_cast<int>(regs.width), height = static_cast<int>(regs.height);
   const double dt = spec_.dt >= 0 ? spec_.dt : prep.scene.animation_seconds / spec_.frames;

@@ -48,7 +48,8 @@ class HostInitiator : public sc_core::sc_module {
  public:
   tlm_utils::simple_initiator_socket<HostInitiator> socket;
 
-  // `frame_end`: the chip's frame-end event.
+  // `frame_end`: the chip's frame-end event. Loads the scene and builds its image; throws
+  // std::runtime_error (one line) for a bad scene or settings.
   HostInitiator(sc_core::sc_module_name name, PlatformSpec spec,
                 const sc_core::sc_event& frame_end);
 
@@ -73,6 +74,7 @@ class HostInitiator : public sc_core::sc_module {
                     std::vector<memif::UploadRun>& runs);
 
   PlatformSpec spec_;
+  PreparedScene prep_;
   const sc_core::sc_event& frame_end_;
   std::vector<HostFrame> frames_;
   std::string error_;
