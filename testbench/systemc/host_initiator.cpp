@@ -41,7 +41,8 @@ HostInitiator::HostInitiator(sc_core::sc_module_name name, PlatformSpec spec,
   // error of the platform's elaboration, not of a running process.
   RenderSettings s = spec_.settings;
   s.time = spec_.start;
-  s.top_level_buffers = 2;  // the next frame's top level goes into the copy in flight's twin
+  // Two copies: the next frame's top level goes into the copy in flight's twin.
+  s.top_level_buffers = spec_.frame_gap ? 1 : 2;
   prep_ = prepare_scene(spec_.scene, s, ff::kFp24);
   SC_HAS_PROCESS(HostInitiator);
   SC_THREAD(run);

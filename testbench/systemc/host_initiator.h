@@ -26,6 +26,8 @@ struct PlatformSpec {
   int frames = 2;
   double start = 0.0;  // the first frame's animation time
   double dt = -1.0;    // seconds between frames; < 0: the animation's length / frames
+  // One top-level copy: every upload waits for the frame in flight to end (render --frame-gap).
+  bool frame_gap = false;
 };
 
 // One frame as the host saw it over the socket.

@@ -3,8 +3,8 @@
 // scene and renders the frames of its animation as `saarcor render SCENE --model cycle --frames N`
 // does, and the platform writes each frame's image and its figures and SystemC times.
 //
-//   saarcor-vp [SCENE] [--frames N] [--res WxH] [--time T] [--dt S] [--shadows] [--depth N]
-//              [--preset P] [--set KEY=VALUE ...] [--out-dir DIR]
+//   saarcor-vp [SCENE] [--frames N] [--res WxH] [--time T] [--dt S] [--frame-gap] [--shadows]
+//              [--depth N] [--preset P] [--set KEY=VALUE ...] [--out-dir DIR]
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -61,6 +61,8 @@ Options parse(int argc, char** argv) {
       o.spec.start = number(a, value());
     } else if (a == "--dt") {
       o.spec.dt = number(a, value());
+    } else if (a == "--frame-gap") {
+      o.spec.frame_gap = true;
     } else if (a == "--shadows") {
       o.spec.settings.shadows = true;
     } else if (a == "--depth") {
@@ -74,8 +76,8 @@ Options parse(int argc, char** argv) {
     } else if (a.starts_with("-") || scene_given) {
       throw std::runtime_error(
           "unknown argument '" + a + "' (saarcor-vp [SCENE] [--frames N] " +
-          "[--res WxH] [--time T] [--dt S] [--shadows] [--depth N] [--preset P] " + "[--set K=V] " +
-          "[--out-dir DIR])");
+          "[--res WxH] [--time T] [--dt S] [--frame-gap] [--shadows] [--depth N] " +
+          "[--preset P] " + "[--set K=V] " + "[--out-dir DIR])");
     } else {
       o.spec.scene = a;
       scene_given = true;

@@ -21,9 +21,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
+fs::path scratch_path(const std::string& tag) {
+  return fs::temp_directory_path() / ("saarcor_vp_" + tag + "_" + std::to_string(getpid()));
+}
+
 fs::path scratch(const std::string& tag) {
-  const fs::path d =
-      fs::temp_directory_path() / ("saarcor_vp_" + tag + "_" + std::to_string(getpid()));
+  const fs::path d = scratch_path(tag);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -66,18 +69,18 @@ std::uint64_t ps(std::uint64_t cycles) {
   return static_cast<std::uint64_t>(std::llround(static_cast<double>(cycles) * 1e6 / 90.0));
 }
 
-TEST(VirtualPlatform, TwoFramesEqualRenderFramesTwoAtTheModelledTime) {
-  const fs::path d = scratch("frames");
-  const std::string scene = "builtin:dynamic --res 64x48 --frames 2";
+// `saarcor render ARGS --model cycle` and `saarcor-vp ARGS`, frame by frame.
+void expect_same_frames(const std::string& tag, const std::string& args, std::size_t frames) {
+  const fs::path d = scratch(tag);
   const CliRun r =
-      run("saarcor", "render " + scene + " --model cycle --out-dir " + (d / "render").string(), d);
+      run("saarcor", "render " + args + " --model cycle --out-dir " + (d / "render").string(), d);
   ASSERT_EQ(r.status, 0) << r.err;
-  const CliRun v = run("saarcor-vp", scene + " --out-dir " + (d / "vp").string(), d);
+  const CliRun v = run("saarcor-vp", args + " --out-dir " + (d / "vp").string(), d);
   ASSERT_EQ(v.status, 0) << v.err;
   const nlohmann::json render = nlohmann::json::parse(slurp(d / "render" / "report.json"));
   const nlohmann::json vp = nlohmann::json::parse(slurp(d / "vp" / "platform.json"));
-  ASSERT_EQ(render["per_frame"].size(), 2u);
-  ASSERT_EQ(vp["frames"].size(), 2u);
+  ASSERT_EQ(render["per_frame"].size(), frames);
+  ASSERT_EQ(vp["frames"].size(), frames);
   EXPECT_EQ(vp["clock_mhz"].get<double>(), 90.0);
   EXPECT_EQ(vp["initial_load"]["bytes"], render["initial_load"]["bytes"]);
   EXPECT_EQ(vp["initial_load"]["cycles"], render["initial_load"]["cycles"]);
@@ -85,7 +88,7 @@ TEST(VirtualPlatform, TwoFramesEqualRenderFramesTwoAtTheModelledTime) {
   // Frame 0 begins once the initial load is stored: START at 0 + its cycles at the clock.
   EXPECT_EQ(start0, vp["frames"][0]["start_written_ps"].get<std::uint64_t>() +
                         ps(render["initial_load"]["cycles"].get<std::uint64_t>()));
-  for (int k = 0; k < 2; ++k) {
+  for (std::size_t k = 0; k < frames; ++k) {
     SCOPED_TRACE("frame " + std::to_string(k));
     const nlohmann::json& a = render["per_frame"][k];
     const nlohmann::json& b = vp["frames"][k];
@@ -103,17 +106,37 @@ TEST(VirtualPlatform, TwoFramesEqualRenderFramesTwoAtTheModelledTime) {
     EXPECT_EQ(b["end_seen_ps"].get<std::uint64_t>(), end);
     EXPECT_EQ(start - start0, ps(a["start_cycle"].get<std::uint64_t>()));
     char name[32];
-    std::snprintf(name, sizeof name, "frame_%04d.png", k);
+    std::snprintf(name, sizeof name, "frame_%04zu.png", k);
     EXPECT_EQ(slurp(d / "vp" / name), slurp(d / "render" / name));  // the file, byte for byte
     const Rgb8Image ri = read_rgb8((d / "render" / name).string());
     const Rgb8Image vi = read_rgb8((d / "vp" / name).string());
     EXPECT_EQ(vi.rgb, ri.rgb);
     EXPECT_EQ(pixel_hash(vi), pixel_hash(ri));
   }
+}
+
+TEST(VirtualPlatform, TwoFramesEqualRenderFramesTwoAtTheModelledTime) {
+  expect_same_frames("frames", "builtin:dynamic --res 64x48 --frames 2", 2);
   // Frame 1's upload (16 instances moved) went beside frame 0 and was stored before its end.
+  const nlohmann::json vp =
+      nlohmann::json::parse(slurp(scratch_path("frames") / "vp" / "platform.json"));
+  EXPECT_FALSE(vp["frames"][1]["upload_in_gap"].get<bool>());
   EXPECT_GT(vp["frames"][1]["upload_bytes"].get<std::uint64_t>(), 0u);
   EXPECT_LT(vp["frames"][1]["upload_cycles"].get<std::uint64_t>(),
             vp["frames"][0]["cycles"].get<std::uint64_t>());
+}
+
+// One top-level copy: every upload waits for the frame's end and is stored before the next
+// START's frame begins (render --frame-gap's timeline).
+TEST(VirtualPlatform, FrameGapUploadsEqualRenderFrameGap) {
+  expect_same_frames("gap", "builtin:dynamic --res 32x24 --frames 3 --frame-gap", 3);
+  const nlohmann::json vp =
+      nlohmann::json::parse(slurp(scratch_path("gap") / "vp" / "platform.json"));
+  EXPECT_TRUE(vp["frames"][1]["upload_in_gap"].get<bool>());
+  // In a gap the upload takes the frame before and then its own time alone (LOAD cycles).
+  EXPECT_EQ(vp["frames"][1]["upload_cycles"].get<std::uint64_t>(),
+            vp["frames"][0]["cycles"].get<std::uint64_t>() +
+                vp["frames"][1]["load_cycles"].get<std::uint64_t>());
 }
 
 TEST(VirtualPlatform, BadInputIsOneLineAndExitOne) {
