@@ -9,6 +9,7 @@ packages=(
   libopenimageio-dev openimageio-tools libopencv-core-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
   libmpfr-dev libembree-dev
+  libsystemc-dev
   verilator yosys
   python3-matplotlib libopenmpi-dev openmpi-bin
   clang libclang-rt-14-dev llvm

@@ -485,4 +485,19 @@ CycleFrame run_cycle(memif::MemoryImage& image, const CycleParams& params,
   return run_cycle_image(image, params, options, &upload);
 }
 
+std::uint64_t run_upload(memif::MemoryImage& image, const CycleParams& params,
+                         memif::HostUpload upload) {
+  upload.frame_reads.clear();  // no frame in flight
+  hw::KernelConfig kc;
+  // A slow bus may wait longer than the watchdog's span for its next burst's credit.
+  const double burst_cycles =
+      4.0 * params.hostbus_burst_words * params.clock_mhz * 1e6 / (params.hostbus_mb_s * 1048576.0);
+  kc.watchdog_cycles =
+      std::max<std::uint64_t>(params.watchdog, static_cast<std::uint64_t>(2.0 * burst_cycles) + 16);
+  hw::Kernel k(kc);
+  memif::MemorySystem mi(k, image, memory_system_config(params));
+  mi.host().upload(upload);
+  return k.run_to_completion([&] { return mi.host().stored(); });
+}
+
 }  // namespace saarcor

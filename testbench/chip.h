@@ -118,4 +118,10 @@ CycleFrame run_cycle(const memif::MemoryImage& image, const units::CycleParams& 
 CycleFrame run_cycle(memif::MemoryImage& image, const units::CycleParams& params,
                      const CycleRunOptions& options, const memif::HostUpload& upload);
 
+// An upload with nothing rendering (a sequence's initial load, an upload in a frame gap): the
+// chip's memory system with only its host bus busy, the words stored into `image`. Returns the
+// cycles until the last word is stored (upload.frame_reads is ignored: no frame is in flight).
+std::uint64_t run_upload(memif::MemoryImage& image, const units::CycleParams& params,
+                         memif::HostUpload upload);
+
 }  // namespace saarcor

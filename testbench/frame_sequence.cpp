@@ -15,9 +15,7 @@
 
 #include "host/frame_upload.h"
 #include "host/tree_settings.h"
-#include "hw/kernel.h"
 #include "hw/stats.h"
-#include "memif/memory_system.h"
 #include "testbench/chip.h"
 #include "testbench/heartbeat.h"
 #include "testbench/report.h"
@@ -100,22 +98,6 @@ memif::HostUpload initial_load(const host::BuiltImage& b) {
   }
   u.register_words = kRegisterWords;
   return u;
-}
-
-// An upload with nothing rendering (the initial load, a frame gap): the cycle model's memory
-// system with only its host bus busy. Returns the cycles until its last word is stored.
-std::uint64_t upload_alone(memif::MemoryImage& board, const units::CycleParams& p,
-                           memif::HostUpload u) {
-  u.frame_reads.clear();  // no frame in flight
-  hw::KernelConfig kc;
-  const double burst_cycles =
-      4.0 * p.hostbus_burst_words * p.clock_mhz * 1e6 / (p.hostbus_mb_s * 1048576.0);
-  kc.watchdog_cycles =
-      std::max<std::uint64_t>(p.watchdog, static_cast<std::uint64_t>(2.0 * burst_cycles) + 16);
-  hw::Kernel k(kc);
-  memif::MemorySystem mi(k, board, units::memory_system_config(p));
-  mi.host().upload(u);
-  return k.run_to_completion([&] { return mi.host().stored(); });
 }
 
 void apply_runs(memif::MemoryImage& board, const std::vector<memif::UploadRun>& runs) {
@@ -317,7 +299,7 @@ void initial_upload(memif::MemoryImage& board, const host::BuiltImage& host,
   r.initial_load_bytes = load.bytes();
   if (cycle) {
     progress("uploading the scene over the host bus (" + std::to_string(load.bytes()) + " bytes)");
-    r.initial_load_cycles = upload_alone(board, cp, load);
+    r.initial_load_cycles = run_upload(board, cp, load);
   } else {
     apply_runs(board, load.runs);
   }
@@ -351,7 +333,7 @@ void run_frame(SequenceRun& run, int k, SequenceFrame& cur, SequenceResult& r) {
     const CycleRunOptions ro = cycle_run_options(run.s, run.beat, k, opts.frames);
     CycleFrame c = more && !next.row.gap ? run_cycle(board, run.cp, ro, next.upload)
                                          : run_cycle(std::as_const(board), run.cp, ro);
-    if (more && next.row.gap) gap_cycles = upload_alone(board, run.cp, next.upload);
+    if (more && next.row.gap) gap_cycles = run_upload(board, run.cp, next.upload);
     next.row.upload_cycles = c.upload_cycles;
     take_figures(cur, c);
     if (opts.check) {
