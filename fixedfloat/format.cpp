@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 namespace saarcor::ff {
 namespace {
@@ -14,6 +15,26 @@ int sign_of(double x) {
 }
 
 }  // namespace
+
+Mode parse_mode(const std::string& round, const std::string& subnormals) {
+  Mode m;
+  if (round == "rne") {
+    m.rounding = Rounding::kNearestEven;
+  } else if (round == "rtz") {
+    m.rounding = Rounding::kTowardZero;
+  } else {
+    throw std::runtime_error("unknown rounding mode '" + round + "' (expected rne or rtz)");
+  }
+  if (subnormals == "flush") {
+    m.subnormals = Subnormals::kFlush;
+  } else if (subnormals == "keep") {
+    m.subnormals = Subnormals::kKeep;
+  } else {
+    throw std::runtime_error("unknown subnormal mode '" + subnormals +
+                             "' (expected flush or keep)");
+  }
+  return m;
+}
 
 bool parse_format(const std::string& text, Format* out) {
   Format f;

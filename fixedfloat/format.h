@@ -68,6 +68,9 @@ inline constexpr Format kFp32{8, 23};
 // Parses "e7m16" (also "fp24", "fp32"). Returns false on anything else or an unsupported format.
 bool parse_format(const std::string& text, Format* out);
 std::string format_name(const Format& f);  // "e7m16"
+// The modes by name, as `saarcor float-calc` and the DPI-C reference take them: rounding "rne" or
+// "rtz", subnormals "flush" or "keep". Throws std::runtime_error (one line) on anything else.
+Mode parse_mode(const std::string& round, const std::string& subnormals);
 
 // --- the core: every op ends here ------------------------------------------------------------
 

@@ -22,13 +22,19 @@ namespace {
 using units::BoundaryEvent;
 using units::BoundaryPort;
 
-TEST(TransformationLockstep, NPlusOneOffIsCaughtAtTheFirstSharedOriginPacket) {
-  SAARCOR_REQUIRE_VARIANT_BUILDS();
+// The transformation unit alone on the room at 24x18.
+LockstepOptions room_transformation() {
   LockstepOptions o;
   o.units = {"transformation"};
   o.scene = "builtin:room";
   o.width = 24;
   o.height = 18;
+  return o;
+}
+
+TEST(TransformationLockstep, NPlusOneOffIsCaughtAtTheFirstSharedOriginPacket) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
+  LockstepOptions o = room_transformation();
   std::uint64_t first = 0;
   bool shared = false;
   o.model_events = [&](const BoundaryEvent& e) {
@@ -56,11 +62,7 @@ TEST(TransformationLockstep, NPlusOneOffIsCaughtAtTheFirstSharedOriginPacket) {
 
 TEST(TransformationLockstep, RowOutOfOrderIsCaughtAtTheFirstEntrysSecondRow) {
   SAARCOR_REQUIRE_VARIANT_BUILDS();
-  LockstepOptions o;
-  o.units = {"transformation"};
-  o.scene = "builtin:room";
-  o.width = 24;
-  o.height = 18;
+  LockstepOptions o = room_transformation();
   int requests = 0;
   std::uint64_t second = 0, address = 0;
   o.model_events = [&](const BoundaryEvent& e) {

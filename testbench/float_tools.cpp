@@ -61,26 +61,6 @@ Format parse_format_or_throw(const std::string& text) {
   return f;
 }
 
-Mode parse_mode_or_throw(const std::string& round, const std::string& subnormals) {
-  Mode m;
-  if (round == "rne") {
-    m.rounding = ff::Rounding::kNearestEven;
-  } else if (round == "rtz") {
-    m.rounding = ff::Rounding::kTowardZero;
-  } else {
-    throw std::runtime_error("unknown rounding mode '" + round + "' (expected rne or rtz)");
-  }
-  if (subnormals == "flush") {
-    m.subnormals = ff::Subnormals::kFlush;
-  } else if (subnormals == "keep") {
-    m.subnormals = ff::Subnormals::kKeep;
-  } else {
-    throw std::runtime_error("unknown subnormal mode '" + subnormals +
-                             "' (expected flush or keep)");
-  }
-  return m;
-}
-
 std::uint32_t eval(Op op, std::uint32_t a, std::uint32_t b, const Format& f, const Mode& m) {
   switch (op) {
     case Op::kAdd:
@@ -340,7 +320,7 @@ void float_info(const FloatInfoOptions& opts, std::ostream& out) {
   if (!opts.value.empty()) {
     out << "value            " << opts.value << " rounded into " << ff::format_name(f) << ":\n";
     for (const char* rnd : {"rne", "rtz"}) {
-      const Mode m = parse_mode_or_throw(rnd, "keep");
+      const Mode m = ff::parse_mode(rnd, "keep");
       double nearest = 0.0;
       const std::uint32_t bits = round_text(opts.value, f, m, &nearest);
       out << "value (" << rnd << ")      " << value_line(bits, f);
@@ -352,7 +332,7 @@ void float_info(const FloatInfoOptions& opts, std::ostream& out) {
 
 std::uint64_t float_calc(const FloatCalcOptions& opts, std::istream& in, std::ostream& out) {
   const Format f = parse_format_or_throw(opts.format);
-  const Mode m = parse_mode_or_throw(opts.round, opts.subnormals);
+  const Mode m = ff::parse_mode(opts.round, opts.subnormals);
   const int digits = hex_digits(f);
   std::string line;
   std::string buffer;
@@ -411,7 +391,7 @@ void float_gen(const FloatGenOptions& opts, std::ostream& out) {
                              "' (expected add sub mul div sqrt lt le eq min max)");
   }
   const Format f = parse_format_or_throw(opts.format);
-  const Mode m = parse_mode_or_throw(opts.round, opts.subnormals);
+  const Mode m = ff::parse_mode(opts.round, opts.subnormals);
   std::mt19937_64 rng(opts.seed);
   const std::vector<std::uint32_t> edges = edge_operands(f);
   const bool unary = is_unary(op);

@@ -35,8 +35,6 @@ T& out(T* p, const char* name) {
   return *p;
 }
 
-// "rne" | "rtz" and "flush" | "keep", as saarcor float-calc takes them.
-ff::Mode parse_mode(const char* round, const char* subnormals);
 // An encoding that must fit `f`'s bits.
 std::uint32_t operand(unsigned int bits, const ff::Format& f, const char* name);
 

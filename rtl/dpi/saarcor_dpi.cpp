@@ -28,6 +28,11 @@ std::string text(const char* s) {
   return s == nullptr ? std::string("(null)") : std::string(s);
 }
 
+// The modes by name (fixedfloat's parse_mode, as saarcor float-calc takes them).
+ff::Mode mode(const char* round, const char* subnormals) {
+  return ff::parse_mode(text(round), text(subnormals));
+}
+
 ff::Format format(int exp_bits, int man_bits) {
   const ff::Format f{exp_bits, man_bits};
   if (!f.valid())
@@ -62,26 +67,6 @@ void set_last_error(const std::string& message) {
   last_error() = message;
 }
 
-ff::Mode parse_mode(const char* round, const char* subnormals) {
-  ff::Mode m;
-  const std::string r = text(round), s = text(subnormals);
-  if (r == "rne") {
-    m.rounding = ff::Rounding::kNearestEven;
-  } else if (r == "rtz") {
-    m.rounding = ff::Rounding::kTowardZero;
-  } else {
-    throw std::invalid_argument("unknown rounding mode '" + r + "' (expected rne or rtz)");
-  }
-  if (s == "flush") {
-    m.subnormals = ff::Subnormals::kFlush;
-  } else if (s == "keep") {
-    m.subnormals = ff::Subnormals::kKeep;
-  } else {
-    throw std::invalid_argument("unknown subnormal mode '" + s + "' (expected flush or keep)");
-  }
-  return m;
-}
-
 std::uint32_t operand(unsigned int bits, const ff::Format& f, const char* name) {
   if ((bits & ~f.bits_mask()) != 0) {
     char hex[16];
@@ -113,7 +98,7 @@ extern "C" int saarcor_dpi_fp_op(const char* op, int exp_bits, int man_bits, con
                                  unsigned int* result) {
   return guarded("saarcor_dpi_fp_op", [&] {
     const ff::Format f = saarcor::dpi::format(exp_bits, man_bits);
-    const ff::Mode m = saarcor::dpi::parse_mode(round, subnormals);
+    const ff::Mode m = saarcor::dpi::mode(round, subnormals);
     const std::uint32_t x = saarcor::dpi::operand(a, f, "a");
     const std::uint32_t y = saarcor::dpi::operand(b, f, "b");
     const std::uint32_t r = saarcor::dpi::binary_op(saarcor::dpi::text(op), x, y, f, m);
@@ -125,7 +110,7 @@ extern "C" int saarcor_dpi_fp_from_real(double value, int exp_bits, int man_bits
                                         const char* subnormals, unsigned int* bits) {
   return guarded("saarcor_dpi_fp_from_real", [&] {
     const ff::Format f = saarcor::dpi::format(exp_bits, man_bits);
-    const ff::Mode m = saarcor::dpi::parse_mode(round, subnormals);
+    const ff::Mode m = saarcor::dpi::mode(round, subnormals);
     out(bits, "bits") = ff::from_double(value, f, m);
   });
 }
@@ -134,7 +119,7 @@ extern "C" int saarcor_dpi_fp_to_real(unsigned int bits, int exp_bits, int man_b
                                       const char* subnormals, double* value) {
   return guarded("saarcor_dpi_fp_to_real", [&] {
     const ff::Format f = saarcor::dpi::format(exp_bits, man_bits);
-    const ff::Mode m = saarcor::dpi::parse_mode("rne", subnormals);
+    const ff::Mode m = saarcor::dpi::mode("rne", subnormals);
     out(value, "value") = ff::decode(saarcor::dpi::operand(bits, f, "bits"), f, m.subnormals);
   });
 }
@@ -145,7 +130,7 @@ extern "C" int saarcor_dpi_traversal_lane(const char* round, const char* subnorm
                                           int* go_near, int* go_far, unsigned int* near_tf,
                                           unsigned int* far_tn) {
   return guarded("saarcor_dpi_traversal_lane", [&] {
-    const units::UnitFp<ff::fp24> fp(saarcor::dpi::parse_mode(round, subnormals));
+    const units::UnitFp<ff::fp24> fp(saarcor::dpi::mode(round, subnormals));
     const units::TraversalLane<ff::fp24> r =
         units::traversal_lane(fp, fp24(split, "split"), fp24(o_axis, "o_axis"),
                               fp24(d_axis, "d_axis"), fp24(tn, "tn"), fp24(tf, "tf"));
@@ -165,7 +150,7 @@ extern "C" int saarcor_dpi_transform_step(const char* round, const char* subnorm
                                           int translate, unsigned int* rx, unsigned int* ry,
                                           unsigned int* rz) {
   return guarded("saarcor_dpi_transform_step", [&] {
-    const units::UnitFp<ff::fp24> fp(saarcor::dpi::parse_mode(round, subnormals));
+    const units::UnitFp<ff::fp24> fp(saarcor::dpi::mode(round, subnormals));
     const units::Mat34<ff::fp24> m{
         {{fp24(m00, "m00"), fp24(m01, "m01"), fp24(m02, "m02"), fp24(t0, "t0")},
          {fp24(m10, "m10"), fp24(m11, "m11"), fp24(m12, "m12"), fp24(t1, "t1")},
@@ -187,7 +172,7 @@ extern "C" int saarcor_dpi_intersect(const char* round, const char* subnormals, 
                                      unsigned int* t, unsigned int* u, unsigned int* v,
                                      unsigned int* c, int* inside, int* accept) {
   return guarded("saarcor_dpi_intersect", [&] {
-    const units::UnitFp<ff::fp24> fp(saarcor::dpi::parse_mode(round, subnormals));
+    const units::UnitFp<ff::fp24> fp(saarcor::dpi::mode(round, subnormals));
     const units::Ray<ff::fp24> ray{{fp24(ox, "ox"), fp24(oy, "oy"), fp24(oz, "oz")},
                                    {fp24(dx, "dx"), fp24(dy, "dy"), fp24(dz, "dz")}};
     units::HitRecord<ff::fp24> best;
