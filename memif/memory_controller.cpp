@@ -403,8 +403,10 @@ int MemoryController::retire_responses() {
     }
     if (best < 0) break;
     Bank& bank = banks_[static_cast<std::size_t>(best)];
-    ports_[static_cast<std::size_t>(bank.inflight.front().port)]->responses.push_slot() =
-        bank.inflight.front().resp;
+    Port& port = *ports_[static_cast<std::size_t>(bank.inflight.front().port)];
+    port.responses.push_slot() = bank.inflight.front().resp;
+    if (port.observer != nullptr) [[unlikely]]
+      port.observer->responded(now(), bank.inflight.front().resp);
     bank.inflight.pop_front();
     if (bank.inflight.empty()) {
       inflight_ &= ~(1u << best);

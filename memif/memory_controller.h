@@ -40,6 +40,14 @@
 
 namespace saarcor::memif {
 
+// What a traced run observes of a port (the lockstep's memory boundary, units/boundary_cache.h):
+// a response pushed into the port's response channel. Null in a run that traces nothing.
+class PortObserver {
+ public:
+  virtual ~PortObserver() = default;
+  virtual void responded(std::uint64_t cycle, const MemResponse& r) = 0;
+};
+
 class MemoryController : public hw::Module {
  public:
   class Lane;
@@ -50,6 +58,7 @@ class MemoryController : public hw::Module {
     // Set while the port is served as a lane (add_lane): its client uses the lane's calls instead
     // of the two channels.
     Lane* lane = nullptr;
+    PortObserver* observer = nullptr;  // every response pushed (null: none)
     Port(hw::Kernel& k, const std::string& n, int capacity, int response_width = 1)
         : name(n),
           requests(k, n + ".req", capacity, 1),

@@ -39,6 +39,9 @@ MemorySystem::MemorySystem(hw::Kernel& kernel, MemoryImage& image, const MemoryS
       const auto type = static_cast<ItemType>(t);
       const std::string name = prefix + item_type_name(type) + "_cache";
       const std::uint16_t client = controller_->add_client(name);
+      if (client != cache_client(p, type))
+        throw std::logic_error("memory system: " + name + " is client " + std::to_string(client) +
+                               ", not " + std::to_string(cache_client(p, type)));
       pipe.caches[t] = std::make_unique<Cache>(kernel, name, type, image, client, *cfg[t]);
       routing_->add_client(client, pipe.caches[t]->memory_requests(), pipe.caches[t]->fills());
     }

@@ -32,6 +32,12 @@ class MemorySystem {
   MemorySystem(hw::Kernel& kernel, MemoryImage& image, const MemorySystemConfig& config = {});
 
   Cache& cache(int pipeline, ItemType type);
+  // The controller client id of a pipeline's cache: each pipeline adds its three caches, its
+  // shading and its frame client in that order (the routing's labels; an RTL routing is
+  // configured with them).
+  static std::uint16_t cache_client(int pipeline, ItemType type) {
+    return static_cast<std::uint16_t>(pipeline * (kItemTypes + 2) + static_cast<int>(type));
+  }
   MemoryController::Port& shading_port(int pipeline);
   MemoryController::Port& frame_port(int pipeline);
   std::uint16_t shading_client(int pipeline) const;

@@ -70,6 +70,8 @@ int SimpleRouting::arbitrate() {
     hw::Channel<MemRequest>& in = *clients_[static_cast<std::size_t>(c)].requests;
     if (!in.can_pop()) continue;
     if (!port_.requests.can_push()) {
+      if (observer_ != nullptr) [[unlikely]]
+        observer_->blocked(now());
       stall();
       return 0;
     }

@@ -29,6 +29,8 @@ class RoutingObserver {
   virtual ~RoutingObserver() = default;
   virtual void forwarded(std::uint64_t cycle, const MemRequest& r) = 0;  // r.client set
   virtual void delivered(std::uint64_t cycle, const MemResponse& r) = 0;
+  // A client had a request and the controller port's request channel was full.
+  virtual void blocked(std::uint64_t /*cycle*/) {}
 };
 
 class SimpleRouting : public hw::Module {
@@ -46,6 +48,7 @@ class SimpleRouting : public hw::Module {
 
   // Every forwarded request and delivered response reports to `o` (null: none, the default).
   void set_observer(RoutingObserver* o) { observer_ = o; }
+  MemoryController::Port& port() { return port_; }
 
   int evaluate() override;
   void commit() override { rr_.commit(); }

@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
+#include "rtl/unit_ports.h"
 #include "rtl/verilated_top.h"
 #include "rtl_cache_builds.h"
 #include "units/boundary_cache.h"
@@ -100,28 +101,7 @@ class CacheUnitRtl final : public UnitRtl {
   void cycle(std::uint64_t cycle, const std::vector<units::BoundaryEvent>& inputs,
              std::vector<units::BoundaryEvent>& outputs) override {
     const CacheOutputs out = rtl_->cycle(take(inputs));
-    using units::BoundaryPort;
-    const auto add = [&](BoundaryPort port, std::uint32_t thread, int fields,
-                         const char* const* names) -> units::BoundaryEvent& {
-      units::BoundaryEvent& e = add_event(outputs, cycle, unit_, port, thread);
-      e.cache = true;
-      e.fields = fields;
-      e.names = names;
-      return e;
-    };
-    if (out.accept)
-      add(BoundaryPort::kCacheAccept, out.acc_tag, 5, units::kCacheAcceptFields).field = {
-          out.acc_index, out.acc_requester, out.acc_tag, out.acc_kind, out.acc_mshr};
-    if (out.resp) {
-      units::BoundaryEvent& e =
-          add(BoundaryPort::kCacheReply, out.resp_tag, 3 + config_.words, units::kCacheReplyFields);
-      e.field = {out.resp_index, out.resp_requester, out.resp_tag};
-      for (int k = 0; k < config_.words; ++k)
-        e.field[3 + static_cast<std::size_t>(k)] = out.resp_words[static_cast<std::size_t>(k)];
-    }
-    if (out.mreq)
-      add(BoundaryPort::kMemRequest, 0, 4, units::kMemRequestFields).field = {
-          out.mreq_tag, out.mreq_bank, out.mreq_offset, out.mreq_words};
+    add_cache_outputs(outputs, cycle, unit_, config_.words, out);
   }
 
  private:
@@ -159,6 +139,32 @@ class CacheUnitRtl final : public UnitRtl {
 };
 
 }  // namespace
+
+void add_cache_outputs(std::vector<units::BoundaryEvent>& outputs, std::uint64_t cycle,
+                       units::UnitId unit, int words, const CacheOutputs& out) {
+  using units::BoundaryPort;
+  const auto add = [&](BoundaryPort port, std::uint32_t thread, int fields,
+                       const char* const* names) -> units::BoundaryEvent& {
+    units::BoundaryEvent& e = add_event(outputs, cycle, unit, port, thread);
+    e.cache = true;
+    e.fields = fields;
+    e.names = names;
+    return e;
+  };
+  if (out.accept)
+    add(BoundaryPort::kCacheAccept, out.acc_tag, 5, units::kCacheAcceptFields).field = {
+        out.acc_index, out.acc_requester, out.acc_tag, out.acc_kind, out.acc_mshr};
+  if (out.resp) {
+    units::BoundaryEvent& e =
+        add(BoundaryPort::kCacheReply, out.resp_tag, 3 + words, units::kCacheReplyFields);
+    e.field = {out.resp_index, out.resp_requester, out.resp_tag};
+    for (int k = 0; k < words; ++k)
+      e.field[3 + static_cast<std::size_t>(k)] = out.resp_words[static_cast<std::size_t>(k)];
+  }
+  if (out.mreq)
+    add(BoundaryPort::kMemRequest, 0, 4, units::kMemRequestFields).field = {
+        out.mreq_tag, out.mreq_bank, out.mreq_offset, out.mreq_words};
+}
 
 const std::vector<CacheBuild>& cache_builds() {
   static const std::vector<CacheBuild> b = {

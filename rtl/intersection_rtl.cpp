@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
+#include "rtl/unit_ports.h"
 #include "rtl/verilated_top.h"
 #include "rtl_intersection_builds.h"
 #include "units/boundary_intersection.h"
@@ -23,7 +24,7 @@ using units::BoundaryEvent;
 using units::BoundaryPort;
 using units::UnitId;
 
-constexpr int kW = 24;  // fp24: the builds' float format
+constexpr int kW = kPortFloatBits;
 
 template <class V>
 class IntersectionRtlOf final : public UnitRtl {
@@ -44,10 +45,7 @@ class IntersectionRtlOf final : public UnitRtl {
       if (e.port == BoundaryPort::kInput) {
         arrive(e);
       } else if (e.port == BoundaryPort::kSideBand) {
-        if (starts == 2) throw std::logic_error("lockstep: three packet starts in one cycle");
-        put_bits(v.st_valid, starts, 1, 1);
-        put_bits(v.st_thread, starts * tw_, tw_, e.thread);
-        put_bits(v.st_shadow, starts++, 1, e.field[0]);
+        drive_packet_start(v, starts++, tw_, e);
       } else {
         throw std::logic_error(std::string("lockstep: the intersection unit has no ") +
                                units::boundary_port_name(e.port) + " input");
@@ -92,25 +90,9 @@ class IntersectionRtlOf final : public UnitRtl {
   // The thread leaving on path f with every lane's closest hit.
   void leaving(std::vector<BoundaryEvent>& out, std::uint64_t cycle) const {
     V& v = *top_;
-    BoundaryEvent& e = out.emplace_back();
-    e.cycle = cycle;
-    e.unit = UnitId::kIntersection;
-    e.port = BoundaryPort::kOutput;
-    e.thread = static_cast<std::uint32_t>(v.out_thread);
-    e.path = v.out_dest ? UnitId::kTraversal : UnitId::kList;
-    e.fields = 3;
-    e.names = units::kIntersectionOutputFields;
-    e.field[0] = v.out_dest;
-    e.field[1] = get_bits(v.out_mask, 0, p_);
-    e.field[2] = get_bits(v.out_done, 0, p_);
-    for (int i = 0; i < p_; ++i) {
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_t, i * kW, kW)));
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_u, i * kW, kW)));
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_v, i * kW, kW)));
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_c, i * kW, kW)));
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_instance, i * 32, 32)));
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_triangle, i * 32, 32)));
-    }
+    add_intersection_output(out, cycle, p_, static_cast<std::uint32_t>(v.out_thread), v.out_dest,
+                            get_bits(v.out_mask, 0, p_), get_bits(v.out_done, 0, p_), v.out_t,
+                            v.out_u, v.out_v, v.out_c, v.out_instance, v.out_triangle);
   }
 
   int tw_, p_;

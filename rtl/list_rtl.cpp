@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
+#include "rtl/unit_ports.h"
 #include "rtl/verilated_top.h"
 #include "rtl_list_builds.h"
 #include "units/boundary_list.h"
@@ -61,6 +62,8 @@ class ListRtlOf final : public ListRtl {
     o.next = v.out_next;
     o.entry = v.out_entry;
     o.mask = get_bits(v.out_mask, 0, p_);
+    o.list = get_bits(v.out_list, 0, p_);
+    o.last = v.out_last;
     top_.rise();
     return o;
   }
@@ -133,19 +136,7 @@ class ListUnitRtl final : public UnitRtl {
           throw std::logic_error("lockstep: an output event given to the list unit as an input");
       }
     }
-    const ListOutputs out = rtl_->cycle(in);
-    if (out.req)
-      add_cache_request(outputs, cycle, units::UnitId::kList, out.req_item, out.req_thread);
-    if (out.out) {
-      units::BoundaryEvent& e = add_event(outputs, cycle, units::UnitId::kList,
-                                          units::BoundaryPort::kOutput, out.out_thread);
-      constexpr units::UnitId kTo[] = {units::UnitId::kTransformation, units::UnitId::kList,
-                                       units::UnitId::kTraversal};
-      e.path = kTo[std::min<std::uint32_t>(out.kind, 2)];
-      e.fields = 5;
-      e.names = units::kListOutputFields;
-      e.field = {out.kind, out.level, out.next, out.entry, out.mask};
-    }
+    add_list_outputs(outputs, cycle, rtl_->cycle(in));
   }
 
  private:

@@ -26,6 +26,7 @@
 #include "hw/kernel.h"
 #include "memif/memory_system.h"
 #include "rtl/cache_rtl.h"
+#include "rtl/dynrtc_rtl.h"
 #include "rtl/intersection_rtl.h"
 #include "rtl/list_rtl.h"
 #include "rtl/transformation_rtl.h"
@@ -101,7 +102,12 @@ struct Stop {};
 // model's `window` cycles behind the clock.
 class Lockstep {
  public:
-  Lockstep(UnitRtl& rtl, const LockstepOptions& o) : rtl_(rtl), o_(o) { rtl_.reset(); }
+  // The whole DynRTC (unit kNone) takes every event of the run: its boundary's inputs, and every
+  // unit's and cache's outputs to compare.
+  Lockstep(UnitRtl& rtl, const LockstepOptions& o)
+      : rtl_(rtl), o_(o), whole_(rtl.unit() == UnitId::kNone) {
+    rtl_.reset();
+  }
 
   // A model event of cycle cur_ (the driver clocks the RTL before the events of a later cycle).
   void model_event(BoundaryEvent e) { pending_.push_back(std::move(e)); }
@@ -115,7 +121,8 @@ class Lockstep {
         outputs.push_back(std::move(e));
         continue;
       }
-      ++events_[static_cast<std::size_t>(e.port)];  // given (the outputs count when compared)
+      if (!whole_ || at_boundary(e))  // given (the outputs count when compared)
+        ++events_[static_cast<std::size_t>(e.port)];
       if (e.port != BoundaryPort::kCacheBlocked) remember(rtl_hist_, e);
       inputs.push_back(std::move(e));
     }
@@ -182,27 +189,57 @@ class Lockstep {
   }
 
   // What the RTL computes (compared), as opposed to what it is given: a unit's cache requests
-  // and threads leaving; a cache's lookups, replies and line requests.
-  static bool is_output(const BoundaryEvent& e) {
+  // and threads leaving; a cache's lookups, replies and line requests; in the whole DynRTC also
+  // the routing's work (each cache's line request taken, its fills).
+  bool is_output(const BoundaryEvent& e) const {
     if (e.cache)
       return e.port == BoundaryPort::kCacheAccept || e.port == BoundaryPort::kCacheReply ||
-             e.port == BoundaryPort::kMemRequest;
+             e.port == BoundaryPort::kMemRequest ||
+             (whole_ && (e.port == BoundaryPort::kMemTaken || e.port == BoundaryPort::kMemFill));
     return e.port == BoundaryPort::kCacheRequest || e.port == BoundaryPort::kOutput;
   }
 
-  static bool before(const BoundaryEvent& a, const BoundaryEvent& b) {
-    return a.cycle != b.cycle ? a.cycle < b.cycle : a.port < b.port;
+  // An input event the whole DynRTC takes from the model: the RGS's hand-overs and side bands
+  // (the hit update is the intersection unit's output), the controller port's.
+  static bool at_boundary(const BoundaryEvent& e) {
+    switch (e.port) {
+      case BoundaryPort::kInput:
+        return e.path == UnitId::kRgs;
+      case BoundaryPort::kSideBand:
+        return e.unit != UnitId::kTraversal;
+      case BoundaryPort::kPortResponse:
+      case BoundaryPort::kPortBlocked:
+        return true;
+      default:
+        return false;
+    }
   }
-  // A cycle's events in (port, thread) order: the model's come in the order its modules ran,
-  // the RTL's in its ports' order; a unit with two output ports (the traversal unit) may let two
-  // threads go in one cycle.
+
+  // Events of a cycle are ordered by port, then by the unit or cache whose they are.
+  static int source(const BoundaryEvent& e) {
+    return 2 * units::unit_index(e.unit) + (e.cache ? 1 : 0);
+  }
+  static bool before(const BoundaryEvent& a, const BoundaryEvent& b) {
+    if (a.cycle != b.cycle) return a.cycle < b.cycle;
+    return a.port != b.port ? a.port < b.port : source(a) < source(b);
+  }
+  // A cycle's events in (port, source, thread) order: the model's come in the order its modules
+  // ran, the RTL's in its ports' order; a unit with two output ports (the traversal unit) may let
+  // two threads go in one cycle.
   static void in_port_order(std::vector<BoundaryEvent>& v) {
     std::stable_sort(v.begin(), v.end(), [](const BoundaryEvent& a, const BoundaryEvent& b) {
-      return a.port != b.port ? a.port < b.port : a.thread < b.thread;
+      if (a.port != b.port) return a.port < b.port;
+      return source(a) != source(b) ? source(a) < source(b) : a.thread < b.thread;
     });
   }
   static bool same_bits(const BoundaryEvent& a, const BoundaryEvent& b) {
-    return a.thread == b.thread && a.fields == b.fields && a.field == b.field && a.wide == b.wide;
+    return source(a) == source(b) && a.thread == b.thread && a.fields == b.fields &&
+           a.field == b.field && a.wide == b.wide;
+  }
+  // The name of the unit or cache an event is of.
+  std::string source_name(const BoundaryEvent& e) const {
+    if (!whole_) return rtl_.name();
+    return e.cache ? units::cache_name(e.unit) : units::unit_name(e.unit);
   }
 
   static const BoundaryEvent* find(const std::deque<BoundaryEvent>& q, const BoundaryEvent& e) {
@@ -243,7 +280,7 @@ class Lockstep {
                             std::uint64_t other) {
     const BoundaryEvent& e = model != nullptr ? *model : *rtl;
     div_.cycle = e.cycle;
-    div_.unit = rtl_.name();
+    div_.unit = source_name(e);
     div_.port = units::boundary_port_name(e.port);
     div_.kind = kind;
     div_.other_cycle = other;
@@ -270,8 +307,8 @@ class Lockstep {
                std::uint64_t cycle) const {
     std::vector<const BoundaryEvent*> last;
     for (auto it = h.rbegin(); it != h.rend() && last.size() < 16; ++it)
-      if (it->cycle <= cycle) last.push_back(&*it);
-    s << "  the last " << last.size() << " events of the " << rtl_.name() << " unit, " << side
+      if (it->cycle <= cycle && source_name(*it) == div_.unit) last.push_back(&*it);
+    s << "  the last " << last.size() << " events of the " << div_.unit << " unit, " << side
       << ":\n";
     for (auto it = last.rbegin(); it != last.rend(); ++it)
       s << "    " << units::format_boundary(**it) << "\n";
@@ -279,6 +316,7 @@ class Lockstep {
 
   UnitRtl& rtl_;
   const LockstepOptions& o_;
+  bool whole_;
   std::vector<BoundaryEvent> pending_;
   std::deque<BoundaryEvent> model_out_, rtl_out_;
   std::deque<BoundaryEvent> model_hist_, rtl_hist_;
@@ -296,13 +334,19 @@ class Cosim {
  public:
   explicit Cosim(const LockstepOptions& o) : o_(o) {}
   void add(UnitRtl& rtl) {
-    (rtl.cache() ? caches_ : units_)[static_cast<std::size_t>(units::unit_index(rtl.unit()))] =
-        &steps_.emplace_back(rtl, o_);
+    Lockstep* l = &steps_.emplace_back(rtl, o_);
+    if (rtl.unit() == UnitId::kNone)
+      whole_ = l;
+    else
+      (rtl.cache() ? caches_ : units_)[static_cast<std::size_t>(units::unit_index(rtl.unit()))] = l;
   }
 
   void model_event(const BoundaryEvent& e) {
     if (o_.model_events) o_.model_events(e);
-    Lockstep* u = (e.cache ? caches_ : units_)[static_cast<std::size_t>(units::unit_index(e.unit))];
+    Lockstep* u =
+        whole_ != nullptr
+            ? whole_
+            : (e.cache ? caches_ : units_)[static_cast<std::size_t>(units::unit_index(e.unit))];
     if (u == nullptr) return;
     if (e.cycle > cur_) advance_to(e.cycle);
     u->model_event(e);
@@ -344,6 +388,7 @@ class Cosim {
   const LockstepOptions& o_;
   std::deque<Lockstep> steps_;  // (a deque: the pointers below stay valid)
   std::array<Lockstep*, units::kMaxUnits> units_{}, caches_{};  // by the (served) unit
+  Lockstep* whole_ = nullptr;                                   // the whole DynRTC's
   std::uint64_t cur_ = 0;                                       // the RTL's next cycle
   std::uint64_t model_cycles_ = 0;
 };
@@ -455,6 +500,7 @@ const TraversalBuild& choose_traversal_build(const units::CycleParams& p, int fa
 struct Recorded {
   std::vector<UnitId> units;
   std::vector<memif::ItemType> caches;
+  bool port = false;  // the memory controller's cache port (the whole DynRTC's boundary)
 };
 
 template <class F, int kLanes>
@@ -484,6 +530,7 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   std::optional<units::CacheRecorder> caches;  // (the units' hooks through it to `rec`)
   if (cs != nullptr && !recorded.caches.empty())
     caches.emplace(mi, image, recorded.caches, &rec, sink);
+  if (caches && recorded.port) caches->record_port(mi);
   if (cs != nullptr)  // (none: the model alone, for the speed beside it)
     d.observe(caches ? static_cast<units::UnitObserver*>(&*caches) : &rec);
   const auto done = [&] {
@@ -616,17 +663,57 @@ struct Chosen {
   const TraversalBuild* traversal = nullptr;
   const IntersectionBuild* intersection = nullptr;
   const TransformationBuild* transformation = nullptr;
+  const DynrtcBuild* dynrtc = nullptr;
 };
+
+// The whole DynRTC's build: the units' parameters of the run, everything else the prototype's
+// (the latencies, the caches' timing, up to 512 items and 4 ways, one response a cycle through a
+// routing whose port channel holds 4).
+const DynrtcBuild& choose_dynrtc_build(const units::CycleParams& p) {
+  choose_traversal_build(p, 0);  // (its rules, and a traversal build for the parameters)
+  const units::CycleParams proto = units::prototype_params();
+  const auto& c = p.cache;
+  bool caches_fit = true;
+  for (const auto& k : c)
+    caches_fit = caches_fit && k.items <= 512 && (k.items & (k.items - 1)) == 0 && k.ways <= 4 &&
+                 (k.ways & (k.ways - 1)) == 0;
+  if (p.lat_add != proto.lat_add || p.lat_mul != proto.lat_mul || p.lat_div != proto.lat_div ||
+      p.lat_cmp != proto.lat_cmp || p.cache_hit_latency != proto.cache_hit_latency ||
+      p.cache_misses != proto.cache_misses || p.cache_merge_targets != proto.cache_merge_targets ||
+      p.cache_request_queue != proto.cache_request_queue ||
+      p.cache_memory_queue != proto.cache_memory_queue || p.routing_responses != 1 ||
+      std::max(p.mem_port_capacity, 2) != 4 || !caches_fit)
+    throw std::runtime_error(
+        "lockstep: the Verilated whole DynRTC is built for the prototype's latencies, cache "
+        "timing, routing and port (caches of up to 512 items and 4 ways, powers of two)");
+  std::string built;
+  for (const DynrtcBuild& b : dynrtc_builds()) {
+    if (b.threads == p.threads && b.packet == p.packet && b.stack == p.stack &&
+        b.mailbox == p.mailbox && b.triangle_mailbox == p.triangle_mailbox)
+      return b;
+    built += " [threads=" + std::to_string(b.threads) + " packet=" + std::to_string(b.packet) +
+             " stack=" + std::to_string(b.stack) + " mailbox=" + std::to_string(b.mailbox) +
+             " triangle_mailbox=" + std::to_string(b.triangle_mailbox) + "]";
+  }
+  throw std::runtime_error(
+      "lockstep: no Verilated whole DynRTC for threads=" + std::to_string(p.threads) +
+      " packet=" + std::to_string(p.packet) + " stack=" + std::to_string(p.stack) +
+      " mailbox=" + std::to_string(p.mailbox) +
+      " triangle_mailbox=" + std::to_string(p.triangle_mailbox) + "; built:" + built);
+}
 std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CycleParams& p,
                                   std::vector<LockstepUnit>& info) {
   bool fault_used = o.fault.empty();
   std::vector<Chosen> chosen;
   for (const std::string& u : expand_units(o.units)) {
     if (u != "traversal" && u != "list" && u != "intersection" && u != "transformation" &&
-        cache_of(u) == UnitId::kNone)
+        u != "dynrtc" && cache_of(u) == UnitId::kNone)
       throw std::runtime_error("lockstep: unknown unit '" + u +
                                "' (the RTL units: traversal, list, transformation, intersection, "
-                               "node-cache, list-cache, row-cache; caches: the three)");
+                               "node-cache, list-cache, row-cache; caches: the three; dynrtc: "
+                               "the whole DynRTC)");
+    if (u == "dynrtc" && o.units.size() != 1)
+      throw std::runtime_error("lockstep: the whole DynRTC (dynrtc) runs alone: it has every unit");
     for (const LockstepUnit& x : info)
       if (x.unit == u) throw std::runtime_error("lockstep: unit '" + u + "' given twice");
     const int fault = fault_of(u, o.fault);
@@ -634,7 +721,9 @@ std::vector<Chosen> choose_builds(const LockstepOptions& o, const units::CyclePa
     LockstepUnit& x = info.emplace_back();
     x.unit = u;
     Chosen& c = chosen.emplace_back();
-    if (cache_of(u) != UnitId::kNone)
+    if (u == "dynrtc")
+      x.build = (c.dynrtc = &choose_dynrtc_build(p))->name;
+    else if (cache_of(u) != UnitId::kNone)
       x.build = (c.cache = &choose_cache_build(p, c.served = cache_of(u), fault))->name;
     else if (u == "list")
       x.build = (c.list = &choose_list_build(p, fault))->name;
@@ -664,6 +753,18 @@ memif::ItemType cache_type(UnitId served) {
 // The Verilated unit or cache of a chosen build.
 std::unique_ptr<UnitRtl> make_rtl(const Chosen& c, const units::CycleParams& p,
                                   const memif::MemoryImage& image) {
+  if (c.dynrtc != nullptr) {
+    DynrtcConfig config;
+    config.frame = image.registers();
+    for (int k = 0; k < memif::kItemTypes; ++k) {
+      const auto type = static_cast<memif::ItemType>(k);
+      const auto t = static_cast<std::size_t>(k);
+      config.caches[t] = {p.cache[t].items, p.cache[t].ways, image.item_words(type),
+                          image.regions().base[t]};
+      config.clients[t] = memif::MemorySystem::cache_client(0, type);
+    }
+    return make_dynrtc_rtl(*c.dynrtc, config);
+  }
   if (c.cache != nullptr) {
     const memif::ItemType type = cache_type(c.served);
     const auto& sizes = p.cache[static_cast<std::size_t>(type)];
@@ -702,10 +803,16 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   for (const Chosen& c : chosen) {
     rtl.push_back(make_rtl(c, p, built.image));
     if (o.wrap_rtl) rtl.back() = o.wrap_rtl(std::move(rtl.back()));
-    if (c.cache != nullptr)
+    if (c.dynrtc != nullptr) {
+      recorded.units = {UnitId::kTransformation, UnitId::kTraversal, UnitId::kList,
+                        UnitId::kIntersection};
+      recorded.caches = {memif::ItemType::kNode, memif::ItemType::kList, memif::ItemType::kRow};
+      recorded.port = true;
+    } else if (c.cache != nullptr) {
       recorded.caches.push_back(cache_type(c.served));
-    else
+    } else {
       recorded.units.push_back(rtl.back()->unit());
+    }
     cs.add(*rtl.back());
   }
   const auto t1 = Clock::now();

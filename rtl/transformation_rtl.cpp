@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
+#include "rtl/unit_ports.h"
 #include "rtl/verilated_top.h"
 #include "rtl_transformation_builds.h"
 #include "units/boundary_transformation.h"
@@ -22,8 +23,6 @@ namespace {
 using units::BoundaryEvent;
 using units::BoundaryPort;
 using units::UnitId;
-
-constexpr int kW = 24;  // fp24: the builds' float format
 
 template <class V>
 class TransformationRtlOf final : public UnitRtl {
@@ -90,62 +89,21 @@ class TransformationRtlOf final : public UnitRtl {
     v.d_kind = e.field[1] != 0;
     v.d_entry = static_cast<std::uint32_t>(e.field[2]);
     put_bits(v.d_mask, 0, p_, e.field[3]);
+    put_bits(v.d_list, 0, p_, e.field[4]);
+    v.d_last = e.field[5] != 0;
   }
 
   // Path a: a packet to generate, per lane T, R'o, R'd.
-  void generate(const BoundaryEvent& e) {
-    V& v = *top_;
-    if (e.path != UnitId::kRgs)
-      throw std::logic_error(std::string("lockstep: a thread reached the transformation unit "
-                                         "from the ") +
-                             units::unit_name(e.path) + " unit, which has no path to it");
-    if (v.a_valid) throw std::logic_error("lockstep: two threads on path a in a cycle");
-    constexpr int kWords = units::kTransformationGenerateWords;
-    if (e.fields != 4 || e.wide.size() != static_cast<std::size_t>(p_ * kWords))
-      throw std::logic_error("lockstep: a packet without its " + std::to_string(p_ * kWords) +
-                             " words on path a");
-    v.a_valid = 1;
-    v.a_thread = static_cast<std::remove_reference_t<decltype(v.a_thread)>>(e.thread);
-    v.a_shadow = e.field[1] != 0;
-    v.a_shared = e.field[2] != 0;
-    put_bits(v.a_valid_lanes, 0, p_, e.field[3]);
-    for (int i = 0; i < p_; ++i) {
-      const std::uint32_t* w = &e.wide[static_cast<std::size_t>(i * kWords)];
-      for (int k = 0; k < 12; ++k)
-        put_bits(v.a_t, (12 * i + k) * kW, kW, w[k]);
-      for (int a = 0; a < 3; ++a) {
-        put_bits(v.a_ro, (3 * i + a) * kW, kW, w[12 + a]);
-        put_bits(v.a_rd, (3 * i + a) * kW, kW, w[15 + a]);
-      }
-    }
-  }
+  void generate(const BoundaryEvent& e) { drive_generate(*top_, p_, e); }
 
   // The thread leaving with its transformed rays (an object's box after them).
   void leaving(std::vector<BoundaryEvent>& out, std::uint64_t cycle) const {
     V& v = *top_;
-    constexpr UnitId kTo[] = {UnitId::kTraversal, UnitId::kIntersection, UnitId::kRgs,
-                              UnitId::kRgs};
-    BoundaryEvent& e =
-        add_event(out, cycle, UnitId::kTransformation, BoundaryPort::kOutput, v.out_thread);
-    e.path = kTo[v.out_dest & 3u];
-    e.fields = 5;
-    e.names = units::kTransformationOutputFields;
-    e.field[0] = v.out_dest;
-    e.field[1] = v.out_level;
-    e.field[2] = v.out_shared;
-    e.field[3] = get_bits(v.out_mask, 0, p_);
-    e.field[4] = v.out_root;
-    for (int i = 0; i < p_; ++i) {
-      for (int a = 0; a < 3; ++a)
-        e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_o, (3 * i + a) * kW, kW)));
-      for (int a = 0; a < 3; ++a)
-        e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_d, (3 * i + a) * kW, kW)));
-    }
-    if (!v.out_level) return;
-    for (int a = 0; a < 3; ++a)
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_lo, a * kW, kW)));
-    for (int a = 0; a < 3; ++a)
-      e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_hi, a * kW, kW)));
+    add_transformation_output(
+        out, cycle, p_, static_cast<std::uint32_t>(v.out_thread),
+        {v.out_dest, v.out_level, v.out_shared, get_bits(v.out_mask, 0, p_), v.out_root,
+         get_bits(v.out_list, 0, p_), v.out_last, v.out_instance, v.out_triangle, v.out_shadow},
+        v.out_o, v.out_d, v.out_lo, v.out_hi);
   }
 
   int p_;

@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "rtl/port_bits.h"
+#include "rtl/unit_ports.h"
 #include "rtl/verilated_top.h"
 #include "rtl_traversal_builds.h"
 #include "units/boundary_traversal.h"
@@ -22,9 +23,7 @@ using units::BoundaryEvent;
 using units::BoundaryPort;
 using units::UnitId;
 
-constexpr int kW = 24;         // fp24: the builds' float format
-constexpr int kRay = 3 * kW;   // O or D of one lane
-constexpr int kNodeBits = 28;  // NODE_W
+constexpr int kW = kPortFloatBits;
 constexpr int kLoadPorts = 2;  // 0: path b (the transformation unit), 1: RGS -> traversal
 
 // The input path a sending unit's thread arrives on (f, list -> traversal, RGS -> traversal, b);
@@ -76,11 +75,12 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
       add_cache_request(outputs, cycle, UnitId::kTraversal, v.req_item,
                         static_cast<std::uint32_t>(v.req_thread));
     if (v.out_valid)
-      leaving(outputs, cycle, v.out_thread, v.out_dest,
-              {v.out_node, v.out_first, v.out_end, get_bits(v.out_mask, 0, p_), v.out_level});
+      add_traversal_output(
+          outputs, cycle, v.out_thread, v.out_dest,
+          {v.out_node, v.out_first, v.out_end, get_bits(v.out_mask, 0, p_), v.out_level});
     if (v.out2_valid)
-      leaving(outputs, cycle, v.out2_thread, v.out2_dest,
-              {v.out2_node, 0, 0, get_bits(v.out2_mask, 0, p_), v.out2_level});
+      add_traversal_output(outputs, cycle, v.out2_thread, v.out2_dest,
+                           {v.out2_node, 0, 0, get_bits(v.out2_mask, 0, p_), v.out2_level});
     top_.rise();
   }
 
@@ -160,39 +160,8 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
     }
   }
 
-  // Load port k: the level start's fields and the lanes' rays (units/boundary_traversal.h).
-  void load(int k, const BoundaryEvent& e) {
-    V& v = *top_;
-    const bool bottom = e.field[1] != 0;
-    const std::size_t words =
-        static_cast<std::size_t>(p_ * units::kTraversalLaneWords) + (bottom ? 6u : 0u);
-    if (e.fields != 7 || e.field[0] != 0 || e.wide.size() != words)
-      throw std::logic_error("lockstep: a level start without its " + std::to_string(words) +
-                             " words for the traversal unit");
-    put_bits(v.ld_valid, k, 1, 1);
-    put_bits(v.ld_thread, k * tw_, tw_, e.thread);
-    put_bits(v.ld_bottom, k, 1, e.field[1]);
-    put_bits(v.ld_shadow, k, 1, e.field[2]);
-    put_bits(v.ld_lane_valid, k * p_, p_, e.field[3]);
-    put_bits(v.ld_done, k * p_, p_, e.field[4]);
-    put_bits(v.ld_mask, k * p_, p_, e.field[5]);
-    put_bits(v.ld_root, k * kNodeBits, kNodeBits, e.field[6]);
-    for (int i = 0; i < p_; ++i) {
-      const std::uint32_t* w = &e.wide[static_cast<std::size_t>(i * units::kTraversalLaneWords)];
-      const int lane = (k * p_ + i) * kRay;
-      for (int a = 0; a < 3; ++a) {
-        put_bits(v.ld_o, lane + a * kW, kW, w[a]);
-        put_bits(v.ld_d, lane + a * kW, kW, w[3 + a]);
-      }
-      put_bits(v.ld_tbest, (k * p_ + i) * kW, kW, w[6]);
-    }
-    const std::size_t box = static_cast<std::size_t>(p_ * units::kTraversalLaneWords);
-    for (int a = 0; a < 3; ++a) {
-      const auto s = static_cast<std::size_t>(a);
-      put_bits(v.ld_lo, k * kRay + a * kW, kW, bottom ? e.wide[box + s] : 0);
-      put_bits(v.ld_hi, k * kRay + a * kW, kW, bottom ? e.wide[box + 3 + s] : 0);
-    }
-  }
+  // Load port k: the level start's fields and the lanes' rays.
+  void load(int k, const BoundaryEvent& e) { drive_level_start(*top_, k, tw_, p_, e); }
 
   // The hit update: every lane's t_best and done.
   void hit_update(const BoundaryEvent& e) {
@@ -206,17 +175,6 @@ class TraversalRtlOf final : public UnitRtl, public TraversalStackProbe {
     put_bits(v.hu_done, 0, p_, e.field[0]);
     for (int i = 0; i < p_; ++i)
       put_bits(v.hu_tbest, i * kW, kW, e.wide[static_cast<std::size_t>(i)]);
-  }
-
-  // A thread leaving on an output port: {node, first, end, mask, level} after the destination.
-  static void leaving(std::vector<BoundaryEvent>& out, std::uint64_t cycle, std::uint32_t thread,
-                      std::uint32_t dest, const std::array<std::uint64_t, 5>& f) {
-    constexpr UnitId kTo[] = {UnitId::kTraversal, UnitId::kList, UnitId::kList, UnitId::kRgs};
-    BoundaryEvent& e = add_event(out, cycle, UnitId::kTraversal, BoundaryPort::kOutput, thread);
-    e.path = kTo[dest & 3u];
-    e.fields = 6;
-    e.names = units::kTraversalOutputFields;
-    e.field = {dest, f[0], f[1], f[2], f[3], f[4]};
   }
 
   int tw_, p_;

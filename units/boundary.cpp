@@ -2,6 +2,7 @@
 #include "units/boundary.h"
 
 #include <cstdio>
+#include <iterator>
 #include <sstream>
 
 namespace saarcor::units {
@@ -14,7 +15,8 @@ constexpr const char* kRequestFields[] = {"phase", "item", "mask"};
 const char* boundary_port_name(BoundaryPort p) {
   constexpr const char* kNames[] = {"input",         "side_band", "cache_request", "cache_response",
                                     "cache_blocked", "output",    "cache_accept",  "cache_reply",
-                                    "mem_request",   "mem_taken", "mem_fill"};
+                                    "mem_request",   "mem_taken", "mem_fill",      "port_response",
+                                    "port_blocked"};
   return kNames[static_cast<int>(p)];
 }
 
@@ -162,7 +164,9 @@ void BoundaryRecorder::cache_response(std::uint64_t cycle, UnitId unit,
                                       const memif::CacheResponse& r) {
   if (!recorded(unit)) return;
   BoundaryEvent e = event(cycle, unit, BoundaryPort::kCacheResponse, r.label.tag);
-  const int words = r.count < kBoundaryFields - 1 ? r.count : kBoundaryFields - 1;
+  // The address, then at most as many words as the response's field names have.
+  constexpr int kMaxWords = static_cast<int>(std::size(kCacheResponseFields)) - 1;
+  const int words = r.count < kMaxWords ? r.count : kMaxWords;
   e.fields = 1 + words;
   e.names = kCacheResponseFields;
   e.field[0] = r.index;

@@ -36,11 +36,16 @@ enum class BoundaryPort : std::uint8_t {
   kMemRequest,   // a line request pushed towards the routing (a miss)
   kMemTaken,     // the routing took the cache's oldest line request
   kMemFill,      // the routing pushed a fill, labelled with its MSHR
+  // The memory controller's cache port, where the whole DynRTC meets the model's controller (its
+  // record names the unit whose cache the client is; kNone for the port's back-pressure).
+  kPortResponse,  // the controller pushed a response into the port: client, tag, words
+  kPortBlocked,   // a client had a line request and the port's request channel was full
 };
-inline constexpr int kBoundaryPorts = 11;
+inline constexpr int kBoundaryPorts = 13;
 const char* boundary_port_name(BoundaryPort p);
 
-inline constexpr int kBoundaryFields = 8;
+// The widest payload: the transformation unit's output (units/boundary_transformation.h).
+inline constexpr int kBoundaryFields = 10;
 // The cache port's payloads (the same for every unit): a request's item address and label, a
 // response's item address and words.
 inline constexpr const char* kCacheRequestFields[] = {"address", "requester", "tag"};

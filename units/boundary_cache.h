@@ -36,6 +36,7 @@ inline constexpr const char* kCacheReplyFields[] = {"address", "requester", "tag
                                                     "word1",   "word2",     "word3"};
 inline constexpr const char* kMemRequestFields[] = {"tag", "bank", "offset", "words"};
 inline constexpr const char* kMemFillFields[] = {"tag", "word0", "word1", "word2", "word3"};
+inline constexpr const char* kPortFields[] = {"client", "tag", "word0", "word1", "word2", "word3"};
 
 enum class CacheKind : std::uint8_t { kHit = 0, kMerge = 1, kMiss = 2 };
 
@@ -57,7 +58,8 @@ inline const char* cache_name(UnitId unit) {
 // units' own recorder, if any). Emits the events of the caches in `types` to `sink`.
 class CacheRecorder final : public UnitObserver,
                             public memif::CacheObserver,
-                            public memif::RoutingObserver {
+                            public memif::RoutingObserver,
+                            public memif::PortObserver {
  public:
   using Sink = std::function<void(const BoundaryEvent&)>;
   CacheRecorder(memif::MemorySystem& mi, const memif::MemoryImage& image,
@@ -71,6 +73,13 @@ class CacheRecorder final : public UnitObserver,
       client_[c.client()] = cache_unit(t);
     }
     mi.routing().set_observer(this);
+  }
+
+  // Also the memory controller's cache port: the responses it pushes towards the routing and
+  // the routing's waits on its request channel (where a whole DynRTC in RTL meets the model).
+  void record_port(memif::MemorySystem& mi) {
+    mi.routing().port().observer = this;
+    port_ = true;
   }
 
   // UnitObserver: the units' hooks on to `next`; their cache port's push and take recorded.
@@ -149,6 +158,19 @@ class CacheRecorder final : public UnitObserver,
       e.field[1 + static_cast<std::size_t>(k)] = r.words[static_cast<std::size_t>(k)];
     sink_(e);
   }
+  void blocked(std::uint64_t c) override {
+    if (port_) sink_(event(c, UnitId::kNone, BoundaryPort::kPortBlocked, 0, 0, nullptr));
+  }
+
+  // memif::PortObserver: a response towards the routing, labelled with its client.
+  void responded(std::uint64_t c, const memif::MemResponse& r) override {
+    BoundaryEvent& e =
+        event(c, of_client(r.client), BoundaryPort::kPortResponse, 0, 2 + r.count, kPortFields);
+    e.field = {r.client, r.tag};
+    for (int k = 0; k < r.count; ++k)
+      e.field[2 + static_cast<std::size_t>(k)] = r.words[static_cast<std::size_t>(k)];
+    sink_(e);
+  }
 
  private:
   bool recorded(UnitId u) const { return recorded_[static_cast<std::size_t>(unit_index(u))]; }
@@ -181,6 +203,7 @@ class CacheRecorder final : public UnitObserver,
   Sink sink_;
   std::array<bool, kMaxUnits> recorded_{};
   std::vector<UnitId> client_;  // controller client id -> the unit its cache serves
+  bool port_ = false;           // record_port: the port's events too
   BoundaryEvent e_;
 };
 
