@@ -505,7 +505,8 @@ struct Recorded {
 
 template <class F, int kLanes>
 void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
-               const units::FunctionalParams& shading, const Recorded& recorded, Cosim* cs) {
+               const units::FunctionalParams& shading, const Recorded& recorded, Cosim* cs,
+               std::vector<std::uint32_t>* frame = nullptr) {
   using State = units::PacketState<F, kLanes, units::FastDatapath>;
   memif::MemoryImage image = image_in;
   LockstepThreads<F, kLanes> threads(image, units::functional_params(p, shading), p.threads);
@@ -540,7 +541,13 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   if (r.status == hw::RunResult::Status::kWatchdog)
     throw std::runtime_error("lockstep: the cycle model's watchdog fired at cycle " +
                              std::to_string(r.cycles));
-  if (cs != nullptr) cs->finish(k.now());
+  if (cs == nullptr) return;
+  cs->finish(k.now());
+  if (frame == nullptr) return;
+  const auto& bank = image.bank(static_cast<int>(image.registers().frame_bank));
+  const std::size_t pixels = static_cast<std::size_t>(image.registers().width) *
+                             static_cast<std::size_t>(image.registers().height);
+  frame->assign(bank.begin(), bank.begin() + static_cast<std::ptrdiff_t>(pixels));
 }
 
 // The cycle model alone on the same thread table (a program per thread), for its speed.
@@ -670,7 +677,6 @@ struct Chosen {
 // (the latencies, the caches' timing, up to 512 items and 4 ways, one response a cycle through a
 // routing whose port channel holds 4).
 const DynrtcBuild& choose_dynrtc_build(const units::CycleParams& p) {
-  choose_traversal_build(p, 0);  // (its rules, and a traversal build for the parameters)
   const units::CycleParams proto = units::prototype_params();
   const auto& c = p.cache;
   bool caches_fit = true;
@@ -682,10 +688,12 @@ const DynrtcBuild& choose_dynrtc_build(const units::CycleParams& p) {
       p.cache_misses != proto.cache_misses || p.cache_merge_targets != proto.cache_merge_targets ||
       p.cache_request_queue != proto.cache_request_queue ||
       p.cache_memory_queue != proto.cache_memory_queue || p.routing_responses != 1 ||
-      std::max(p.mem_port_capacity, 2) != 4 || !caches_fit)
+      std::max(p.mem_port_capacity, 2) != 4 || !caches_fit || !p.skip_empty || !p.clip_exit_only ||
+      p.clip_faces_per_step != 1)
     throw std::runtime_error(
         "lockstep: the Verilated whole DynRTC is built for the prototype's latencies, cache "
-        "timing, routing and port (caches of up to 512 items and 4 ways, powers of two)");
+        "timing, routing, port and traversal rules (caches of up to 512 items and 4 ways, "
+        "powers of two)");
   std::string built;
   for (const DynrtcBuild& b : dynrtc_builds()) {
     if (b.threads == p.threads && b.packet == p.packet && b.stack == p.stack &&
@@ -779,6 +787,21 @@ std::unique_ptr<UnitRtl> make_rtl(const Chosen& c, const units::CycleParams& p,
   return make_traversal_unit_rtl(*c.traversal, image.registers());
 }
 
+// What the model records for a chosen build: its unit's or cache's events; the whole DynRTC's
+// are every unit's and cache's and the controller port's.
+void record(const Chosen& c, const UnitRtl& rtl, Recorded& recorded) {
+  if (c.dynrtc != nullptr) {
+    recorded.units = {UnitId::kTransformation, UnitId::kTraversal, UnitId::kList,
+                      UnitId::kIntersection};
+    recorded.caches = {memif::ItemType::kNode, memif::ItemType::kList, memif::ItemType::kRow};
+    recorded.port = true;
+  } else if (c.cache != nullptr) {
+    recorded.caches.push_back(cache_type(c.served));
+  } else {
+    recorded.units.push_back(rtl.unit());
+  }
+}
+
 }  // namespace
 
 LockstepResult run_lockstep(const LockstepOptions& o) {
@@ -803,25 +826,16 @@ LockstepResult run_lockstep(const LockstepOptions& o) {
   for (const Chosen& c : chosen) {
     rtl.push_back(make_rtl(c, p, built.image));
     if (o.wrap_rtl) rtl.back() = o.wrap_rtl(std::move(rtl.back()));
-    if (c.dynrtc != nullptr) {
-      recorded.units = {UnitId::kTransformation, UnitId::kTraversal, UnitId::kList,
-                        UnitId::kIntersection};
-      recorded.caches = {memif::ItemType::kNode, memif::ItemType::kList, memif::ItemType::kRow};
-      recorded.port = true;
-    } else if (c.cache != nullptr) {
-      recorded.caches.push_back(cache_type(c.served));
-    } else {
-      recorded.units.push_back(rtl.back()->unit());
-    }
+    record(c, *rtl.back(), recorded);
     cs.add(*rtl.back());
   }
   const auto t1 = Clock::now();
   using Fp24 = ff::Float<7, 16>;
   try {
     if (p.packet <= 4)
-      run_model<Fp24, 4>(built.image, p, shading, recorded, &cs);
+      run_model<Fp24, 4>(built.image, p, shading, recorded, &cs, &res.frame);
     else
-      run_model<Fp24, units::kMaxPacket>(built.image, p, shading, recorded, &cs);
+      run_model<Fp24, units::kMaxPacket>(built.image, p, shading, recorded, &cs, &res.frame);
   } catch (const Stop&) {
   }
   res.seconds = std::chrono::duration<double>(Clock::now() - t1).count();

@@ -83,6 +83,9 @@ struct LockstepResult {
   std::uint64_t model_cycles = 0;       // the frame's cycles in the model
   double rtl_seconds = 0, seconds = 0;  // the RTL units together; the whole co-simulation
   double model_seconds = 0;  // with LockstepOptions::bench: the model alone, the same frame
+  // The frame the model's RGS wrote into the frame buffer (pixel (x, y) at y * width + x, RGB8 in
+  // bits 0..23), from the hit records every compared port agreed on; empty after a divergence.
+  std::vector<std::uint32_t> frame;
 };
 
 // Runs the co-simulation. Throws std::runtime_error (one line) for bad input: an unknown unit, a
