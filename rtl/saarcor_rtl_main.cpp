@@ -4,7 +4,7 @@
 //
 //   saarcor-rtl check FILE [--out OUT] [--max N]
 //
-//   saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection,caches]
+//   saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection,caches|dynrtc]
 //                        [--res WxH]
 //                        [--set KEY=VALUE ...] [--shadows] [--depth N] [--until CYCLE]
 //                        [--wave FILE] [--bench]
@@ -29,7 +29,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: saarcor-rtl check FILE [--out OUT] [--max N]\n"
-    "       saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection]\n"
+    "       saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection,caches|dynrtc]\n"
     "                            [--res WxH] [--set KEY=VALUE ...] [--shadows] [--depth N]\n"
     "                            [--until CYCLE] [--wave FILE] [--bench] [--fault NAME]\n"
     "  lockstep: runs the cycle model and the Verilated units (traversal, list, transformation,\n"
