@@ -61,6 +61,8 @@ class ListRtlOf final : public ListRtl {
     o.next = v.out_next;
     o.entry = v.out_entry;
     o.mask = get_bits(v.out_mask, 0, p_);
+    o.list = get_bits(v.out_list, 0, p_);
+    o.last = v.out_last;
     top_.rise();
     return o;
   }
@@ -142,9 +144,9 @@ class ListUnitRtl final : public UnitRtl {
       constexpr units::UnitId kTo[] = {units::UnitId::kTransformation, units::UnitId::kList,
                                        units::UnitId::kTraversal};
       e.path = kTo[std::min<std::uint32_t>(out.kind, 2)];
-      e.fields = 5;
+      e.fields = 7;
       e.names = units::kListOutputFields;
-      e.field = {out.kind, out.level, out.next, out.entry, out.mask};
+      e.field = {out.kind, out.level, out.next, out.entry, out.mask, out.list, out.last ? 1u : 0u};
     }
   }
 

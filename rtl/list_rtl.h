@@ -40,6 +40,8 @@ struct ListOutputs {
   bool out = false;
   std::uint32_t out_thread = 0, kind = 0, level = 0, next = 0, entry = 0;
   std::uint64_t mask = 0;
+  std::uint64_t list = 0;  // kind 0: the level's rays still in the list
+  bool last = false;       // kind 0: the entry was the list's last
 };
 
 class ListRtl {

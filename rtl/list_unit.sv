@@ -12,7 +12,10 @@
 //   Step (one cycle, at issue): the entry goes through the level's mailbox; if a ray still needs
 //   it, it goes to the transformation unit (kind 0, path d) with those rays, and a top-level
 //   entry (an object the thread enters) clears the triangle mailbox; otherwise the list goes on
-//   through the unit's own loop (kind 1) or, at its end, the traversal unit pops (kind 2).
+//   through the unit's own loop (kind 1) or, at its end, the traversal unit pops (kind 2). An
+//   entry carries on what the units after it need to route the thread (D49): the level's rays
+//   still in the list and whether the entry was its last (the cursor after it at the end),
+//   which travel with it through the transformation unit to the intersection unit (paths d, e).
 //   Side band (path a): a new packet clears the thread's object mailbox (D28).
 // The output leaves DEPTH cycles after the issue (the mailbox compare, lat_cmp).
 module list_unit #(
@@ -56,9 +59,11 @@ module list_unit #(
     output logic                 out_level,
     output logic [31:0]          out_next,
     output logic [31:0]          out_entry,
-    output logic [P-1:0]         out_mask
+    output logic [P-1:0]         out_mask,
+    output logic [P-1:0]         out_list,  // kind 0: the level's rays still in the list, else 0
+    output logic                 out_last   // kind 0: the entry was the list's last, else 0
 );
-  localparam int PW = 2 + 1 + 32 + 32 + P;
+  localparam int PW = 2 + 1 + 32 + 32 + P + P + 1;
   localparam int MBN = MB > 0 ? MB : 1;
   localparam int TMBN = TMB > 0 ? TMB : 1;
   localparam int MBB = MB > 1 ? $clog2(MB + 1) : 1;
@@ -106,7 +111,7 @@ module list_unit #(
   logic unused_acc;
   assign unused_acc = acc_valid;
   /* verilator lint_on UNUSEDSIGNAL */
-  assign {out_kind, out_level, out_next, out_entry, out_mask} = out_payload;
+  assign {out_kind, out_level, out_next, out_entry, out_mask, out_list, out_last} = out_payload;
 
   // ---- the list step of the issuing thread -----------------------------------------------------
   logic          lv;
@@ -158,8 +163,10 @@ module list_unit #(
   logic fin;  // the list was done on arrival: no entry was read (D49)
   assign fin = nx >= en || m == '0;
   assign kind = fin ? 2'd2 : todo != '0 ? 2'd0 : (nx1 < en && m != '0) ? 2'd1 : 2'd2;
-  assign iss_payload = {kind, lv, fin ? nx : nx1, kind == 2'd0 ? entry : 32'd0,
-                        kind == 2'd0 ? todo : m};
+  logic handed;  // the entry goes to the transformation unit
+  assign handed = kind == 2'd0;
+  assign iss_payload = {kind, lv, fin ? nx : nx1, handed ? entry : 32'd0, handed ? todo : m,
+                        handed ? m : {P{1'b0}}, handed && nx1 >= en};
 
   always_ff @(posedge clk) begin
     if (rst) begin

@@ -96,10 +96,41 @@ TEST(ListUnitRtl, EntryLeavesAfterFetchHitIssueAndDepthThenMailboxSkipPops) {
   EXPECT_EQ(m.out[0].second.entry, entry);
   EXPECT_EQ(m.out[0].second.mask, 0xFu);
   EXPECT_EQ(m.out[0].second.next, 101u);
+  EXPECT_EQ(m.out[0].second.list, 0xFu);  // the level's rays, on to the intersection unit
+  EXPECT_FALSE(m.out[0].second.last);     // entry 101 is left
   EXPECT_EQ(m.out[1].first, left2);
   EXPECT_EQ(m.out[1].second.kind, static_cast<std::uint32_t>(units::ListOut::kPop));
   EXPECT_EQ(m.out[1].second.mask, 0x3u);
   EXPECT_EQ(m.out[1].second.next, 102u);
+  EXPECT_EQ(m.out[1].second.list, 0u);  // a pop carries the list in its mask alone
+  EXPECT_FALSE(m.out[1].second.last);
+}
+
+// A list of one entry: the entry leaves as the list's last (its cursor after it at the end),
+// with the level's rays (0b0110) beside the rays that need it (the same two: an empty mailbox).
+TEST(ListUnitRtl, EntryThatEndsItsListLeavesMarkedLast) {
+  const std::uint64_t hit = static_cast<std::uint64_t>(memif::CacheConfig{}.hit_latency);
+  Mock m;
+  const std::uint32_t t = 2;
+  ListInputs& leaf = m.in[1];
+  leaf.valid[2] = leaf.start[2] = true;
+  leaf.thread[2] = t;
+  leaf.level[2] = true;  // a bottom-level list: the entry is a triangle
+  leaf.next[2] = 30;
+  leaf.end[2] = 31;
+  leaf.mask[2] = 0b0110;
+  m.in[1 + kPathLatency + hit].resp = true;
+  m.in[1 + kPathLatency + hit].resp_thread = t;
+  m.in[1 + kPathLatency + hit].resp_word = 7;
+  m.run(30);
+  ASSERT_EQ(m.out.size(), 1u);
+  EXPECT_EQ(m.out[0].second.kind, static_cast<std::uint32_t>(units::ListOut::kEntry));
+  EXPECT_EQ(m.out[0].second.level, 1u);
+  EXPECT_EQ(m.out[0].second.entry, 7u);
+  EXPECT_EQ(m.out[0].second.next, 31u);
+  EXPECT_EQ(m.out[0].second.mask, 0b0110u);
+  EXPECT_EQ(m.out[0].second.list, 0b0110u);
+  EXPECT_TRUE(m.out[0].second.last);
 }
 
 // Input priority (D25; units/dynrtp.cpp: the unit's loop, then the intersection unit, then path

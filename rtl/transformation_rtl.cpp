@@ -90,6 +90,8 @@ class TransformationRtlOf final : public UnitRtl {
     v.d_kind = e.field[1] != 0;
     v.d_entry = static_cast<std::uint32_t>(e.field[2]);
     put_bits(v.d_mask, 0, p_, e.field[3]);
+    put_bits(v.d_list, 0, p_, e.field[4]);
+    v.d_last = e.field[5] != 0;
   }
 
   // Path a: a packet to generate, per lane T, R'o, R'd.
@@ -128,13 +130,13 @@ class TransformationRtlOf final : public UnitRtl {
     BoundaryEvent& e =
         add_event(out, cycle, UnitId::kTransformation, BoundaryPort::kOutput, v.out_thread);
     e.path = kTo[v.out_dest & 3u];
-    e.fields = 5;
+    e.fields = 10;
     e.names = units::kTransformationOutputFields;
-    e.field[0] = v.out_dest;
-    e.field[1] = v.out_level;
-    e.field[2] = v.out_shared;
-    e.field[3] = get_bits(v.out_mask, 0, p_);
-    e.field[4] = v.out_root;
+    e.field = {v.out_dest,     v.out_level,
+               v.out_shared,   get_bits(v.out_mask, 0, p_),
+               v.out_root,     get_bits(v.out_list, 0, p_),
+               v.out_last,     v.out_instance,
+               v.out_triangle, v.out_shadow};
     for (int i = 0; i < p_; ++i) {
       for (int a = 0; a < 3; ++a)
         e.wide.push_back(static_cast<std::uint32_t>(get_bits(v.out_o, (3 * i + a) * kW, kW)));

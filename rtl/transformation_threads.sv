@@ -17,7 +17,11 @@
 //   shared one or +0 (the model's rule).
 //   Output: DEPTH cycles after the last step (its result forwarded), to the traversal unit (a
 //   level starts: after ray generation, or an object, with its box and root), the intersection
-//   unit (a triangle), or the RGS (generated shadow rays).
+//   unit (a triangle), or the RGS (generated shadow rays). A triangle carries on to the
+//   intersection unit what it needs beside the rays (units/boundary_intersection.h): the list's
+//   rays and last as path d brought them, the object the thread entered (its last object entry)
+//   and the triangle's id; a level start (to the traversal unit, or the RGS for shadow rays)
+//   carries the packet's shadow flag from path a. A field a destination does not carry is 0.
 module transformation_threads #(
     parameter int THREADS = 16,
     parameter int P       = 4,
@@ -30,12 +34,15 @@ module transformation_threads #(
     input  logic                 clk,
     input  logic                 rst,
     input  logic [31:0]          instance_row_base,  // the frame register
-    // Path d (from the list unit): kind 0 an object, 1 a triangle; the entry id; the rays.
+    // Path d (from the list unit): kind 0 an object, 1 a triangle; the entry id; the rays; the
+    // level's rays still in the list and whether the entry was its last (D49).
     input  logic                 d_valid,
     input  logic [TW-1:0]        d_thread,
     input  logic                 d_kind,
     input  logic [31:0]          d_entry,
     input  logic [P-1:0]         d_mask,
+    input  logic [P-1:0]         d_list,
+    input  logic                 d_last,
     // Path a (from the RGS): a packet. Lane i's T is a_t[i*288 +: 288] (m_r0, m_r1, m_r2, t_r for
     // r = 0, 1, 2, 24 bits each, lowest first), R'o a_ro[i*72 +: 72] (x lowest), R'd likewise.
     input  logic                 a_valid,
@@ -66,7 +73,14 @@ module transformation_threads #(
     output logic [P*72-1:0]      out_o,
     output logic [P*72-1:0]      out_d,
     output logic [71:0]          out_lo,
-    output logic [71:0]          out_hi
+    output logic [71:0]          out_hi,
+    // Dest 1 (path e): list, last, the object the thread entered and the triangle; else 0.
+    output logic [P-1:0]         out_list,
+    output logic                 out_last,
+    output logic [31:0]          out_instance,
+    output logic [31:0]          out_triangle,
+    // Dest 0 and 2 (a level starts): the packet's shadow flag; else 0.
+    output logic                 out_shadow
 );
   localparam int W = 24;
   localparam int DEPTH = LAT_MUL + 2 * LAT_ADD;
@@ -78,6 +92,9 @@ module transformation_threads #(
   logic [1:0]    op_r[THREADS];
   logic [31:0]   entry_r[THREADS];
   logic [P-1:0]  mask_r[THREADS];
+  logic [P-1:0]  list_r[THREADS];                      // path d's list and last
+  logic          last_r[THREADS];
+  logic [31:0]   inst_r[THREADS];                      // the object the thread entered
   logic          shadow_r[THREADS], shared_r[THREADS];
   logic [287:0]  gt_r[THREADS][P];                     // ray generation's T per lane
   logic [71:0]   gro_r[THREADS][P], grd_r[THREADS][P];  // and R'
@@ -245,6 +262,11 @@ module transformation_threads #(
   assign out_root = o_op == 2'(OpObject) ? root_r[out_thread] : 32'd0;
   assign out_lo = o_op == 2'(OpObject) ? lo_r[out_thread] : 72'd0;
   assign out_hi = o_op == 2'(OpObject) ? hi_r[out_thread] : 72'd0;
+  assign out_list = o_op == 2'(OpTriangle) ? list_r[out_thread] : '0;
+  assign out_last = o_op == 2'(OpTriangle) && last_r[out_thread];
+  assign out_instance = o_op == 2'(OpTriangle) ? inst_r[out_thread] : 32'd0;
+  assign out_triangle = o_op == 2'(OpTriangle) ? entry_r[out_thread] : 32'd0;
+  assign out_shadow = o_op != 2'(OpTriangle) && shadow_r[out_thread];
 
   // A response's row, unpacked (fp24: the fields at bits 0, 24, 48, 72 of the three words).
   logic [31:0] resp_row;
@@ -305,6 +327,9 @@ module transformation_threads #(
         op_r[d_thread] <= d_kind ? 2'(OpTriangle) : 2'(OpObject);
         entry_r[d_thread] <= d_entry;
         mask_r[d_thread] <= d_mask;
+        list_r[d_thread] <= d_list;
+        last_r[d_thread] <= d_last;
+        if (!d_kind) inst_r[d_thread] <= d_entry;
       end
       if (a_valid) begin
         op_r[a_thread] <= 2'(OpGen);

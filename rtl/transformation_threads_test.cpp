@@ -50,6 +50,7 @@ std::array<Row, 3> shift_x(std::uint32_t tx) {
 struct Leaving {
   std::uint64_t cycle = 0;
   std::uint32_t thread = 0, dest = 0, level = 0, mask = 0, root = 0;
+  std::uint32_t list = 0, last = 0, instance = 0, triangle = 0, shadow = 0;
   std::vector<Vec> o, d;
   Vec lo{}, hi{};
 };
@@ -73,13 +74,13 @@ class Rig {
     ctx_.reset();
     Verilated::threadContextp(Verilated::defaultContextp());
   }
-  // Path a: a primary packet (shared origin `o`, per lane direction d[i]) through matrix m.
+  // Path a: a packet (shared origin `o`, per lane direction d[i]) through matrix m.
   void generate(std::uint32_t thread, bool shared, const std::array<Row, 3>& m, const Vec& o,
-                const std::vector<Vec>& d) {
+                const std::vector<Vec>& d, bool shadow = false) {
     V& v = *v_;
     v.a_valid = 1;
     v.a_thread = static_cast<std::remove_reference_t<decltype(v.a_thread)>>(thread);
-    v.a_shadow = 0;
+    v.a_shadow = shadow;
     v.a_shared = shared;
     v.a_valid_lanes = 0xF;
     for (int i = 0; i < kLanes; ++i) {
@@ -91,14 +92,18 @@ class Rig {
       }
     }
   }
-  // Path d: an object (kind 0) or a triangle (kind 1).
-  void entry(std::uint32_t thread, bool triangle, std::uint32_t id, std::uint32_t mask) {
+  // Path d: an object (kind 0) or a triangle (kind 1), with the level's rays still in the list
+  // and whether the entry was its last.
+  void entry(std::uint32_t thread, bool triangle, std::uint32_t id, std::uint32_t mask,
+             std::uint32_t list, bool last) {
     V& v = *v_;
     v.d_valid = 1;
     v.d_thread = static_cast<std::remove_reference_t<decltype(v.d_thread)>>(thread);
     v.d_kind = triangle;
     v.d_entry = id;
     v.d_mask = mask;
+    v.d_list = list;
+    v.d_last = last;
   }
   void cycle() {
     V& v = *v_;
@@ -147,6 +152,11 @@ class Rig {
     l.level = v.out_level;
     l.mask = v.out_mask;
     l.root = v.out_root;
+    l.list = v.out_list;
+    l.last = v.out_last;
+    l.instance = v.out_instance;
+    l.triangle = v.out_triangle;
+    l.shadow = v.out_shadow;
     const auto field = [](const auto& port, int k) {
       return static_cast<std::uint32_t>(get_bits(port, k * 24, 24));
     };
@@ -166,14 +176,10 @@ const std::vector<Vec> kDirs = {
     {kOne, kZero, kZero}, {kZero, kOne, kZero}, {kZero, kZero, kOne}, {kHalf, kHalf, kZero}};
 const Vec kOrigin = {kHalf, kQuarter, kOne};
 
-// Ray generation, an object and a triangle of one thread: steps, fetches and rays.
-TEST(TransformationThreads, GenerationObjectAndTriangleInTheCyclesOfTheRules) {
-  const units::CycleParams p = units::prototype_params();
-  const auto depth = static_cast<std::uint64_t>(p.transformation_depth());  // mul + add + add
-  ASSERT_EQ(p.packet, kLanes);
-  Rig<Vxf_proto> rig;
-  // Instance 2: rows 112-117 (matrix: a shift by -1 in x; header: root 77, triangle rows at 500;
-  // box (0, 0, 0) .. (2, 1, 1)); triangle 4: rows 512-514 (a shift by +1 in x).
+// Instance 2: rows 112-117 (matrix: a shift by -1 in x; header: root 77, triangle rows at 500;
+// box (0, 0, 0) .. (2, 1, 1)); triangle 4: rows 512-514 (a shift by +1 in x).
+template <class V>
+void load_instance_and_triangle(Rig<V>& rig) {
   const auto inst = shift_x(kMinusOne);
   for (std::uint32_t r = 0; r < 3; ++r)
     rig.rows[kRowBase + 12 + r] = pack(inst[r]);
@@ -183,6 +189,15 @@ TEST(TransformationThreads, GenerationObjectAndTriangleInTheCyclesOfTheRules) {
   const auto tri = shift_x(kOne);
   for (std::uint32_t r = 0; r < 3; ++r)
     rig.rows[512 + r] = pack(tri[r]);
+}
+
+// Ray generation, an object and a triangle of one thread: steps, fetches and rays.
+TEST(TransformationThreads, GenerationObjectAndTriangleInTheCyclesOfTheRules) {
+  const units::CycleParams p = units::prototype_params();
+  const auto depth = static_cast<std::uint64_t>(p.transformation_depth());  // mul + add + add
+  ASSERT_EQ(p.packet, kLanes);
+  Rig<Vxf_proto> rig;
+  load_instance_and_triangle(rig);
 
   rig.run_to(5);
   rig.generate(9, true, shift_x(kOne), kOrigin, kDirs);
@@ -200,7 +215,7 @@ TEST(TransformationThreads, GenerationObjectAndTriangleInTheCyclesOfTheRules) {
 
   const std::uint64_t c = 120;
   rig.run_to(c);
-  rig.entry(9, false, 2, 0b0101);  // instance 2 for lanes 0 and 2
+  rig.entry(9, false, 2, 0b0101, 0b0111, false);  // instance 2 for lanes 0 and 2
   rig.run_to(200);
   // Six rows, one a cycle from the accept on; ready with the last response, issued a cycle on.
   ASSERT_EQ(rig.requests.size(), 6u);
@@ -224,7 +239,8 @@ TEST(TransformationThreads, GenerationObjectAndTriangleInTheCyclesOfTheRules) {
   }
 
   rig.run_to(220);
-  rig.entry(9, true, 4, 0b0001);  // triangle 4 (rows 500 + 3 * 4) for lane 0
+  // Triangle 4 (rows 500 + 3 * 4) for lane 0, the bottom-level list's last, rays 0 and 1 in it.
+  rig.entry(9, true, 4, 0b0001, 0b0011, true);
   rig.run_to(300);
   ASSERT_EQ(rig.requests.size(), 9u);
   EXPECT_EQ(rig.requests[6].second, 512u);
@@ -235,6 +251,39 @@ TEST(TransformationThreads, GenerationObjectAndTriangleInTheCyclesOfTheRules) {
   EXPECT_EQ(rig.out[2].o[0], world_o);
   EXPECT_EQ(rig.out[2].d[0], kDirs[0]);
   EXPECT_EQ(rig.out[2].d[1], (Vec{kZero, kZero, kZero}));  // lane 1 never entered a triangle
+}
+
+// What leaves beside the rays, for a shadow packet (path a's flag 1): a triangle (dest 1) takes
+// to the intersection unit its input fields, path d's list and last, the object the thread
+// entered (instance 2, though the triangle's id replaced the entry since) and the triangle, and
+// no shadow flag (that unit has it from path a's side band); a level start (generation to the
+// RGS, which decides to trace the shadow rays; the object to the traversal unit) the flag alone.
+TEST(TransformationThreads, TriangleCarriesTheIntersectionFieldsALevelStartTheShadowFlag) {
+  Rig<Vxf_proto> rig;
+  load_instance_and_triangle(rig);
+  rig.run_to(5);
+  rig.generate(3, true, shift_x(kOne), kOrigin, kDirs, true);
+  rig.run_to(60);
+  rig.entry(3, false, 2, 0b1111, 0b1111, true);  // the top-level list's last entry
+  rig.run_to(140);
+  rig.entry(3, true, 4, 0b0010, 0b0110, true);  // rays 1 and 2 in the bottom list, its last
+  rig.run_to(220);
+  ASSERT_EQ(rig.out.size(), 3u);
+  EXPECT_EQ(rig.out[0].dest, 2u);  // the RGS
+  EXPECT_EQ(rig.out[1].dest, 0u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(rig.out[k].shadow, 1u) << k;
+    EXPECT_EQ(rig.out[k].list, 0u) << k;
+    EXPECT_EQ(rig.out[k].last, 0u) << k;  // the object's last flag stays behind
+    EXPECT_EQ(rig.out[k].instance, 0u) << k;
+    EXPECT_EQ(rig.out[k].triangle, 0u) << k;
+  }
+  EXPECT_EQ(rig.out[2].dest, 1u);
+  EXPECT_EQ(rig.out[2].shadow, 0u);
+  EXPECT_EQ(rig.out[2].list, 0b0110u);
+  EXPECT_EQ(rig.out[2].last, 1u);
+  EXPECT_EQ(rig.out[2].instance, 2u);
+  EXPECT_EQ(rig.out[2].triangle, 4u);
 }
 
 // Without a shared origin a packet takes 2n steps, as does every packet of the fault build.

@@ -2,6 +2,7 @@
 #include "units/boundary.h"
 
 #include <cstdio>
+#include <iterator>
 #include <sstream>
 
 namespace saarcor::units {
@@ -162,7 +163,9 @@ void BoundaryRecorder::cache_response(std::uint64_t cycle, UnitId unit,
                                       const memif::CacheResponse& r) {
   if (!recorded(unit)) return;
   BoundaryEvent e = event(cycle, unit, BoundaryPort::kCacheResponse, r.label.tag);
-  const int words = r.count < kBoundaryFields - 1 ? r.count : kBoundaryFields - 1;
+  // The address, then at most as many words as the response's field names have.
+  constexpr int kMaxWords = static_cast<int>(std::size(kCacheResponseFields)) - 1;
+  const int words = r.count < kMaxWords ? r.count : kMaxWords;
   e.fields = 1 + words;
   e.names = kCacheResponseFields;
   e.field[0] = r.index;

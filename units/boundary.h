@@ -40,7 +40,8 @@ enum class BoundaryPort : std::uint8_t {
 inline constexpr int kBoundaryPorts = 11;
 const char* boundary_port_name(BoundaryPort p);
 
-inline constexpr int kBoundaryFields = 8;
+// The widest payload: the transformation unit's output (units/boundary_transformation.h).
+inline constexpr int kBoundaryFields = 10;
 // The cache port's payloads (the same for every unit): a request's item address and label, a
 // response's item address and words.
 inline constexpr const char* kCacheRequestFields[] = {"address", "requester", "tag"};

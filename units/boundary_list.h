@@ -7,7 +7,10 @@
 //   output: kind (0: an entry some ray still needs goes to the transformation unit, path d; 1: a
 //     skipped entry, the list goes on through the unit's loop; 2: the list is done, the traversal
 //     unit pops), level, next (the cursor after the entry), entry (kind 0: the instance or
-//     triangle id), mask (kind 0: the rays that still need the entry; else the rays in the list).
+//     triangle id), mask (kind 0: the rays that still need the entry; else the rays in the list),
+//     list and last (kind 0: the level's rays still in the list and whether the entry was its
+//     last, which travel with the entry through the transformation unit to the intersection
+//     unit, D49, as units/boundary_transformation.h's path d input carries them; else 0).
 // A resume's cursor is the unit's own (it holds next and end per thread and level); only the mask
 // comes with the thread: the intersection unit's any-hit terminations remove rays from it.
 #pragma once
@@ -24,7 +27,8 @@ namespace saarcor::units {
 enum class ListOut : std::uint8_t { kEntry = 0, kSkip = 1, kPop = 2 };
 
 inline constexpr const char* kListInputFields[] = {"op", "level", "next", "end", "mask"};
-inline constexpr const char* kListOutputFields[] = {"kind", "level", "next", "entry", "mask"};
+inline constexpr const char* kListOutputFields[] = {"kind", "level", "next", "entry",
+                                                    "mask", "list",  "last"};
 
 template <class F, int kLanes, class D>
 class ListPayload final : public BoundaryPayload {
@@ -74,15 +78,22 @@ class ListPayload final : public BoundaryPayload {
       kind = ListOut::kEntry;
     else if (s.phase == Phase::kList && after_[t] == level)
       kind = ListOut::kSkip;
-    std::uint64_t entry = 0, mask = s.list.mask(level);
+    std::uint64_t entry = 0, mask = s.list.mask(level), list = 0, last = 0;
     if (kind == ListOut::kEntry) {
       entry = level == Level::kTop ? s.list.instance() : s.list.triangle();
       mask = s.list.entry_mask();
+      list = s.list.mask(level);
+      last = s.list.next(level) >= s.list.end(level) ? 1u : 0u;
     }
-    e.fields = 5;
+    e.fields = 7;
     e.names = kListOutputFields;
-    e.field = {static_cast<std::uint64_t>(kind), static_cast<std::uint64_t>(level),
-               s.list.next(level), entry, mask};
+    e.field = {static_cast<std::uint64_t>(kind),
+               static_cast<std::uint64_t>(level),
+               s.list.next(level),
+               entry,
+               mask,
+               list,
+               last};
   }
 
  private:

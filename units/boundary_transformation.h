@@ -18,7 +18,12 @@
 //     entry's mask, or ray generation's valid lanes), root (dest 0, bottom: the object's kd-tree
 //     root, from its header row); wide: per lane the transformed ray O[3], D[3] (world rays,
 //     object-space rays or unit-triangle-space rays); an object's box after them (rows 4 and 5 of
-//     the instance record, lo[3], hi[3]), which the traversal unit clips against (D29).
+//     the instance record, lo[3], hi[3]), which the traversal unit clips against (D29); dest 1
+//     also carries what the intersection unit's input takes (units/boundary_intersection.h):
+//     list and last as path d brought them, instance (the object the thread entered: its last
+//     object entry) and triangle (the entry's id); dest 0 and 2 (a level starts at the traversal
+//     unit, after the RGS for shadow rays) carry shadow (the packet's kind, from path a). A field
+//     a destination does not carry is 0.
 // Steps: n + 1 for a packet whose rays share an origin, 2n otherwise, whatever the mask (D30).
 #pragma once
 
@@ -37,8 +42,8 @@ enum class TransformationOut : std::uint8_t { kTraversal = 0, kIntersection = 1,
 inline constexpr const char* kTransformationEntryFields[] = {"op",   "kind", "entry",
                                                              "mask", "list", "last"};
 inline constexpr const char* kTransformationGenerateFields[] = {"op", "shadow", "shared", "valid"};
-inline constexpr const char* kTransformationOutputFields[] = {"dest", "level", "shared", "mask",
-                                                              "root"};
+inline constexpr const char* kTransformationOutputFields[] = {
+    "dest", "level", "shared", "mask", "root", "list", "last", "instance", "triangle", "shadow"};
 // Wide words per lane: ray generation's input (T, R'o, R'd) and an output's ray (O, D).
 inline constexpr int kTransformationGenerateWords = 18;
 inline constexpr int kTransformationRayWords = 6;
@@ -87,11 +92,19 @@ class TransformationPayload final : public BoundaryPayload {
       dest = TransformationOut::kIntersection;
     else if (threads_.request(t).unit == UnitId::kRgs)
       dest = TransformationOut::kRgs;
-    e.fields = 5;
+    const bool triangle = dest == TransformationOut::kIntersection;
+    e.fields = 10;
     e.names = kTransformationOutputFields;
-    e.field = {static_cast<std::uint64_t>(dest), object ? 1u : 0u, s.shared_origin ? 1u : 0u,
+    e.field = {static_cast<std::uint64_t>(dest),
+               object ? 1u : 0u,
+               s.shared_origin ? 1u : 0u,
                done == Phase::kGenerate ? s.valid_mask() : s.list.entry_mask(),
-               object ? s.list.header().root : 0u};
+               object ? s.list.header().root : 0u,
+               triangle ? s.list.mask(Level::kBottom) : 0u,
+               triangle && s.list.next(Level::kBottom) >= s.list.end(Level::kBottom) ? 1u : 0u,
+               triangle ? s.list.instance() : 0u,
+               triangle ? s.list.triangle() : 0u,
+               !triangle && s.kind == RayKind::kShadow ? 1u : 0u};
     e.wide.clear();
     Ray<F> Lane<F>::*ray = done == Phase::kGenerate ? &Lane<F>::world
                            : object                 ? &Lane<F>::current
