@@ -96,6 +96,16 @@ module dynrtc #(
     input  logic [15:0]           rsp_client,
     input  logic [MW-1:0]         rsp_tag,
     input  logic [DW-1:0]         rsp_words,
+    // A chip-level routing instead of the DynRTC's own (ext_route: several DynRTCs share one
+    // controller port, as the model's pipelines do): the caches' memory sides, k = 0 node, 1 list,
+    // 2 row; the fill's tag and words are the routing's shared bus.
+    input  logic                  ext_route,
+    output logic [2:0]            x_mq_valid,
+    output logic [2:0]            x_fill_ready,
+    input  logic [2:0]            x_mem_take,
+    input  logic [2:0]            x_fill_valid,
+    input  logic [MW-1:0]         x_fill_tag,
+    input  logic [DW-1:0]         x_fill_words,
     // ---- the units' ports, observed ---------------------------------------------------------
     output logic                  tv_req,
     output logic [NODE_W-1:0]     tv_req_item,
@@ -191,6 +201,15 @@ module dynrtc #(
   logic [3*3-1:0]    c_req_requester;
   logic [3*LW-1:0]   c_req_tag;
   logic [2:0]        c_mq_valid, c_fill_ready;
+  logic [2:0]        r_mem_take, r_fill_valid;
+  logic [MW-1:0]     r_fill_tag;
+  logic [DW-1:0]     r_fill_words;
+  assign x_mq_valid = c_mq_valid;
+  assign x_fill_ready = c_fill_ready;
+  assign c_mem_take = ext_route ? x_mem_take : r_mem_take;
+  assign c_fill_valid = ext_route ? x_fill_valid : r_fill_valid;
+  assign c_fill_tag = ext_route ? x_fill_tag : r_fill_tag;
+  assign c_fill_words = ext_route ? x_fill_words : r_fill_words;
 
   // ---- traversal ------------------------------------------------------------------------------
   logic tv_req_valid;
@@ -394,11 +413,11 @@ module dynrtc #(
   logic r_fwd_valid, r_overflow, r_unknown;
   logic [1:0] r_fwd_client;
   routing #(.CLIENTS(3), .RESP_CAP(RESP_CAP), .TAG_W(MW), .WORDS(4)) route (
-      .clk, .rst, .cfg_id, .mq_valid(c_mq_valid), .mem_take(c_mem_take), .port_blocked,
-      .fwd_valid(r_fwd_valid), .fwd_client(r_fwd_client),
-      .rsp_valid, .rsp_client, .rsp_tag, .rsp_words,
-      .fill_ready(c_fill_ready), .fill_valid(c_fill_valid), .fill_tag(c_fill_tag),
-      .fill_words(c_fill_words), .overflow(r_overflow), .unknown_client(r_unknown));
+      .clk, .rst, .cfg_id, .mq_valid(ext_route ? 3'b000 : c_mq_valid), .mem_take(r_mem_take),
+      .port_blocked, .fwd_valid(r_fwd_valid), .fwd_client(r_fwd_client),
+      .rsp_valid(rsp_valid && !ext_route), .rsp_client, .rsp_tag, .rsp_words,
+      .fill_ready(c_fill_ready), .fill_valid(r_fill_valid), .fill_tag(r_fill_tag),
+      .fill_words(r_fill_words), .overflow(r_overflow), .unknown_client(r_unknown));
   assign routing_error = r_overflow || r_unknown;
   /* verilator lint_off UNUSEDSIGNAL */
   logic unused_fwd;

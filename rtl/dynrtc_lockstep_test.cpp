@@ -5,6 +5,8 @@
 // and secondary rays, and with 2-way caches. (The units alone: rtl/lockstep_test.cpp.)
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -104,6 +106,28 @@ TEST(DynrtcLockstep, DuckGltf) {
   expect_whole_agrees(run_dynrtc(std::string(SAARCOR_SHARED_SCENES) + "/Duck/Duck.gltf", {}));
 }
 
+// pipelines=2: two whole DynRTCs on one RTL routing share the model's memory controller; every
+// event of both is compared (the second's threads are the model's ids 64..127).
+TEST(DynrtcLockstep, TwoPipelinesShareOneRoutingAndTheController) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
+  std::vector<units::BoundaryEvent> events;
+  LockstepOptions o;
+  o.units = {"dynrtc"};
+  o.scene = "builtin:room";
+  o.set = {"pipelines=2"};
+  std::array<std::uint64_t, 2> outputs{};
+  o.model_events = [&](const units::BoundaryEvent& e) {
+    if (e.port == BoundaryPort::kOutput && !e.cache) ++outputs[static_cast<std::size_t>(e.dynrtp)];
+  };
+  const LockstepResult r = run_lockstep(o);
+  expect_whole_agrees(r);
+  // Both DynRTPs worked; 192 packets between them, each generated once.
+  EXPECT_GT(outputs[0], 0u);
+  EXPECT_GT(outputs[1], 0u);
+  EXPECT_EQ(r.unit("dynrtc").event(BoundaryPort::kInput), 192u);
+  EXPECT_EQ(r.unit("dynrtc").event(BoundaryPort::kOutput), outputs[0] + outputs[1]);
+}
+
 TEST(DynrtcLockstep, RunsAloneAndOnlyOnItsBuildsConfigurations) {
   LockstepOptions o;
   o.scene = "builtin:room";
@@ -118,6 +142,11 @@ TEST(DynrtcLockstep, RunsAloneAndOnlyOnItsBuildsConfigurations) {
     EXPECT_NE(std::string(e.what()).find("prototype's latencies"), std::string::npos) << e.what();
   }
   o.set = {"cache.traversal.ways=3"};
+  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  o.set = {"pipelines=3"};
+  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  o.units = {"list"};
+  o.set = {"pipelines=2"};  // two DynRTPs run only as whole DynRTCs
   EXPECT_THROW(run_lockstep(o), std::runtime_error);
 }
 

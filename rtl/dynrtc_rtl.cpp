@@ -24,16 +24,21 @@ using units::UnitId;
 
 constexpr UnitId kCacheUnits[3] = {UnitId::kTraversal, UnitId::kList, UnitId::kTransformation};
 
+// One Verilated DynRTC as a part of the lockstep: its boundary's inputs driven, its ports read
+// as the model's records. Pipeline q's threads are the model's ids [q x threads, (q + 1) x
+// threads): its events are moved to the RTL's ids (0 ..) on the way in and back on the way out.
 template <class V>
-class DynrtcRtlOf final : public UnitRtl {
+class DynrtcCore {
  public:
-  DynrtcRtlOf(const DynrtcBuild& b, const DynrtcConfig& c)
-      : tw_(thread_bits(b.threads)), p_(b.packet), config_(c) {}
+  DynrtcCore(const DynrtcBuild& b, const DynrtcConfig& c, bool ext_route, int pipe)
+      : tw_(thread_bits(b.threads)),
+        p_(b.packet),
+        pipe_(pipe),
+        offset_(static_cast<std::uint32_t>(pipe * b.threads)),
+        ext_route_(ext_route),
+        config_(c) {}
 
-  UnitId unit() const override { return UnitId::kNone; }
-  std::string name() const override { return "dynrtc"; }
-
-  void reset() override {
+  void reset() {
     V& v = *top_;
     constexpr int kW = kPortFloatBits;
     for (int k = 0; k < 3; ++k) {
@@ -49,18 +54,33 @@ class DynrtcRtlOf final : public UnitRtl {
     }
     v.top_root = config_.frame.top_root;
     v.instance_row_base = config_.frame.instance_row_base;
+    v.ext_route = ext_route_;
     clear_inputs();
     top_.reset();
   }
 
-  void cycle(std::uint64_t cycle, const std::vector<BoundaryEvent>& inputs,
-             std::vector<BoundaryEvent>& outputs) override {
-    V& v = *top_;
+  // The cycle's boundary events of this DynRTP onto its ports, and the clock low.
+  void drive(const std::vector<BoundaryEvent>& inputs) {
     clear_inputs();
     int clears = 0, starts = 0;
-    for (const BoundaryEvent& e : inputs)
-      drive(e, clears, starts);
+    for (const BoundaryEvent& e : inputs) {
+      if (e.dynrtp != pipe_ && e.port != BoundaryPort::kPortResponse &&
+          e.port != BoundaryPort::kPortBlocked)
+        continue;
+      BoundaryEvent local = e;
+      local.thread -= offset_;
+      drive(local, clears, starts);
+    }
     top_.fall();
+  }
+
+  V& ports() { return *top_; }
+  // The routing's inputs changed (a chip-level routing): the DynRTC settles again.
+  void settle() { top_->eval(); }
+
+  // The cycle's outputs, checked and recorded.
+  void outputs(std::uint64_t cycle, std::vector<BoundaryEvent>& out) const {
+    V& v = *top_;
     if (v.conflict)
       throw std::runtime_error(
           "lockstep: two threads for the list unit's path from the traversal "
@@ -71,17 +91,30 @@ class DynrtcRtlOf final : public UnitRtl {
           "lockstep: the routing's response channel overflowed or a response "
           "named no cache in cycle " +
           std::to_string(cycle));
-    traversal_and_list(cycle, outputs);
-    transformation_and_intersection(cycle, outputs);
+    const std::size_t first = out.size();
+    traversal_and_list(cycle, out);
+    transformation_and_intersection(cycle, out);
     for (int k = 0; k < 3; ++k)
-      cache(cycle, k, outputs);
-    top_.rise();
+      cache(cycle, k, out);
+    for (std::size_t i = first; i < out.size(); ++i)
+      to_model(out[i]);
   }
 
-  void start_trace(const std::string& path) override { top_.start_trace(path); }
-  void stop_trace() override { top_.stop_trace(); }
+  void rise() { top_.rise(); }
+  void start_trace(const std::string& path) { top_.start_trace(path); }
+  void stop_trace() { top_.stop_trace(); }
 
  private:
+  // An RTL record in the model's thread ids: the thread and a cache label's tag.
+  void to_model(BoundaryEvent& e) const {
+    e.dynrtp = pipe_;
+    const bool labelled = e.port == BoundaryPort::kCacheRequest ||
+                          e.port == BoundaryPort::kCacheAccept ||
+                          e.port == BoundaryPort::kCacheReply;
+    if (!e.cache || labelled) e.thread += offset_;  // (a line request's record has no thread)
+    if (labelled) e.field[2] += offset_;
+  }
+
   void clear_inputs() {
     V& v = *top_;
     v.a_valid = 0;
@@ -91,6 +124,8 @@ class DynrtcRtlOf final : public UnitRtl {
     v.ld_valid = 0;
     v.port_blocked = 0;
     v.rsp_valid = 0;
+    v.x_mem_take = 0;
+    v.x_fill_valid = 0;
   }
 
   // A model event at the DynRTC's boundary onto its ports; the others are the RTL's own.
@@ -126,7 +161,6 @@ class DynrtcRtlOf final : public UnitRtl {
         return;  // a cache's request, response or back-pressure: wired inside
     }
   }
-
   void traversal_and_list(std::uint64_t cycle, std::vector<BoundaryEvent>& out) const {
     V& v = *top_;
     if (v.tv_req)
@@ -214,10 +248,114 @@ class DynrtcRtlOf final : public UnitRtl {
     }
   }
 
-  int tw_, p_;
+  int tw_, p_, pipe_;
+  std::uint32_t offset_;
+  bool ext_route_;
   DynrtcConfig config_;
   VerilatedTop<V> top_;
 };
+
+// The whole DynRTC of pipelines=1: one top with its own routing.
+template <class V>
+class DynrtcRtlOf final : public UnitRtl {
+ public:
+  DynrtcRtlOf(const DynrtcBuild& b, const DynrtcConfig& c) : core_(b, c, false, 0) {}
+  UnitId unit() const override { return UnitId::kNone; }
+  std::string name() const override { return "dynrtc"; }
+  void reset() override { core_.reset(); }
+  void cycle(std::uint64_t cycle, const std::vector<BoundaryEvent>& inputs,
+             std::vector<BoundaryEvent>& outputs) override {
+    core_.drive(inputs);
+    core_.outputs(cycle, outputs);
+    core_.rise();
+  }
+  void start_trace(const std::string& path) override { core_.start_trace(path); }
+  void stop_trace() override { core_.stop_trace(); }
+
+ private:
+  DynrtcCore<V> core_;
+};
+
+#if defined(SAARCOR_DYNRTC_ROUTING)
+// Two whole DynRTCs (pipelines=2) on one RTL routing over their six caches (rtl/routing.sv, the
+// model's one SimpleRouting over every pipeline's clients): each DynRTC takes the chip-level
+// routing (ext_route), whose takes and fills the wires below carry in the same cycle (the caches'
+// line-request queue and fill room are registers: the routing settles after the DynRTCs, the
+// DynRTCs after it).
+template <class V, class R>
+class DynrtcPairRtl final : public UnitRtl {
+ public:
+  DynrtcPairRtl(const DynrtcBuild& b, const std::vector<DynrtcConfig>& c) {
+    for (int q = 0; q < 2; ++q)
+      cores_.push_back(std::make_unique<DynrtcCore<V>>(b, c[static_cast<std::size_t>(q)], true, q));
+    for (int i = 0; i < 6; ++i)
+      put_bits(route_->cfg_id, 16 * i, 16,
+               c[static_cast<std::size_t>(i / 3)].clients[static_cast<std::size_t>(i % 3)]);
+  }
+  UnitId unit() const override { return UnitId::kNone; }
+  std::string name() const override { return "dynrtc"; }
+  void reset() override {
+    for (auto& c : cores_)
+      c->reset();
+    route_->port_blocked = 0;
+    route_->rsp_valid = 0;
+    route_.reset();
+  }
+
+  void cycle(std::uint64_t cycle, const std::vector<BoundaryEvent>& inputs,
+             std::vector<BoundaryEvent>& outputs) override {
+    R& r = *route_;
+    r.port_blocked = 0;
+    r.rsp_valid = 0;
+    for (const BoundaryEvent& e : inputs)
+      port(e);
+    for (int q = 0; q < 2; ++q) {
+      cores_[static_cast<std::size_t>(q)]->drive(inputs);
+      const auto& v = cores_[static_cast<std::size_t>(q)]->ports();
+      put_bits(r.mq_valid, 3 * q, 3, v.x_mq_valid);
+      put_bits(r.fill_ready, 3 * q, 3, v.x_fill_ready);
+    }
+    route_.fall();
+    if (r.overflow || r.unknown_client)
+      throw std::runtime_error(
+          "lockstep: the routing's response channel overflowed or a response "
+          "named no cache in cycle " +
+          std::to_string(cycle));
+    for (int q = 0; q < 2; ++q) {
+      auto& v = cores_[static_cast<std::size_t>(q)]->ports();
+      v.x_mem_take = static_cast<CData>(get_bits(r.mem_take, 3 * q, 3));
+      v.x_fill_valid = static_cast<CData>(get_bits(r.fill_valid, 3 * q, 3));
+      v.x_fill_tag = r.fill_tag;
+      for (int w = 0; w < 4; ++w)
+        put_bits(v.x_fill_words, 32 * w, 32, get_bits(r.fill_words, 32 * w, 32));
+      cores_[static_cast<std::size_t>(q)]->settle();
+      cores_[static_cast<std::size_t>(q)]->outputs(cycle, outputs);
+    }
+    for (auto& c : cores_)
+      c->rise();
+    route_.rise();
+  }
+  void start_trace(const std::string& path) override { cores_[0]->start_trace(path); }
+  void stop_trace() override { cores_[0]->stop_trace(); }
+
+ private:
+  // The controller port's events onto the routing.
+  void port(const BoundaryEvent& e) {
+    R& r = *route_;
+    if (e.port == BoundaryPort::kPortBlocked) r.port_blocked = 1;
+    if (e.port != BoundaryPort::kPortResponse) return;
+    if (r.rsp_valid) throw std::logic_error("lockstep: two port responses in one cycle");
+    r.rsp_valid = 1;
+    r.rsp_client = static_cast<std::uint16_t>(e.field[0]);
+    put_bits(r.rsp_tag, 0, 32, e.field[1]);
+    for (int k = 0; k + 2 < e.fields; ++k)
+      put_bits(r.rsp_words, 32 * k, 32, e.field[static_cast<std::size_t>(k) + 2]);
+  }
+
+  std::vector<std::unique_ptr<DynrtcCore<V>>> cores_;
+  VerilatedTop<R> route_;
+};
+#endif
 
 }  // namespace
 
@@ -232,11 +370,19 @@ const std::vector<DynrtcBuild>& dynrtc_builds() {
 }
 
 std::unique_ptr<UnitRtl> make_dynrtc_rtl(const DynrtcBuild& build,
-                                         [[maybe_unused]] const DynrtcConfig& config) {
-#define SAARCOR_DYNRTC_BUILD(id, cls, threads, packet, stack, mb, tmb) \
-  if (build.name == #id) return std::make_unique<DynrtcRtlOf<cls>>(build, config);
+                                         [[maybe_unused]] const std::vector<DynrtcConfig>& config) {
+  if (config.size() != 1 && config.size() != 2)
+    throw std::runtime_error("lockstep: one or two whole DynRTCs, not " +
+                             std::to_string(config.size()));
+#if defined(SAARCOR_DYNRTC_ROUTING)
+#define SAARCOR_DYNRTC_BUILD(id, cls, threads, packet, stack, mb, tmb)                   \
+  if (build.name == #id) {                                                               \
+    if (config.size() == 1) return std::make_unique<DynrtcRtlOf<cls>>(build, config[0]); \
+    return std::make_unique<DynrtcPairRtl<cls, SAARCOR_DYNRTC_ROUTING>>(build, config);  \
+  }
   SAARCOR_DYNRTC_BUILDS(SAARCOR_DYNRTC_BUILD)
 #undef SAARCOR_DYNRTC_BUILD
+#endif
   throw std::runtime_error("no Verilated whole-DynRTC build named '" + build.name + "'");
 }
 

@@ -8,6 +8,8 @@
 // (each cache's mem_taken and mem_fill).
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,7 +36,10 @@ struct DynrtcConfig {
   std::array<std::uint16_t, 3> clients{};
 };
 
-// name() is "dynrtc"; unit() is UnitId::kNone (the lockstep gives it every event of the run).
-std::unique_ptr<UnitRtl> make_dynrtc_rtl(const DynrtcBuild& build, const DynrtcConfig& config);
+// One whole DynRTC per configuration: one (with its own routing) or two (pipelines=2: one RTL
+// routing over their six caches, the model's routing). name() is "dynrtc"; unit() is
+// UnitId::kNone (the lockstep gives it every event of the run).
+std::unique_ptr<UnitRtl> make_dynrtc_rtl(const DynrtcBuild& build,
+                                         const std::vector<DynrtcConfig>& config);
 
 }  // namespace saarcor::rtl

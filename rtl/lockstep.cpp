@@ -217,7 +217,7 @@ class Lockstep {
 
   // Events of a cycle are ordered by port, then by the unit or cache whose they are.
   static int source(const BoundaryEvent& e) {
-    return 2 * units::unit_index(e.unit) + (e.cache ? 1 : 0);
+    return 2 * (units::kMaxUnits * e.dynrtp + units::unit_index(e.unit)) + (e.cache ? 1 : 0);
   }
   static bool before(const BoundaryEvent& a, const BoundaryEvent& b) {
     if (a.cycle != b.cycle) return a.cycle < b.cycle;
@@ -281,13 +281,14 @@ class Lockstep {
     const BoundaryEvent& e = model != nullptr ? *model : *rtl;
     div_.cycle = e.cycle;
     div_.unit = source_name(e);
+    div_.dynrtp = e.dynrtp;
     div_.port = units::boundary_port_name(e.port);
     div_.kind = kind;
     div_.other_cycle = other;
     first_difference(model, rtl);
     std::ostringstream s;
-    s << "saarcor-rtl lockstep: DIVERGENCE at cycle " << div_.cycle << ", dynrtp0 " << div_.unit
-      << " unit, port " << div_.port << ", field " << div_.field << "\n";
+    s << "saarcor-rtl lockstep: DIVERGENCE at cycle " << div_.cycle << ", dynrtp" << div_.dynrtp
+      << " " << div_.unit << " unit, port " << div_.port << ", field " << div_.field << "\n";
     s << "  class: " << kind;
     if (div_.kind == "timing")
       s << " (" << (model != nullptr ? "the RTL has it at cycle " : "the model has it at cycle ")
@@ -307,7 +308,8 @@ class Lockstep {
                std::uint64_t cycle) const {
     std::vector<const BoundaryEvent*> last;
     for (auto it = h.rbegin(); it != h.rend() && last.size() < 16; ++it)
-      if (it->cycle <= cycle && source_name(*it) == div_.unit) last.push_back(&*it);
+      if (it->cycle <= cycle && source_name(*it) == div_.unit && it->dynrtp == div_.dynrtp)
+        last.push_back(&*it);
     s << "  the last " << last.size() << " events of the " << div_.unit << " unit, " << side
       << ":\n";
     for (auto it = last.rbegin(); it != last.rend(); ++it)
@@ -509,13 +511,17 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
                std::vector<std::uint32_t>* frame = nullptr) {
   using State = units::PacketState<F, kLanes, units::FastDatapath>;
   memif::MemoryImage image = image_in;
-  LockstepThreads<F, kLanes> threads(image, units::functional_params(p, shading), p.threads);
+  // DynRTP q's threads are ids [q x threads, (q + 1) x threads) of one table (units::DynRtp).
+  LockstepThreads<F, kLanes> threads(image, units::functional_params(p, shading),
+                                     p.threads * p.pipelines);
   hw::KernelConfig kc;
   kc.watchdog_cycles = p.watchdog;
   hw::Kernel k(kc);
   memif::MemorySystem mi(k, image, units::memory_system_config(p));
-  units::RayGenerationController rgc(threads.packets(), 1);
-  units::DynRtp d(k, mi, p, threads, rgc, 0);
+  units::RayGenerationController rgc(threads.packets(), p.pipelines);
+  std::vector<std::unique_ptr<units::DynRtp>> pipes;
+  for (int q = 0; q < p.pipelines; ++q)
+    pipes.push_back(std::make_unique<units::DynRtp>(k, mi, p, threads, rgc, q));
   const auto state = [&](units::ThreadToken t) -> const State& { return threads.state(t); };
   units::ListPayload<F, kLanes, units::FastDatapath> list(threads, state);
   units::TraversalPayload<F, kLanes, units::FastDatapath> traversal(threads, state);
@@ -530,12 +536,16 @@ void run_model(const memif::MemoryImage& image_in, const units::CycleParams& p,
   units::BoundaryRecorder rec(threads, p.threads, recorded.units, payloads, sink);
   std::optional<units::CacheRecorder> caches;  // (the units' hooks through it to `rec`)
   if (cs != nullptr && !recorded.caches.empty())
-    caches.emplace(mi, image, recorded.caches, &rec, sink);
+    caches.emplace(mi, image, recorded.caches, &rec, sink, p.pipelines, p.threads);
   if (caches && recorded.port) caches->record_port(mi);
   if (cs != nullptr)  // (none: the model alone, for the speed beside it)
-    d.observe(caches ? static_cast<units::UnitObserver*>(&*caches) : &rec);
+    for (auto& d : pipes)
+      d->observe(caches ? static_cast<units::UnitObserver*>(&*caches) : &rec);
   const auto done = [&] {
-    return rgc.all_handed_out() && d.rgs().idle() && mi.frame_writes_stored();
+    bool idle = rgc.all_handed_out() && mi.frame_writes_stored();
+    for (const auto& d : pipes)
+      idle = idle && d->rgs().idle();
+    return idle;
   };
   const hw::RunResult r = k.run(done);
   if (r.status == hw::RunResult::Status::kWatchdog)
@@ -600,9 +610,12 @@ units::CycleParams run_params(const LockstepOptions& o, host::ImageParams& ip) {
     else
       units::apply_cycle_setting(p, kv);
   units::check_cycle_params(p);
-  if (p.pipelines != 1)
-    throw std::runtime_error("lockstep: the harness drives one DynRTP (pipelines=1), not " +
-                             std::to_string(p.pipelines));
+  const bool whole = o.units.size() == 1 && o.units[0] == "dynrtc";
+  if (p.pipelines != 1 && !(whole && p.pipelines == 2))
+    throw std::runtime_error(
+        "lockstep: the harness drives one DynRTP (pipelines=1), or two whole "
+        "DynRTCs (--units dynrtc, pipelines=2), not " +
+        std::to_string(p.pipelines));
   return p;
 }
 
@@ -762,16 +775,19 @@ memif::ItemType cache_type(UnitId served) {
 std::unique_ptr<UnitRtl> make_rtl(const Chosen& c, const units::CycleParams& p,
                                   const memif::MemoryImage& image) {
   if (c.dynrtc != nullptr) {
-    DynrtcConfig config;
-    config.frame = image.registers();
-    for (int k = 0; k < memif::kItemTypes; ++k) {
-      const auto type = static_cast<memif::ItemType>(k);
-      const auto t = static_cast<std::size_t>(k);
-      config.caches[t] = {p.cache[t].items, p.cache[t].ways, image.item_words(type),
-                          image.regions().base[t]};
-      config.clients[t] = memif::MemorySystem::cache_client(0, type);
+    std::vector<DynrtcConfig> configs(static_cast<std::size_t>(p.pipelines));
+    for (int q = 0; q < p.pipelines; ++q) {
+      DynrtcConfig& config = configs[static_cast<std::size_t>(q)];
+      config.frame = image.registers();
+      for (int k = 0; k < memif::kItemTypes; ++k) {
+        const auto type = static_cast<memif::ItemType>(k);
+        const auto t = static_cast<std::size_t>(k);
+        config.caches[t] = {p.cache[t].items, p.cache[t].ways, image.item_words(type),
+                            image.regions().base[t]};
+        config.clients[t] = memif::MemorySystem::cache_client(q, type);
+      }
     }
-    return make_dynrtc_rtl(*c.dynrtc, config);
+    return make_dynrtc_rtl(*c.dynrtc, configs);
   }
   if (c.cache != nullptr) {
     const memif::ItemType type = cache_type(c.served);

@@ -58,6 +58,7 @@ struct LockstepOptions {
 
 struct Divergence {
   std::uint64_t cycle = 0;
+  int dynrtp = 0;
   std::string unit, port, field, kind;  // kind: payload, order, timing, missing, extra
   std::uint64_t model_value = 0, rtl_value = 0;
   std::uint64_t other_cycle = 0;  // timing: the RTL's cycle of the model's event (or vice versa)

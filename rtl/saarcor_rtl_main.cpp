@@ -29,7 +29,8 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: saarcor-rtl check FILE [--out OUT] [--max N]\n"
-    "       saarcor-rtl lockstep SCENE [--units traversal,list,transformation,intersection,caches|dynrtc]\n"
+    "       saarcor-rtl lockstep SCENE [--units "
+    "traversal,list,transformation,intersection,caches|dynrtc]\n"
     "                            [--res WxH] [--set KEY=VALUE ...] [--shadows] [--depth N]\n"
     "                            [--until CYCLE] [--wave FILE] [--bench] [--fault NAME]\n"
     "  lockstep: runs the cycle model and the Verilated units (traversal, list, transformation,\n"

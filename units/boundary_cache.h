@@ -62,16 +62,20 @@ class CacheRecorder final : public UnitObserver,
                             public memif::PortObserver {
  public:
   using Sink = std::function<void(const BoundaryEvent&)>;
+  // The caches of the first `pipelines` DynRTPs, whose threads are ids [p x
+  // threads_per_pipeline, (p + 1) x threads_per_pipeline) (BoundaryEvent::dynrtp is p).
   CacheRecorder(memif::MemorySystem& mi, const memif::MemoryImage& image,
-                const std::vector<memif::ItemType>& types, UnitObserver* next, Sink sink)
-      : image_(image), next_(next), sink_(std::move(sink)) {
-    for (memif::ItemType t : types) {
-      memif::Cache& c = mi.cache(0, t);
-      c.set_observer(this);
-      recorded_[static_cast<std::size_t>(unit_index(cache_unit(t)))] = true;
-      if (client_.size() <= c.client()) client_.resize(c.client() + 1u, UnitId::kNone);
-      client_[c.client()] = cache_unit(t);
-    }
+                const std::vector<memif::ItemType>& types, UnitObserver* next, Sink sink,
+                int pipelines = 1, int threads_per_pipeline = 0)
+      : image_(image), next_(next), sink_(std::move(sink)), per_pipeline_(threads_per_pipeline) {
+    for (int p = 0; p < pipelines; ++p)
+      for (memif::ItemType t : types) {
+        memif::Cache& c = mi.cache(p, t);
+        c.set_observer(this);
+        recorded_[static_cast<std::size_t>(unit_index(cache_unit(t)))] = true;
+        if (client_.size() <= c.client()) client_.resize(c.client() + 1u, {UnitId::kNone, 0});
+        client_[c.client()] = {cache_unit(t), p};
+      }
     mi.routing().set_observer(this);
   }
 
@@ -110,6 +114,7 @@ class CacheRecorder final : public UnitObserver,
     if (!recorded(u)) return;
     BoundaryEvent& e =
         event(c, u, BoundaryPort::kCacheRequest, r.label.tag, 3, kCacheRequestFields);
+    e.dynrtp = thread_pipe(r.label.tag);
     e.field = {r.index, r.label.requester, r.label.tag};
     sink_(e);
   }
@@ -118,6 +123,7 @@ class CacheRecorder final : public UnitObserver,
     if (!recorded(u)) return;
     BoundaryEvent& e =
         event(c, u, BoundaryPort::kCacheReply, r.label.tag, 3 + r.count, kCacheReplyFields);
+    e.dynrtp = thread_pipe(r.label.tag);
     e.field = {r.index, r.label.requester, r.label.tag};
     for (int k = 0; k < r.count; ++k)
       e.field[3 + static_cast<std::size_t>(k)] = r.words[static_cast<std::size_t>(k)];
@@ -138,6 +144,7 @@ class CacheRecorder final : public UnitObserver,
     const memif::WordLocation loc = image_.locate(cache.type(), item, 0);
     BoundaryEvent& e =
         event(c, cache_unit(cache.type()), BoundaryPort::kMemRequest, 0, 4, kMemRequestFields);
+    e.dynrtp = client_pipe(cache.client());
     e.field = {static_cast<std::uint64_t>(mshr), static_cast<std::uint64_t>(loc.bank), loc.offset,
                static_cast<std::uint64_t>(image_.item_words(cache.type()))};
     sink_(e);
@@ -147,12 +154,15 @@ class CacheRecorder final : public UnitObserver,
   // memif::RoutingObserver: the memory side's inputs.
   void forwarded(std::uint64_t c, const memif::MemRequest& r) override {
     const UnitId u = of_client(r.client);
-    if (u != UnitId::kNone) sink_(event(c, u, BoundaryPort::kMemTaken, 0, 0, nullptr));
+    if (u == UnitId::kNone) return;
+    event(c, u, BoundaryPort::kMemTaken, 0, 0, nullptr).dynrtp = client_pipe(r.client);
+    sink_(e_);
   }
   void delivered(std::uint64_t c, const memif::MemResponse& r) override {
     const UnitId u = of_client(r.client);
     if (u == UnitId::kNone) return;
     BoundaryEvent& e = event(c, u, BoundaryPort::kMemFill, 0, 1 + r.count, kMemFillFields);
+    e.dynrtp = client_pipe(r.client);
     e.field = {r.tag};
     for (int k = 0; k < r.count; ++k)
       e.field[1 + static_cast<std::size_t>(k)] = r.words[static_cast<std::size_t>(k)];
@@ -166,6 +176,7 @@ class CacheRecorder final : public UnitObserver,
   void responded(std::uint64_t c, const memif::MemResponse& r) override {
     BoundaryEvent& e =
         event(c, of_client(r.client), BoundaryPort::kPortResponse, 0, 2 + r.count, kPortFields);
+    e.dynrtp = client_pipe(r.client);
     e.field = {r.client, r.tag};
     for (int k = 0; k < r.count; ++k)
       e.field[2 + static_cast<std::size_t>(k)] = r.words[static_cast<std::size_t>(k)];
@@ -175,7 +186,13 @@ class CacheRecorder final : public UnitObserver,
  private:
   bool recorded(UnitId u) const { return recorded_[static_cast<std::size_t>(unit_index(u))]; }
   UnitId of_client(std::uint16_t client) const {
-    return client < client_.size() ? client_[client] : UnitId::kNone;
+    return client < client_.size() ? client_[client].unit : UnitId::kNone;
+  }
+  int client_pipe(std::uint16_t client) const {
+    return client < client_.size() ? client_[client].pipe : 0;
+  }
+  int thread_pipe(std::uint32_t thread) const {
+    return per_pipeline_ > 0 ? static_cast<int>(thread) / per_pipeline_ : 0;
   }
   BoundaryEvent& event(std::uint64_t cycle, UnitId u, BoundaryPort port, std::uint32_t thread,
                        int fields, const char* const* names) {
@@ -195,6 +212,7 @@ class CacheRecorder final : public UnitObserver,
                              kCacheAcceptFields);
     e.field = {item, label.requester, label.tag, static_cast<std::uint64_t>(kind),
                static_cast<std::uint64_t>(mshr)};
+    e.dynrtp = client_pipe(cache.client());
     sink_(e);
   }
 
@@ -202,8 +220,13 @@ class CacheRecorder final : public UnitObserver,
   UnitObserver* next_;
   Sink sink_;
   std::array<bool, kMaxUnits> recorded_{};
-  std::vector<UnitId> client_;  // controller client id -> the unit its cache serves
-  bool port_ = false;           // record_port: the port's events too
+  struct Client {
+    UnitId unit;
+    int pipe;
+  };
+  std::vector<Client> client_;  // controller client id -> the unit its cache serves, its DynRTP
+  int per_pipeline_;
+  bool port_ = false;  // record_port: the port's events too
   BoundaryEvent e_;
 };
 
