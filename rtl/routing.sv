@@ -13,7 +13,7 @@
 // Clients are numbered by their controller client ids (cfg_id): a response's label is an id.
 module routing #(
     parameter int CLIENTS  = 3,
-    parameter int RESP_CAP = 4,   // the controller port's response channel (port_capacity)
+    parameter int RESP_CAP = 4,   // the controller port's response channel (a power of two)
     parameter int TAG_W    = 4,   // response tag bits (a cache's MSHR)
     parameter int WORDS    = 4,   // memif kMaxRequestWords
     parameter int CW       = CLIENTS > 1 ? $clog2(CLIENTS) : 1
@@ -78,11 +78,12 @@ module routing #(
     any = 1'b0;
     pick = '0;
     for (int k = CLIENTS - 1; k >= 0; k--) begin
-      logic [CW-1:0] c;
-      c = CW'((int'(rr) + k) % CLIENTS);
-      if (mq_valid[c]) begin
+      logic [CW:0] c;  // rr + k < 2 CLIENTS: one subtraction wraps it
+      c = {1'b0, rr} + (CW + 1)'(k);
+      if (c >= (CW + 1)'(CLIENTS)) c = c - (CW + 1)'(CLIENTS);
+      if (mq_valid[c[CW-1:0]]) begin
         any = 1'b1;
-        pick = c;
+        pick = c[CW-1:0];
       end
     end
   end
@@ -106,9 +107,9 @@ module routing #(
         q_words[QW'((QW + 1)'(q_head) + q_count)] <= rsp_words;
         if (q_count == (QW + 1)'(RESP_CAP) && !deliver) overflow <= 1'b1;
       end
-      if (deliver) q_head <= QW'((int'(q_head) + 1) % RESP_CAP);
+      if (deliver) q_head <= q_head + 1'b1;  // (RESP_CAP a power of two)
       q_count <= q_count + (QW + 1)'(rsp_valid) - (QW + 1)'(deliver);
-      if (fwd_valid) rr <= CW'((int'(pick) + 1) % CLIENTS);
+      if (fwd_valid) rr <= pick == CW'(CLIENTS - 1) ? '0 : pick + 1'b1;
     end
   end
 endmodule

@@ -14,7 +14,8 @@
 # Tops: the operators (fp_add ...), the datapaths (*_unit), and the whole units traversal_ctrl
 # (P lanes, the stack, the per-thread state), list_unit (the thread machinery, the mailboxes),
 # transformation_threads and intersection_threads (the thread machinery around the datapaths),
-# cache (one per-type cache: RTL_PARAMS="WAYS=1 WORDS=2" is the prototype's kd-node cache).
+# cache (one per-type cache: RTL_PARAMS="WAYS=1 WORDS=2" is the prototype's kd-node cache),
+# routing (the simple routing between the caches and the controller port).
 # Default tops: every operator and datapath (generic: about 4 minutes; xc2v: longer); the whole
 # units only when named (traversal_ctrl takes minutes even with 2 threads; list_unit.sv's own
 # default is 16 threads, the prototype's 64 is RTL_PARAMS="THREADS=64").
@@ -57,7 +58,7 @@ sources() {  # the files a top needs beside the operators
       echo "$here/transform_unit.sv $here/unit_threads.sv $here/transformation_threads.sv" ;;
     intersection_threads)
       echo "$here/intersection_unit.sv $here/unit_threads.sv $here/intersection_threads.sv" ;;
-    traversal_unit | transform_unit | intersection_unit | cache) echo "$here/$1.sv" ;;
+    traversal_unit | transform_unit | intersection_unit | cache | routing) echo "$here/$1.sv" ;;
     fp_*) echo "" ;;
     *) return 1 ;;
   esac
