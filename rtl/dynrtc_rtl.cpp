@@ -147,15 +147,8 @@ class DynrtcCore {
         put_bits(v.clr_thread, tw_ * clears++, tw_, e.thread);
         return;
       case BoundaryPort::kPortResponse:
-        if (v.rsp_valid) throw std::logic_error("lockstep: two port responses in one cycle");
-        v.rsp_valid = 1;
-        v.rsp_client = static_cast<std::uint16_t>(e.field[0]);
-        put_bits(v.rsp_tag, 0, 32, e.field[1]);
-        for (int k = 0; k + 2 < e.fields; ++k)
-          put_bits(v.rsp_words, 32 * k, 32, e.field[static_cast<std::size_t>(k) + 2]);
-        return;
       case BoundaryPort::kPortBlocked:
-        v.port_blocked = 1;
+        drive_controller_port(v, e);
         return;
       default:
         return;  // a cache's request, response or back-pressure: wired inside
@@ -308,7 +301,7 @@ class DynrtcPairRtl final : public UnitRtl {
     r.port_blocked = 0;
     r.rsp_valid = 0;
     for (const BoundaryEvent& e : inputs)
-      port(e);
+      drive_controller_port(r, e);
     for (int q = 0; q < 2; ++q) {
       cores_[static_cast<std::size_t>(q)]->drive(inputs);
       const auto& v = cores_[static_cast<std::size_t>(q)]->ports();
@@ -339,19 +332,6 @@ class DynrtcPairRtl final : public UnitRtl {
   void stop_trace() override { cores_[0]->stop_trace(); }
 
  private:
-  // The controller port's events onto the routing.
-  void port(const BoundaryEvent& e) {
-    R& r = *route_;
-    if (e.port == BoundaryPort::kPortBlocked) r.port_blocked = 1;
-    if (e.port != BoundaryPort::kPortResponse) return;
-    if (r.rsp_valid) throw std::logic_error("lockstep: two port responses in one cycle");
-    r.rsp_valid = 1;
-    r.rsp_client = static_cast<std::uint16_t>(e.field[0]);
-    put_bits(r.rsp_tag, 0, 32, e.field[1]);
-    for (int k = 0; k + 2 < e.fields; ++k)
-      put_bits(r.rsp_words, 32 * k, 32, e.field[static_cast<std::size_t>(k) + 2]);
-  }
-
   std::vector<std::unique_ptr<DynrtcCore<V>>> cores_;
   VerilatedTop<R> route_;
 };

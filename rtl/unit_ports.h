@@ -105,6 +105,24 @@ void drive_packet_start(V& v, int slot, int tw, const units::BoundaryEvent& e) {
   put_bits(v.st_shadow, slot, 1, e.field[0]);
 }
 
+// The memory controller's cache port onto a routing's ports: a response pushed towards it, or
+// its request channel full. Other events are not the port's (false).
+template <class V>
+bool drive_controller_port(V& v, const units::BoundaryEvent& e) {
+  if (e.port == units::BoundaryPort::kPortBlocked) {
+    v.port_blocked = 1;
+    return true;
+  }
+  if (e.port != units::BoundaryPort::kPortResponse) return false;
+  if (v.rsp_valid) throw std::logic_error("lockstep: two port responses in one cycle");
+  v.rsp_valid = 1;
+  v.rsp_client = static_cast<std::uint16_t>(e.field[0]);
+  put_bits(v.rsp_tag, 0, 32, e.field[1]);
+  for (int k = 0; k + 2 < e.fields; ++k)
+    put_bits(v.rsp_words, 32 * k, 32, e.field[static_cast<std::size_t>(k) + 2]);
+  return true;
+}
+
 // ---- outputs -----------------------------------------------------------------------------------
 
 // The traversal unit's thread leaving on an output port: {node, first, end, mask, level} after
