@@ -58,6 +58,7 @@ TEST(Sampling, PlanHoldsOneWarmupAndWindowPerPeriod) {
     EXPECT_LE(first + 15, 1000 * i + size);
     for (std::size_t k = 1; k < 15; ++k)
       EXPECT_EQ(p.order[15 * w + k], first + static_cast<int>(k));
+    EXPECT_EQ(p.window_first[w], first + 5);  // where the window's covariate is read
   }
   // The places differ between periods (no column aliasing) and repeat between runs.
   std::set<int> offsets;
