@@ -87,9 +87,8 @@ PacketCostModel::PacketCostModel(const memif::MemoryImage& image) : image_(image
   }
 }
 
-const PacketCostModel::Node& PacketCostModel::node(std::uint32_t index) const {
+void PacketCostModel::read_node(std::uint32_t index) const {
   Node& m = nodes_[index];
-  if (m.bits != kUnread) return m;
   const memif::KdNode n = image_.node(index);
   m.bits = n.leaf
                ? 3u
@@ -97,7 +96,6 @@ const PacketCostModel::Node& PacketCostModel::node(std::uint32_t index) const {
   m.child = n.leaf ? n.first : n.child_pair;
   m.count = n.count;
   m.split = n.leaf ? 0.0f : decode(n.split);
-  return m;
 }
 
 const Row3& PacketCostModel::triangle(std::uint32_t first_row) const {
@@ -225,17 +223,36 @@ RayCost PacketCostModel::trace_pixel(double x, double y) const {
   return trace(cam_p_, d);
 }
 
+RayCost& operator+=(RayCost& a, const RayCost& b) {
+  a.box = a.box || b.box;
+  a.hit = a.hit || b.hit;
+  a.steps += b.steps;
+  a.leaves += b.leaves;
+  a.lists += b.lists;
+  a.transforms += b.transforms;
+  a.tests += b.tests;
+  return a;
+}
+
 std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet) {
   const auto& r = image.registers();
   const int w = static_cast<int>(r.width), h = static_cast<int>(r.height);
   const units::PacketTiling t = units::packet_tiling(w, h, packet);
   const PacketCostModel model(image);
+  // Packets of 16 rays or more: one ray per quadrant of the tile (a ray per 4 pixels at most,
+  // as with 4-ray packets), since one ray of 16 predicts its packet less well.
+  const int split = packet >= 16 ? 2 : 1;
   std::vector<RayCost> costs(static_cast<std::size_t>(t.count()));
   for (int i = 0; i < t.count(); ++i) {
-    // The tile's centre, the tile clipped to the image (the frame's last column and row).
-    const int x0 = (i % t.tiles_x) * t.tile_width, y0 = (i / t.tiles_x) * t.tile_height;
-    const int x1 = std::min(x0 + t.tile_width, w) - 1, y1 = std::min(y0 + t.tile_height, h) - 1;
-    costs[static_cast<std::size_t>(i)] = model.trace_pixel(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    const int tx = (i % t.tiles_x) * t.tile_width, ty = (i / t.tiles_x) * t.tile_height;
+    for (int q = 0; q < split * split; ++q) {
+      // The part's centre, the part clipped to the image (the frame's last column and row).
+      const int pw = t.tile_width / split, ph = t.tile_height / split;
+      const int x0 = tx + (q % split) * pw, y0 = ty + (q / split) * ph;
+      const int x1 = std::min(x0 + pw, w) - 1, y1 = std::min(y0 + ph, h) - 1;
+      if (x1 < x0 || y1 < y0) continue;  // a quadrant outside the image
+      costs[static_cast<std::size_t>(i)] += model.trace_pixel(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    }
   }
   return costs;
 }

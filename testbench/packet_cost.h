@@ -57,7 +57,13 @@ class PacketCostModel {
     std::array<float, 3> o{}, d{}, inv{};  // inv: 1 / d, the slab distances' factors
   };
   static Ray make_ray(const std::array<float, 3>& o, const std::array<float, 3>& d);
-  const Node& node(std::uint32_t index) const;
+  // The node, read from the image on the first visit (inline: the traversal's every step).
+  const Node& node(std::uint32_t index) const {
+    if (nodes_[index].bits == kUnread) [[unlikely]]
+      read_node(index);
+    return nodes_[index];
+  }
+  void read_node(std::uint32_t index) const;
   template <class Visit>
   void traverse(std::uint32_t root, const Ray& r, float t0, float t1, RayCost& c, Visit&& v) const;
   void trace_instance(std::uint32_t instance, const Ray& world, float& t_best, RayCost& c) const;
@@ -74,8 +80,12 @@ class PacketCostModel {
   std::array<float, 3> cam_r_{}, cam_u_{}, cam_d_{}, cam_p_{};
 };
 
+// Adds b's counts to a's (box and hit: either).
+RayCost& operator+=(RayCost& a, const RayCost& b);
+
 // The cost of every packet of the image's frame in the RGC's order (packets of `packet` rays,
-// units::packet_tiling): the ray through the centre of the packet's tile, clipped to the image.
+// units::packet_tiling): the ray through the centre of the packet's tile, clipped to the image;
+// for packets of 16 rays or more, the sum of the rays through its four quadrants' centres.
 std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet);
 
 }  // namespace saarcor
