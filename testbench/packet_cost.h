@@ -1,9 +1,10 @@
 // A per-packet cost known for every packet of a frame without the cycle simulation: the work of
-// one ray through the packet's centre, traced by a plain binary32 traversal of the memory image's
-// own kd-trees (docs/sampling.md, decision D52). The sampled simulation's regression estimator
+// one ray through the packet's centre (four, through its quadrants', for packets of 16 rays or
+// more), traced by a plain binary32 traversal of the memory image's own kd-trees
+// (docs/sampling.md, decision D52). The sampled simulation's regression estimator
 // (testbench/sampling.h) uses it as its covariate: the windows measure cycles, this says where
-// the frame's work lies between them. One ray per packet costs about a hundredth of the cycle
-// run, where the fp24 functional model over every ray costs a quarter of it.
+// the frame's work lies between them. It costs 0.2-3.5 % of the full cycle run, where the fp24
+// functional model over every ray costs a quarter of it.
 #pragma once
 
 #include <array>
