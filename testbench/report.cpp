@@ -348,6 +348,8 @@ nlohmann::json sampling_json(const CycleFrame& c) {
                       {"packets_simulated", s.packets_simulated},
                       {"cycles_simulated", s.cycles_simulated},
                       {"cycles_per_packet_cov", s.cycles_per_packet_cov},
+                      {"covariate_seconds", s.covariate_seconds},
+                      {"covariate_correlation", s.covariate_correlation},
                       {"trusted", s.defeated.empty()}};
   // A frame that defeats the sampling says why, and gives no interval to read as a narrow one.
   if (!s.defeated.empty()) {

@@ -31,6 +31,7 @@ struct SampleCheckOptions {
 struct SampleCase {
   std::string scene, config, res;
   double full_seconds = 0, sampled_seconds = 0;
+  double covariate_seconds = 0;  // the part of sampled_seconds the packets' covariate took
   std::uint64_t packets = 0, packets_simulated = 0;
   int windows = 0;
   bool trusted = true;  // the sample gave an interval (otherwise `defeated` says why)

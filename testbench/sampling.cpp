@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "testbench/packet_cost.h"
 #include "units/functional_model.h"
 
 namespace saarcor {
@@ -96,6 +97,7 @@ SamplePlan plan_sample(int packets, const SampleSpec& s) {
       plan.order.push_back(k);
     plan.marks.push_back(static_cast<int>(plan.order.size()));
     plan.strata.push_back(size);
+    plan.window_first.push_back(first + s.warmup);
     ++plan.windows;
   }
   return plan;
@@ -114,27 +116,64 @@ double student_t975(int df) {
          (3 * z7 + 19 * z5 + 17 * z3 - 15 * z) / (384 * n * n * n);
 }
 
+namespace {
+
+double mean_of(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v)
+    m += x / static_cast<double>(v.size());
+  return m;
+}
+
+// Sum of (a_i - mean a)(b_i - mean b).
+double co_sum(const std::vector<double>& a, const std::vector<double>& b) {
+  const double ma = mean_of(a), mb = mean_of(b);
+  double s = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    s += (a[i] - ma) * (b[i] - mb);
+  return s;
+}
+
+}  // namespace
+
+double correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size() || a.size() < 2) return 0;
+  const double aa = co_sum(a, a), bb = co_sum(b, b);
+  return aa > 0 && bb > 0 ? co_sum(a, b) / std::sqrt(aa * bb) : 0;
+}
+
 FigureEstimate estimate_cycles(const std::vector<double>& cpp, const std::vector<double>& strata,
-                               double sampled_fraction) {
+                               double sampled_fraction, const std::vector<double>& x,
+                               const std::vector<double>& period_x) {
   FigureEstimate e;
-  const auto n = static_cast<double>(cpp.size());
-  if (cpp.empty()) return e;
-  if (strata.size() != cpp.size()) throw std::logic_error("estimate_cycles: one stratum a window");
-  double sum = 0, packets = 0;
-  for (std::size_t i = 0; i < cpp.size(); ++i) {
-    sum += cpp[i];
-    e.value += strata[i] * cpp[i];
+  const std::size_t n = cpp.size();
+  if (n == 0) return e;
+  if (strata.size() != n) throw std::logic_error("estimate_cycles: one stratum a window");
+  const bool regression = !x.empty();
+  if (regression && (x.size() != n || period_x.size() != n))
+    throw std::logic_error("estimate_cycles: one covariate a window and a period");
+  // The slope; the intercept's degree of freedom is the mean's, the slope's one more.
+  const double sxx = regression ? co_sum(x, x) : 0;
+  const double b = sxx > 0 ? co_sum(x, cpp) / sxx : 0;
+  const std::size_t fitted = regression ? 2 : 1;
+  double packets = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    e.value += strata[i] * (cpp[i] + (regression ? b * (period_x[i] - x[i]) : 0.0));
     packets += strata[i];
   }
-  const double mean = sum / n;
-  if (cpp.size() < 2) return e;
+  if (n <= fitted) return e;
+  const double my = mean_of(cpp), mx = regression ? mean_of(x) : 0;
   double ss = 0;
-  for (double c : cpp)
-    ss += (c - mean) * (c - mean);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = cpp[i] - my - (regression ? b * (x[i] - mx) : 0.0);
+    ss += r * r;
+  }
+  const auto df = static_cast<double>(n - fitted);
   // The standard error of the mean, with the finite-population correction of sampling a share
   // `sampled_fraction` of the frame's packets.
-  const double se = std::sqrt(ss / (n - 1) / n * std::max(0.0, 1.0 - sampled_fraction));
-  const double half = student_t975(static_cast<int>(cpp.size()) - 1) * se * packets;
+  const double se =
+      std::sqrt(ss / df / static_cast<double>(n) * std::max(0.0, 1.0 - sampled_fraction));
+  const double half = student_t975(static_cast<int>(n - fitted)) * se * packets;
   e.ci = {e.value - half, e.value + half};
   return e;
 }
@@ -258,18 +297,41 @@ double coefficient_of_variation(const std::vector<double>& v) {
   return mean > 0 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) / mean : 0;
 }
 
-// The frame's figures from the run's windows into `c` (its usual fields) and `s`.
+// The covariate's means per window (its own packets) and per period (estimate_cycles' x and
+// period_x).
+void covariate_means(const SamplePlan& plan, const SampleSpec& spec,
+                     const std::vector<double>& cost, std::vector<double>& x,
+                     std::vector<double>& period_x) {
+  std::vector<double> prefix(cost.size() + 1, 0.0);
+  for (std::size_t k = 0; k < cost.size(); ++k)
+    prefix[k + 1] = prefix[k] + cost[k];
+  const auto mean = [&](std::size_t a, std::size_t b) {
+    b = std::min(b, cost.size());
+    return b > a ? (prefix[b] - prefix[a]) / static_cast<double>(b - a) : 0.0;
+  };
+  for (int i = 0; i < plan.windows; ++i) {
+    const auto first = static_cast<std::size_t>(plan.window_first[std::size_t(i)]);
+    x.push_back(mean(first, first + static_cast<std::size_t>(spec.window)));
+    const auto begin = static_cast<std::size_t>(i) * static_cast<std::size_t>(spec.period);
+    period_x.push_back(mean(begin, begin + static_cast<std::size_t>(plan.strata[std::size_t(i)])));
+  }
+}
+
+// The frame's figures from the run's windows and the packets' covariate into `c` (its usual
+// fields) and `s`.
 void estimate_frame(const units::CycleParams& p, const SamplePlan& plan, std::uint64_t packets,
-                    CycleFrame& c, SampleSummary& s) {
+                    const std::vector<double>& cost, CycleFrame& c, SampleSummary& s) {
   std::vector<units::FigureCounts> spans;
-  std::vector<double> cpp;
+  std::vector<double> cpp, x, period_x;
   for (int i = 0; i < plan.windows; ++i) {
     spans.push_back(units::span(c.marks[2 * std::size_t(i)], c.marks[2 * std::size_t(i) + 1]));
     cpp.push_back(static_cast<double>(spans.back().cycle) / s.spec.window);
   }
+  covariate_means(plan, s.spec, cost, x, period_x);
+  s.covariate_correlation = correlation(x, cpp);
   const double f = static_cast<double>(plan.windows) * s.spec.window / static_cast<double>(packets);
-  const FigureEstimate cycles =
-      estimate_cycles(cpp, std::vector<double>(plan.strata.begin(), plan.strata.end()), f);
+  const FigureEstimate cycles = estimate_cycles(
+      cpp, std::vector<double>(plan.strata.begin(), plan.strata.end()), f, x, period_x);
   const double hz = p.clock_mhz * 1e6;
   // The frame's rays from the simulated packets' rays per packet (`rays` stays theirs, as the
   // per-ray counters beside it are).
@@ -305,6 +367,13 @@ CycleFrame run_sampled(const memif::MemoryImage& image, const units::CycleParams
   const SamplePlan plan = plan_sample(packets, spec);
   if (plan.windows == 0 || static_cast<int>(plan.order.size()) > packets)
     return run_cycle(image, params, options);
+  // The covariate of every packet, before the run and inside its host time.
+  const auto tc = std::chrono::steady_clock::now();
+  std::vector<double> cost;
+  for (const RayCost& r : packet_costs(image, params.packet))
+    cost.push_back(cost_covariate(r));
+  const double covariate_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
   CycleRunOptions o = options;
   o.packet_order = plan.order;
   o.marks = plan.marks;
@@ -316,7 +385,8 @@ CycleFrame run_sampled(const memif::MemoryImage& image, const units::CycleParams
   s->packets = static_cast<std::uint64_t>(packets);
   s->packets_simulated = plan.order.size();
   s->cycles_simulated = c.cycles;
-  estimate_frame(params, plan, static_cast<std::uint64_t>(packets), c, *s);
+  s->covariate_seconds = covariate_seconds;
+  estimate_frame(params, plan, static_cast<std::uint64_t>(packets), cost, c, *s);
   c.packets = static_cast<std::uint64_t>(packets);
   c.sampling = std::move(s);
   c.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -42,6 +42,7 @@ struct SamplePlan {
   std::vector<int> order;
   std::vector<int> marks;
   std::vector<int> strata;
+  std::vector<int> window_first;  // per window: its first measured packet
   int windows = 0;
 };
 SamplePlan plan_sample(int packets, const SampleSpec& s);
@@ -64,6 +65,10 @@ struct SampleSummary {
   std::uint64_t packets_simulated = 0;  // warm-ups and windows
   std::uint64_t cycles_simulated = 0;   // the sampled run's clock at its end
   double cycles_per_packet_cov = 0;     // of the windows' cycles per packet
+  // The packets' cost covariate (testbench/packet_cost.h): its host seconds, part of the run's,
+  // and its correlation with the windows' cycles per packet over the windows.
+  double covariate_seconds = 0;
+  double covariate_correlation = 0;
   // Empty when the interval is trusted; otherwise why not (the report prints this instead).
   std::string defeated;
   SampleInterval cycles, fps, rays_per_s;
@@ -80,10 +85,22 @@ struct FigureEstimate {
 FigureEstimate estimate_figure(const std::vector<units::FigureCounts>& spans, int figure,
                                double clock_mhz, double sampled_fraction);
 // The cycles of a frame from the windows' cycles per packet, window i standing for strata[i]
-// packets (SamplePlan::strata): the sum of strata[i] x cycles_per_packet[i]; the interval from
-// their sample variance.
+// packets (SamplePlan::strata).
+// Without a covariate (x empty): the sum of strata[i] x cycles_per_packet[i]; the interval from
+// their sample variance (n - 1 degrees of freedom).
+// With one (the regression estimator; Cochran, Sampling Techniques, 7.1): x[i] is the mean
+// covariate (testbench/packet_cost.h) of the packets window i's cycles follow, period_x[i] that of
+// its period's packets, b the least-squares slope of cycles per packet on x over the windows. The
+// total is the sum of strata[i] x (cycles_per_packet[i] + b (period_x[i] - x[i])): each window
+// carried to its period by what the covariate says of the difference. The interval from the
+// residuals about the fitted line (n - 2 degrees of freedom). A covariate that does not vary over
+// the windows gives b = 0.
 FigureEstimate estimate_cycles(const std::vector<double>& cycles_per_packet,
-                               const std::vector<double>& strata, double sampled_fraction);
+                               const std::vector<double>& strata, double sampled_fraction,
+                               const std::vector<double>& x = {},
+                               const std::vector<double>& period_x = {});
+// The Pearson correlation of two equally long series (0 when either does not vary).
+double correlation(const std::vector<double>& a, const std::vector<double>& b);
 // Student's t quantile 0.975 for `df` degrees of freedom (>= 1).
 double student_t975(int df);
 

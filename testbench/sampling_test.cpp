@@ -58,6 +58,7 @@ TEST(Sampling, PlanHoldsOneWarmupAndWindowPerPeriod) {
     EXPECT_LE(first + 15, 1000 * i + size);
     for (std::size_t k = 1; k < 15; ++k)
       EXPECT_EQ(p.order[15 * w + k], first + static_cast<int>(k));
+    EXPECT_EQ(p.window_first[w], first + 5);  // where the window's covariate is read
   }
   // The places differ between periods (no column aliasing) and repeat between runs.
   std::set<int> offsets;
@@ -91,6 +92,36 @@ TEST(Sampling, CyclesEstimateByHand) {
   EXPECT_NEAR(h.ci.high - 1200.0, 496.83 * std::sqrt(0.5), 0.01);
   // A window standing for more packets weighs more: 10 x 20 + 12 x 30 + 14 x 50 = 1,260.
   EXPECT_DOUBLE_EQ(estimate_cycles({10, 12, 14}, {20, 30, 50}, 0.0).value, 1260.0);
+}
+
+TEST(Sampling, RegressionEstimateOnSyntheticData) {
+  // A frame whose packets cost exactly 2 + 3x cycles for a covariate x: four periods of 100
+  // packets with covariate means 2, 2, 3 and 5 (true total 100 x (8 + 8 + 11 + 17) = 4,400).
+  // The windows fell on packets of covariate means 1, 2, 3 and 4 and measured 5, 8, 11 and 14
+  // cycles per packet: the plain estimate is 100 x (5 + 8 + 11 + 14) = 3,800 (13.6 % low), the
+  // regression estimate (slope 3, no residual) 3,800 + 3 x 100 x ((2+2+3+5) - (1+2+3+4)) = 4,400
+  // exactly, with an interval of width 0.
+  const std::vector<double> strata(4, 100.0);
+  const std::vector<double> y = {5, 8, 11, 14}, x = {1, 2, 3, 4}, px = {2, 2, 3, 5};
+  EXPECT_DOUBLE_EQ(estimate_cycles(y, strata, 0.0).value, 3800.0);
+  const FigureEstimate exact = estimate_cycles(y, strata, 0.0, x, px);
+  EXPECT_NEAR(exact.value, 4400.0, 1e-9);
+  EXPECT_NEAR(exact.ci.low, 4400.0, 1e-9);
+  EXPECT_NEAR(exact.ci.high, 4400.0, 1e-9);
+  // With noise: y = 4, 6, 9, 11. Mean x 2.5, mean y 7.5, Sxx = 5, Sxy = 1.5 x 3.5 + 0.5 x 1.5 +
+  // 0.5 x 1.5 + 1.5 x 3.5 = 12, slope b = 2.4. Estimate 100 x (4+6+9+11) + 2.4 x 100 x (12 - 10)
+  // = 3,480. Fitted line 1.5 + 2.4x: 3.9, 6.3, 8.7, 11.1; residuals 0.1, -0.3, 0.3, -0.1, sum of
+  // squares 0.2, over n - 2 = 2 degrees of freedom 0.1; standard error of the mean
+  // sqrt(0.1 / 4) = 0.158114, times 400 packets = 63.2456, times t(2) = 4.3027: 272.13.
+  const FigureEstimate noisy = estimate_cycles({4, 6, 9, 11}, strata, 0.0, x, px);
+  EXPECT_NEAR(noisy.value, 3480.0, 1e-9);
+  EXPECT_NEAR(noisy.ci.high - noisy.value, 272.13, 0.01);
+  EXPECT_NEAR(noisy.value - noisy.ci.low, 272.13, 0.01);
+  // A covariate without spread over the windows: slope 0, each window carried to its period as
+  // the plain estimator does (the interval then on n - 2 degrees of freedom).
+  EXPECT_DOUBLE_EQ(estimate_cycles(y, strata, 0.0, {1, 1, 1, 1}, px).value, 3800.0);
+  EXPECT_NEAR(correlation(x, y), 1.0, 1e-12);
+  EXPECT_EQ(correlation(x, {2, 2, 2, 2}), 0.0);
 }
 
 TEST(Sampling, RatioFigureEstimateByHand) {

@@ -1,0 +1,260 @@
+// One ray per packet through the image's kd-trees in binary32 (testbench/packet_cost.h).
+#include "testbench/packet_cost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "fixedfloat/format.h"
+#include "units/functional_model.h"
+
+namespace saarcor {
+
+double cost_covariate(const RayCost& c) {
+  return 1.0 + static_cast<double>(c.steps) + static_cast<double>(c.tests);
+}
+
+namespace {
+
+using Row3 = std::array<std::array<float, 4>, 3>;
+using Vec = std::array<float, 3>;
+
+constexpr int kMaxDepth = 128;  // deferred far children of one level's path
+
+// out_r = (m_r0*x + m_r1*y) + (m_r2*z + t_r), t_r = 0 for a direction (the transformation unit).
+Vec transform(const Row3& m, const Vec& v, float w) {
+  Vec r{};
+  for (std::size_t i = 0; i < 3; ++i)
+    r[i] = (m[i][0] * v[0] + m[i][1] * v[1]) + (m[i][2] * v[2] + m[i][3] * w);
+  return r;
+}
+
+// Clips [t0, t1] to the box by slabs; a NaN (ray in a slab plane) leaves the interval.
+void clip(const Vec& lo, const Vec& hi, const Vec& o, const Vec& d, float& t0, float& t1) {
+  for (std::size_t a = 0; a < 3; ++a) {
+    const float n = (lo[a] - o[a]) / d[a], f = (hi[a] - o[a]) / d[a];
+    const bool neg = std::signbit(d[a]);
+    if ((neg ? f : n) > t0) t0 = neg ? f : n;
+    if ((neg ? n : f) < t1) t1 = neg ? n : f;
+  }
+}
+
+}  // namespace
+
+PacketCostModel::Ray PacketCostModel::make_ray(const Vec& o, const Vec& d) {
+  Ray r{o, d, {}};
+  for (std::size_t a = 0; a < 3; ++a)
+    r.inv[a] = 1.0f / d[a];
+  return r;
+}
+
+float PacketCostModel::decode(std::uint32_t bits) const {
+  return static_cast<float>(ff::decode(bits, image_.format(), ff::Subnormals::kFlush));
+}
+
+PacketCostModel::PacketCostModel(const memif::MemoryImage& image) : image_(image) {
+  const auto& r = image.registers();
+  // Nodes are read when a ray first reaches them: a frame's rays visit a small part of a large
+  // scene's trees.
+  nodes_.assign(image.regions().count[static_cast<int>(memif::ItemType::kNode)], Node{});
+  for (std::uint32_t i = 0; i < r.instance_count; ++i) {
+    const std::uint32_t base = r.instance_row_base + memif::kInstanceRows * i;
+    Instance in;
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const auto row = image.row(base + k);
+      for (std::size_t j = 0; j < 4; ++j)
+        in.world_to_object[k][j] = decode(row[j]);
+    }
+    const memif::InstanceHeader h = image.instance_header(i);
+    in.root = h.root;
+    in.triangle_rows = h.triangle_row_base;
+    const auto lo = image.row(base + 4), hi = image.row(base + 5);
+    for (std::size_t a = 0; a < 3; ++a) {
+      in.lo[a] = decode(lo[a]);
+      in.hi[a] = decode(hi[a]);
+    }
+    instances_.push_back(in);
+  }
+  const std::uint32_t rows = image.regions().count[static_cast<int>(memif::ItemType::kRow)];
+  slots_.assign(rows, -1);
+  for (std::size_t a = 0; a < 3; ++a) {
+    scene_lo_[a] = decode(r.scene_min[a]);
+    scene_hi_[a] = decode(r.scene_max[a]);
+    cam_r_[a] = decode(r.cam_r[a]);
+    cam_u_[a] = decode(r.cam_u[a]);
+    cam_d_[a] = decode(r.cam_d[a]);
+    cam_p_[a] = decode(r.cam_p[a]);
+  }
+}
+
+void PacketCostModel::read_node(std::uint32_t index) const {
+  Node& m = nodes_[index];
+  const memif::KdNode n = image_.node(index);
+  m.bits = n.leaf
+               ? 3u
+               : n.axis | (std::uint32_t{n.empty_left} << 2) | (std::uint32_t{n.empty_right} << 3);
+  m.child = n.leaf ? n.first : n.child_pair;
+  m.count = n.count;
+  m.split = n.leaf ? 0.0f : decode(n.split);
+}
+
+const Row3& PacketCostModel::triangle(std::uint32_t first_row) const {
+  std::int32_t& slot = slots_[first_row];
+  if (slot < 0) {
+    Row3 m{};
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const auto row = image_.row(first_row + k);
+      for (std::size_t j = 0; j < 4; ++j)
+        m[k][j] = decode(row[j]);
+    }
+    slot = static_cast<std::int32_t>(matrices_.size());
+    matrices_.push_back(m);
+  }
+  return matrices_[static_cast<std::size_t>(slot)];
+}
+
+// Front-to-back kd traversal over [t0, t1], as the traversal unit decides: the far child only
+// when the plane lies before the segment, the near only when beyond it, both otherwise; an empty
+// child is never entered. visit(leaf, t_far) returns true to stop (a hit before the leaf's end).
+template <class Visit>
+void PacketCostModel::traverse(std::uint32_t root, const Ray& r, float t0, float t1, RayCost& c,
+                               Visit&& visit) const {
+  struct Entry {
+    std::uint32_t node;
+    float t0, t1;
+  };
+  Entry stack[kMaxDepth];
+  int top = 0;
+  std::uint32_t node = root;
+  for (;;) {
+    bool live = true;
+    while (live && (this->node(node).bits & 3u) != 3u) {
+      const Node& n = this->node(node);
+      ++c.steps;
+      const std::size_t axis = n.bits & 3u;
+      const float d = (n.split - r.o[axis]) * r.inv[axis];
+      const std::uint32_t flip = std::signbit(r.d[axis]) ? 1u : 0u;
+      const std::uint32_t near = n.child + flip, far = n.child + 1u - flip;
+      const bool near_live = ((n.bits >> (2u + flip)) & 1u) == 0;
+      const bool far_live = ((n.bits >> (3u - flip)) & 1u) == 0;
+      if (d < t0 || t1 < d) {
+        node = d < t0 ? far : near;
+        live = d < t0 ? far_live : near_live;
+        continue;
+      }
+      const bool split = d == d;  // NaN: the ray lies in the plane, both over the segment
+      if (far_live && top < kMaxDepth) stack[top++] = {far, split ? d : t0, t1};
+      if (split) t1 = d;
+      node = near;
+      live = near_live;
+    }
+    if (live) {
+      ++c.leaves;
+      if (visit(this->node(node), t1)) return;
+    }
+    if (top == 0) return;
+    --top;
+    node = stack[top].node;
+    t0 = stack[top].t0;
+    t1 = stack[top].t1;
+  }
+}
+
+void PacketCostModel::trace_instance(std::uint32_t instance, const Ray& world, float& t_best,
+                                     RayCost& c) const {
+  const Instance& in = instances_[instance];
+  ++c.transforms;
+  const Ray r = make_ray(transform(in.world_to_object, world.o, 1.0f),
+                         transform(in.world_to_object, world.d, 0.0f));
+  float t0 = 0.0f, t1 = t_best;
+  clip(in.lo, in.hi, r.o, r.d, t0, t1);
+  if (!(t0 <= t1)) return;
+  traverse(in.root, r, t0, t1, c, [&](const Node& leaf, float leaf_far) {
+    for (std::uint32_t i = 0; i < leaf.count; ++i) {
+      ++c.lists;
+      ++c.tests;
+      const Row3& m =
+          triangle(in.triangle_rows + memif::kTriangleRows * image_.list_entry(leaf.child + i));
+      const Vec o = transform(m, r.o, 1.0f), d = transform(m, r.d, 0.0f);
+      const float t = -o[2] / d[2];
+      if (!(t > 0.0f && t < t_best) || d[2] == 0.0f) continue;
+      const float u = o[0] + t * d[0], v = o[1] + t * d[1];
+      if (u >= 0.0f && v >= 0.0f && u + v <= 1.0f) {
+        t_best = t;
+        c.hit = true;
+      }
+    }
+    return t_best < leaf_far;
+  });
+}
+
+RayCost PacketCostModel::trace(const Vec& origin, const Vec& direction) const {
+  RayCost c;
+  const Ray r = make_ray(origin, direction);
+  float t0 = 0.0f, t1 = std::numeric_limits<float>::infinity();
+  clip(scene_lo_, scene_hi_, r.o, r.d, t0, t1);
+  if (!(t0 <= t1) || nodes_.empty()) return c;
+  c.box = true;
+  float t_best = std::numeric_limits<float>::infinity();
+  // The mailbox: an instance listed in several top-level leaves is entered once per ray (a ray
+  // entering more instances than it holds may enter one twice: a cost, not a result).
+  std::array<std::uint32_t, 64> seen{};
+  std::size_t n_seen = 0;
+  traverse(image_.registers().top_root, r, t0, t1, c, [&](const Node& leaf, float leaf_far) {
+    for (std::uint32_t i = 0; i < leaf.count; ++i) {
+      ++c.lists;
+      const std::uint32_t inst = image_.list_entry(leaf.child + i);
+      if (inst >= instances_.size() ||
+          std::find(seen.begin(), seen.begin() + n_seen, inst) != seen.begin() + n_seen)
+        continue;
+      if (n_seen < seen.size()) seen[n_seen++] = inst;
+      trace_instance(inst, r, t_best, c);
+    }
+    return t_best < leaf_far;
+  });
+  return c;
+}
+
+RayCost PacketCostModel::trace_pixel(double x, double y) const {
+  const auto px = static_cast<float>(x), py = static_cast<float>(y);
+  Vec d{};
+  for (std::size_t i = 0; i < 3; ++i)
+    d[i] = (cam_r_[i] * px + cam_u_[i] * py) + cam_d_[i];
+  return trace(cam_p_, d);
+}
+
+RayCost& operator+=(RayCost& a, const RayCost& b) {
+  a.box = a.box || b.box;
+  a.hit = a.hit || b.hit;
+  a.steps += b.steps;
+  a.leaves += b.leaves;
+  a.lists += b.lists;
+  a.transforms += b.transforms;
+  a.tests += b.tests;
+  return a;
+}
+
+std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet) {
+  const auto& r = image.registers();
+  const int w = static_cast<int>(r.width), h = static_cast<int>(r.height);
+  const units::PacketTiling t = units::packet_tiling(w, h, packet);
+  const PacketCostModel model(image);
+  // Packets of 16 rays or more: one ray per quadrant of the tile (a ray per 4 pixels at most,
+  // as with 4-ray packets), since one ray of 16 predicts its packet less well.
+  const int split = packet >= 16 ? 2 : 1;
+  std::vector<RayCost> costs(static_cast<std::size_t>(t.count()));
+  for (int i = 0; i < t.count(); ++i) {
+    const int tx = (i % t.tiles_x) * t.tile_width, ty = (i / t.tiles_x) * t.tile_height;
+    for (int q = 0; q < split * split; ++q) {
+      // The part's centre, the part clipped to the image (the frame's last column and row).
+      const int pw = t.tile_width / split, ph = t.tile_height / split;
+      const int x0 = tx + (q % split) * pw, y0 = ty + (q / split) * ph;
+      const int x1 = std::min(x0 + pw, w) - 1, y1 = std::min(y0 + ph, h) - 1;
+      if (x1 < x0 || y1 < y0) continue;  // a quadrant outside the image
+      costs[static_cast<std::size_t>(i)] += model.trace_pixel(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    }
+  }
+  return costs;
+}
+
+}  // namespace saarcor
