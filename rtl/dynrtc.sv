@@ -13,9 +13,9 @@
 // the transformation unit with its side bands to the list and intersection units, RGS ->
 // traversal on load port 1, and what leaves for it: path g and generated shadow rays) and the
 // memory controller (the routing's port). The units' ports are also brought out (the mon_*-like
-// outputs named by unit: tv_ traversal, ls_ list, tf_ transformation, is_ intersection, nc_/lc_/rc_
-// the node, list and row caches) so that a testbench sees every internal port, as part 1's
-// boundary record names them.
+// outputs named by unit: tv_ traversal, ls_ list, tf_ transformation, is_ intersection, c_ the
+// caches, k = 0 node, 1 list, 2 row) so that a testbench sees every internal port, as the
+// boundary record (units/boundary.h) names them.
 // A top-level entry is an object and a bottom-level one a triangle; the intersection unit works
 // on bottom-level lists only, so its resume arrives at level 1.
 module dynrtc #(

@@ -1,8 +1,9 @@
 // The whole DynRTC in RTL (rtl/dynrtc.sv: the four units, the three caches and the simple routing
 // wired to each other) in lockstep with the cycle model, which gives it only what the RGS hands
 // over and what the memory controller's cache port does: every unit's and cache's output and the
-// routing's work are compared, 0 divergences, on part 1's scenes and configurations, with shadows
-// and secondary rays, and with 2-way caches. (The units alone: rtl/lockstep_test.cpp.)
+// routing's work are compared, 0 divergences, on the scenes and configurations the units run on
+// alone, with shadows and secondary rays, with 2-way caches, and two DynRTCs on one routing
+// (pipelines=2). (The units alone: rtl/lockstep_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <array>
@@ -104,6 +105,13 @@ TEST(DynrtcLockstep, Suncor) {
 TEST(DynrtcLockstep, DuckGltf) {
   SAARCOR_REQUIRE_VARIANT_BUILDS();
   expect_whole_agrees(run_dynrtc(std::string(SAARCOR_SHARED_SCENES) + "/Duck/Duck.gltf", {}));
+}
+
+TEST(DynrtcLockstep, TwoCylinderEngineSixteenRayPackets) {
+  SAARCOR_REQUIRE_VARIANT_BUILDS();
+  expect_whole_agrees(
+      run_dynrtc(std::string(SAARCOR_SHARED_SCENES) + "/2CylinderEngine/2CylinderEngine.gltf",
+                 {"threads=16", "packet=16"}));
 }
 
 // pipelines=2: two whole DynRTCs on one RTL routing share the model's memory controller; every
