@@ -151,6 +151,10 @@ TEST(DynrtcLockstep, RunsAloneAndOnlyOnItsBuildsConfigurations) {
   }
   o.set = {"cache.traversal.ways=3"};
   EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  o.set = {};
+  o.fault = "pop-off";  // the faults are the units' builds: never silently a healthy run
+  EXPECT_THROW(run_lockstep(o), std::runtime_error);
+  o.fault = "";
   o.set = {"pipelines=3"};
   EXPECT_THROW(run_lockstep(o), std::runtime_error);
   o.units = {"list"};
