@@ -328,8 +328,19 @@ class DynrtcPairRtl final : public UnitRtl {
       c->rise();
     route_.rise();
   }
-  void start_trace(const std::string& path) override { cores_[0]->start_trace(path); }
-  void stop_trace() override { cores_[0]->stop_trace(); }
+  // Each DynRTC's waveform: the second's file name has ".dynrtp1" before its extension.
+  void start_trace(const std::string& path) override {
+    cores_[0]->start_trace(path);
+    const std::size_t dot = path.rfind('.');
+    const std::size_t slash = path.rfind('/');
+    const bool ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+    cores_[1]->start_trace(ext ? path.substr(0, dot) + ".dynrtp1" + path.substr(dot)
+                               : path + ".dynrtp1");
+  }
+  void stop_trace() override {
+    for (auto& c : cores_)
+      c->stop_trace();
+  }
 
  private:
   std::vector<std::unique_ptr<DynrtcCore<V>>> cores_;
