@@ -14,8 +14,13 @@
 //                         miss pushes towards the routing;
 //                  input  mem_taken: the routing took the cache's oldest line request;
 //                  input  mem_fill: tag (the MSHR), the words: the routing pushed a fill.
-// The model emits them through the cache's and the routing's observers and the units' cache
-// hooks (UnitObserver::cache_request, cache_response); the RTL (rtl/cache.sv) through its ports.
+// With record_port, also the memory controller's cache port, where a whole DynRTC in RTL meets the
+// model (named by the unit whose cache the response's client is; kNone for the back-pressure):
+//   port_response: client, tag, the words: the controller pushed a response towards the routing;
+//   port_blocked:  a client had a line request and the port's request channel was full.
+// The model emits them through the cache's, the routing's and the port's observers and the units'
+// cache hooks (UnitObserver::cache_request, cache_response); the RTL (rtl/cache.sv,
+// rtl/dynrtc.sv) through its ports. Several DynRTPs' caches are told apart by `dynrtp`.
 #pragma once
 
 #include <array>
