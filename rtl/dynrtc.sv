@@ -18,6 +18,8 @@
 // boundary record (units/boundary.h) names them.
 // A top-level entry is an object and a bottom-level one a triangle; the intersection unit works
 // on bottom-level lists only, so its resume arrives at level 1.
+// Several DynRTCs share one controller port through a chip-level routing (ext_route: the caches'
+// line-request and fill queues are then the x_* ports, and the DynRTC's own routing is idle).
 module dynrtc #(
     parameter int THREADS = 64,
     parameter int P       = 4,
