@@ -59,15 +59,21 @@ class DynrtcCore {
     top_.reset();
   }
 
-  // The cycle's boundary events of this DynRTP onto its ports, and the clock low.
+  // The cycle's boundary events of this DynRTP onto its ports (the controller port's only with
+  // the DynRTC's own routing), and the clock low.
   void drive(const std::vector<BoundaryEvent>& inputs) {
     clear_inputs();
     int clears = 0, starts = 0;
     for (const BoundaryEvent& e : inputs) {
-      if (e.dynrtp != pipe_ && e.port != BoundaryPort::kPortResponse &&
-          e.port != BoundaryPort::kPortBlocked)
+      if (!at_dynrtc_boundary(e)) continue;  // (the lockstep gives no other)
+      const bool port =
+          e.port == BoundaryPort::kPortResponse || e.port == BoundaryPort::kPortBlocked;
+      if (port ? ext_route_ : e.dynrtp != pipe_) continue;
+      if (port || offset_ == 0) {
+        drive(e, clears, starts);
         continue;
-      BoundaryEvent local = e;
+      }
+      BoundaryEvent local = e;  // (a hand-over of the second DynRTC: its own thread ids)
       local.thread -= offset_;
       drive(local, clears, starts);
     }
@@ -128,12 +134,11 @@ class DynrtcCore {
     v.x_fill_valid = 0;
   }
 
-  // A model event at the DynRTC's boundary onto its ports; the others are the RTL's own.
+  // A model event at the DynRTC's boundary (at_dynrtc_boundary) onto its ports.
   void drive(const BoundaryEvent& e, int& clears, int& starts) {
     V& v = *top_;
     switch (e.port) {
       case BoundaryPort::kInput:
-        if (e.path != UnitId::kRgs) return;  // another unit's hand-over: wired inside
         if (e.unit == UnitId::kTransformation) return drive_generate(v, p_, e);
         if (v.r_valid) throw std::logic_error("lockstep: two threads on RGS -> traversal");
         v.r_valid = 1;
@@ -141,17 +146,13 @@ class DynrtcCore {
         return drive_level_start(v, 1, tw_, p_, e);
       case BoundaryPort::kSideBand:
         if (e.unit == UnitId::kIntersection) return drive_packet_start(v, starts++, tw_, e);
-        if (e.unit != UnitId::kList) return;  // the hit update: the intersection unit's output
         if (clears == 2) throw std::logic_error("lockstep: three packet starts in one cycle");
         put_bits(v.clr_valid, clears, 1, 1);
         put_bits(v.clr_thread, tw_ * clears++, tw_, e.thread);
         return;
-      case BoundaryPort::kPortResponse:
-      case BoundaryPort::kPortBlocked:
+      default:
         drive_controller_port(v, e);
         return;
-      default:
-        return;  // a cache's request, response or back-pressure: wired inside
     }
   }
   void traversal_and_list(std::uint64_t cycle, std::vector<BoundaryEvent>& out) const {

@@ -31,6 +31,7 @@
 #include "rtl/list_rtl.h"
 #include "rtl/transformation_rtl.h"
 #include "rtl/traversal_rtl.h"
+#include "rtl/unit_ports.h"
 #include "units/boundary_cache.h"
 #include "units/boundary_intersection.h"
 #include "units/boundary_list.h"
@@ -121,8 +122,9 @@ class Lockstep {
         outputs.push_back(std::move(e));
         continue;
       }
-      if (!whole_ || at_boundary(e))  // given (the outputs count when compared)
-        ++events_[static_cast<std::size_t>(e.port)];
+      // The whole DynRTC is given its boundary only: the rest is what its own units compute.
+      if (whole_ && !at_dynrtc_boundary(e)) continue;
+      ++events_[static_cast<std::size_t>(e.port)];  // given (the outputs count when compared)
       if (e.port != BoundaryPort::kCacheBlocked) remember(rtl_hist_, e);
       inputs.push_back(std::move(e));
     }
@@ -197,22 +199,6 @@ class Lockstep {
              e.port == BoundaryPort::kMemRequest ||
              (whole_ && (e.port == BoundaryPort::kMemTaken || e.port == BoundaryPort::kMemFill));
     return e.port == BoundaryPort::kCacheRequest || e.port == BoundaryPort::kOutput;
-  }
-
-  // An input event the whole DynRTC takes from the model: the RGS's hand-overs and side bands
-  // (the hit update is the intersection unit's output), the controller port's.
-  static bool at_boundary(const BoundaryEvent& e) {
-    switch (e.port) {
-      case BoundaryPort::kInput:
-        return e.path == UnitId::kRgs;
-      case BoundaryPort::kSideBand:
-        return e.unit != UnitId::kTraversal;
-      case BoundaryPort::kPortResponse:
-      case BoundaryPort::kPortBlocked:
-        return true;
-      default:
-        return false;
-    }
   }
 
   // Events of a cycle are ordered by port, then by the unit or cache whose they are.

@@ -30,6 +30,24 @@ inline constexpr int kPortNodeBits = 28;   // NODE_W
 
 // ---- inputs ------------------------------------------------------------------------------------
 
+// A model event the whole DynRTC takes at its boundary (rtl/dynrtc.sv): the RGS's hand-overs
+// (path a, RGS -> traversal) and path a's side bands (the traversal unit's hit update is the
+// intersection unit's output there), and the memory controller port's events. Every other input
+// is another RTL unit's or cache's output, wired inside.
+inline bool at_dynrtc_boundary(const units::BoundaryEvent& e) {
+  switch (e.port) {
+    case units::BoundaryPort::kInput:
+      return e.path == units::UnitId::kRgs;
+    case units::BoundaryPort::kSideBand:
+      return e.unit != units::UnitId::kTraversal;
+    case units::BoundaryPort::kPortResponse:
+    case units::BoundaryPort::kPortBlocked:
+      return true;
+    default:
+      return false;
+  }
+}
+
 // The traversal unit's load port k (0: path b, 1: RGS -> traversal): the level start's fields
 // and the lanes' rays (units/boundary_traversal.h), in the cycle the thread is pushed.
 template <class V>
