@@ -88,6 +88,7 @@ class Chip {
   }
   int pipelines() const { return static_cast<int>(pipes_.size()); }
   int handed_out() const { return rgc_.handed_out(); }
+  void charge_packets(units::PacketCharges* c) { rgc_.set_charges(c); }
   DynRtp& pipeline(int i) { return *pipes_[static_cast<std::size_t>(i)]; }
   void observe(UnitObserver* o) {
     for (auto& d : pipes_)
@@ -422,6 +423,11 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   CycleFrame out;
   out.params = p;
   out.packets = static_cast<std::uint64_t>(threads.packets());
+  std::optional<units::PacketCharges> charges;
+  if (opt.charge_packets) {
+    charges.emplace(threads.packets(), p.pipelines * p.threads);
+    chip.charge_packets(&*charges);
+  }
   const ChipCounters counters(chip);
   const FigureCounts start = snapshot(k, counters);
   const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
@@ -432,6 +438,10 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   if (opt.interval != 0)
     out.series = interval_figures(k, counters, start, opt.interval, p.clock_mhz);
   out.cycles = k.now();
+  if (charges) {
+    out.packet_charges = charges->charges();
+    out.uncharged_cycles = charges->empty_cycles() + (k.now() - charges->last_event());
+  }
   if (uploading) finish_upload(k, chip, p, out);
 
   threads.finish();

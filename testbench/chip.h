@@ -52,6 +52,9 @@ struct CycleRunOptions {
   // counts are read into CycleFrame::marks: mark m is read once m packets have been handed out.
   std::vector<int> packet_order;
   std::vector<int> marks;
+  // A sampled frame: charge each packet its share of the cycles (units::PacketCharges) into
+  // CycleFrame::packet_charges.
+  bool charge_packets = false;
 };
 
 struct CycleFrame {
@@ -88,6 +91,10 @@ struct CycleFrame {
   std::uint64_t module_evaluations = 0;     // host work: evaluate() calls (sleeping modules skip)
   std::vector<units::CycleFigures> series;  // with interval != 0: the figures of each interval
   std::vector<units::FigureCounts> marks;   // the counts at CycleRunOptions::marks
+  // With CycleRunOptions::charge_packets: the cycles charged to each handed-out packet, by
+  // hand-out ordinal (units::PacketCharges), and the cycles in which no packet was in flight.
+  std::vector<double> packet_charges;
+  std::uint64_t uncharged_cycles = 0;
   // A sampled frame (testbench/sampling.h): how it was sampled and each estimate's interval; the
   // figures above are then the estimates. Null for a frame simulated whole.
   std::shared_ptr<const SampleSummary> sampling;

@@ -14,6 +14,16 @@ double cost_covariate(const RayCost& c) {
   return 1.0 + static_cast<double>(c.steps) + static_cast<double>(c.tests);
 }
 
+CostFeatures cost_features(const RayCost& c) {
+  return {1.0,
+          static_cast<double>(c.steps),
+          static_cast<double>(c.tests),
+          static_cast<double>(c.leaves),
+          static_cast<double>(c.lists),
+          static_cast<double>(c.transforms),
+          c.box ? 1.0 : 0.0};
+}
+
 namespace {
 
 using Row3 = std::array<std::array<float, 4>, 3>;

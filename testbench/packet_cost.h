@@ -26,9 +26,17 @@ struct RayCost {
   std::uint32_t tests = 0;       // ray-triangle tests
 };
 
-// The covariate of the estimator: kd-tree steps plus triangle tests (the two kinds of work a
-// packet's threads wait for), plus one for the scene-box test every packet makes.
+// A single covariate: kd-tree steps plus triangle tests (the two kinds of work a packet's threads
+// wait for), plus one for the scene-box test every packet makes.
 double cost_covariate(const RayCost& c);
+
+// What the sampled simulation's cycles estimate is fitted on, per packet (testbench/sampling.h
+// estimate_cycles): a constant (the box test and the RGS's work every packet has), kd-tree steps,
+// triangle tests, leaves, list entries, transformations, and whether the packet meets the scene's
+// box. Each kind of work takes its own unit's cycles, so each gets its own coefficient.
+inline constexpr int kCostFeatures = 7;
+using CostFeatures = std::array<double, kCostFeatures>;
+CostFeatures cost_features(const RayCost& c);
 
 // The image's trees, instances and triangle matrices read once into binary32, for tracing rays
 // on the host. Matrices are decoded when a ray first needs them.

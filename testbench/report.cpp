@@ -343,6 +343,7 @@ nlohmann::json sampling_json(const CycleFrame& c) {
   nlohmann::json j = {{"window", s.spec.window},
                       {"period", s.spec.period},
                       {"warmup", s.spec.warmup},
+                      {"cooldown", s.spec.cooldown},
                       {"windows", s.windows},
                       {"packets", s.packets},
                       {"packets_simulated", s.packets_simulated},
@@ -350,6 +351,8 @@ nlohmann::json sampling_json(const CycleFrame& c) {
                       {"cycles_per_packet_cov", s.cycles_per_packet_cov},
                       {"covariate_seconds", s.covariate_seconds},
                       {"covariate_correlation", s.covariate_correlation},
+                      {"costly_packets", s.costly_packets},
+                      {"costly_windows", s.costly_windows},
                       {"trusted", s.defeated.empty()}};
   // A frame that defeats the sampling says why, and gives no interval to read as a narrow one.
   if (!s.defeated.empty()) {

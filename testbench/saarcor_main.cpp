@@ -124,8 +124,8 @@ CLI::Option* add_sample_option(CLI::App* sub, std::string& spec) {
   return sub
       ->add_option("--sample", spec,
                    "cycle model: sample the frame (SMARTS windows) and give each figure a 95 % "
-                   "interval; SPEC window=W,period=K,warmup=U in packets (default " +
-                       saarcor::sample_spec_text({}) + ")")
+                   "interval; SPEC window=W,period=K,warmup=U,cooldown=C in packets, any subset "
+                   "(the rest chosen for the chip and the frame: docs/sampling.md)")
       ->expected(0, 1);
 }
 bool sample_given(CLI::App* sub) {
@@ -364,7 +364,8 @@ void add_sample_check(CLI::App& app, saarcor::SampleCheckOptions& opts, int& sta
   sub->add_option("--config", opts.configs, "only this covering-design configuration (repeatable)");
   sub->add_option(
       "--sample", opts.sample_spec,
-      "SPEC window=W,period=K,warmup=U (default " + saarcor::sample_spec_text({}) + ")");
+      "SPEC window=W,period=K,warmup=U,cooldown=C (any subset; the rest chosen for the chip and "
+      "the frame)");
   sub->add_option("--json", opts.json, "write every case and the summary as JSON");
   sub->add_flag("--quiet", opts.quiet, "no line per case");
   sub->callback([&] { status = saarcor::run_sample_check(opts); });

@@ -36,7 +36,7 @@ int spec_value(const std::string& spec, const std::string& key, const std::strin
 SampleSpec parse_sample_spec(const std::string& spec) {
   SampleSpec s;
   if (spec.empty()) return s;
-  bool seen[3] = {false, false, false};
+  bool seen[4] = {false, false, false, false};
   std::size_t pos = 0;
   while (pos <= spec.size()) {
     const std::size_t end = std::min(spec.find(',', pos), spec.size());
@@ -44,24 +44,49 @@ SampleSpec parse_sample_spec(const std::string& spec) {
     const std::size_t eq = kv.find('=');
     if (eq == std::string::npos) bad_spec(spec, "expected KEY=VALUE, got '" + kv + "'");
     const std::string key = kv.substr(0, eq);
-    const int k = key == "window" ? 0 : key == "period" ? 1 : key == "warmup" ? 2 : -1;
-    if (k < 0) bad_spec(spec, "unknown key '" + key + "' (window, period, warmup)");
+    const int k = key == "window"     ? 0
+                  : key == "period"   ? 1
+                  : key == "warmup"   ? 2
+                  : key == "cooldown" ? 3
+                                      : -1;
+    if (k < 0) bad_spec(spec, "unknown key '" + key + "' (window, period, warmup, cooldown)");
     if (seen[k]) bad_spec(spec, key + " given twice");
     seen[k] = true;
     const int v = spec_value(spec, key, kv.substr(eq + 1));
-    (k == 0 ? s.window : k == 1 ? s.period : s.warmup) = v;
+    (k == 0 ? s.window : k == 1 ? s.period : k == 2 ? s.warmup : s.cooldown) = v;
     pos = end + 1;
   }
-  if (s.window < 1) bad_spec(spec, "window must be >= 1");
-  if (s.warmup + s.window > s.period)
-    bad_spec(spec, "warmup + window (" + std::to_string(s.warmup + s.window) +
-                       ") exceeds the period (" + std::to_string(s.period) + ")");
+  if (seen[0] && s.window < 1) bad_spec(spec, "window must be >= 1");
+  if (seen[0] && seen[1] && seen[2] && seen[3] && s.warmup + s.window + s.cooldown > s.period)
+    bad_spec(spec, "warmup + window + cooldown (" +
+                       std::to_string(s.warmup + s.window + s.cooldown) + ") exceeds the period (" +
+                       std::to_string(s.period) + ")");
+  if (seen[0] && seen[1] && s.window > s.period)
+    bad_spec(spec, "window (" + std::to_string(s.window) + ") exceeds the period (" +
+                       std::to_string(s.period) + ")");
   return s;
 }
 
+SampleSpec resolve_sample_spec(const SampleSpec& s, const units::CycleParams& p,
+                               const units::PacketTiling& tiling) {
+  const int t = p.threads * p.pipelines;
+  const int packets = tiling.count();
+  SampleSpec r = s;
+  if (r.warmup == kAuto) r.warmup = std::max(64, 2 * t);
+  if (r.cooldown == kAuto) r.cooldown = std::max(32, t);
+  if (r.window == kAuto) r.window = std::max(2 * t, tiling.tiles_x);
+  if (r.period == kAuto) {
+    const auto by_share = static_cast<int>(
+        std::lround(static_cast<double>(r.warmup + r.window + r.cooldown) / kSampleShare));
+    r.period = std::max(r.window, std::min(by_share, packets / kSampleWindows));
+  }
+  return r;
+}
+
 std::string sample_spec_text(const SampleSpec& s) {
-  return "window=" + std::to_string(s.window) + ",period=" + std::to_string(s.period) +
-         ",warmup=" + std::to_string(s.warmup);
+  const auto v = [](int x) { return x == kAuto ? std::string("auto") : std::to_string(x); };
+  return "window=" + v(s.window) + ",period=" + v(s.period) + ",warmup=" + v(s.warmup) +
+         ",cooldown=" + v(s.cooldown);
 }
 
 namespace {
@@ -77,28 +102,43 @@ std::uint64_t period_hash(std::uint64_t i) {
 }  // namespace
 
 SamplePlan plan_sample(int packets, const SampleSpec& s) {
+  if (s.window < 1 || s.period < s.window || s.warmup < 0 || s.cooldown < 0)
+    throw std::logic_error("plan_sample: an unresolved or impossible spec " + sample_spec_text(s));
   SamplePlan plan;
-  // Period i is [iK, iK + K); its warm-up and window, U + W packets in a row, start at a place
-  // drawn in [0, K - U - W] (stratified sampling: one window per period). A window at the same
-  // place of every period would see the same columns of the image whenever K is a multiple of a
-  // row's packets, and miss an object standing in the others.
-  // The last period also holds the frame's remainder (the bottom rows of tiles): left out, its
-  // packets would be estimated by the others' mean, a bias wherever they cost more or less.
+  // Period i is [iK, iK + K); its window of W packets starts at a place drawn in [iK, iK + K - W]
+  // (stratified sampling, one window per period, every packet of the period as likely to be
+  // measured as any other). A window at the same place of every period would see the same columns
+  // of the image whenever K is a multiple of a row's packets, and miss an object standing in the
+  // others. The last period also holds the frame's remainder (the bottom rows of tiles): left out,
+  // its packets would be estimated by the others' mean, a bias wherever they cost more or less.
+  // Around the window run its warm-up (the U packets before it: the caches fill, and the threads
+  // with the window's neighbours) and its cool-down (the C after it: its last packets share the
+  // machine with their neighbours, as in the frame, not with the next warm-up's). Both may reach
+  // into the neighbouring periods; where a warm-up would overlap the packets run before it, it
+  // starts after them (the run is then continuous, as the frame is), and neither runs past the
+  // frame's ends (there the frame itself starts or drains).
   const int periods = packets / s.period;
   for (int i = 0; i < periods; ++i) {
     const int size = i + 1 < periods ? s.period : packets - i * s.period;
-    const int slack = size - s.warmup - s.window;
-    const int first = i * s.period + static_cast<int>(period_hash(static_cast<std::uint64_t>(i)) %
-                                                      static_cast<std::uint64_t>(slack + 1));
-    for (int k = first; k < first + s.warmup; ++k)
-      plan.order.push_back(k);
-    plan.marks.push_back(static_cast<int>(plan.order.size()));
-    for (int k = first + s.warmup; k < first + s.warmup + s.window; ++k)
-      plan.order.push_back(k);
-    plan.marks.push_back(static_cast<int>(plan.order.size()));
+    plan.window_first.push_back(i * s.period +
+                                static_cast<int>(period_hash(static_cast<std::uint64_t>(i)) %
+                                                 static_cast<std::uint64_t>(size - s.window + 1)));
     plan.strata.push_back(size);
-    plan.window_first.push_back(first + s.warmup);
-    ++plan.windows;
+  }
+  plan.windows = periods;
+  int end = 0;  // the packets before `end` are handed out or skipped
+  for (int i = 0; i < periods; ++i) {
+    const int window = plan.window_first[static_cast<std::size_t>(i)];
+    const int next = i + 1 < periods ? plan.window_first[static_cast<std::size_t>(i) + 1] : packets;
+    for (int k = std::max(end, window - s.warmup); k < window; ++k)
+      plan.order.push_back(k);
+    plan.marks.push_back(static_cast<int>(plan.order.size()));
+    for (int k = window; k < window + s.window; ++k)
+      plan.order.push_back(k);
+    plan.marks.push_back(static_cast<int>(plan.order.size()));
+    end = std::min(next, window + s.window + s.cooldown);
+    for (int k = window + s.window; k < end; ++k)
+      plan.order.push_back(k);
   }
   return plan;
 }
@@ -142,38 +182,133 @@ double correlation(const std::vector<double>& a, const std::vector<double>& b) {
   return aa > 0 && bb > 0 ? co_sum(a, b) / std::sqrt(aa * bb) : 0;
 }
 
-FigureEstimate estimate_cycles(const std::vector<double>& cpp, const std::vector<double>& strata,
-                               double sampled_fraction, const std::vector<double>& x,
-                               const std::vector<double>& period_x) {
+namespace {
+
+// Least squares on the normal equations a x = b (a symmetric, positive semi-definite, k x k):
+// Cholesky with a column whose pivot has vanished (no spread left once the earlier columns are
+// fitted, such as transformations in a scene without instances) dropped, its coefficient 0.
+std::vector<double> least_squares(std::vector<std::vector<double>> a, std::vector<double> b) {
+  const std::size_t k = b.size();
+  std::vector<bool> dropped(k, false);
+  std::vector<std::vector<double>> l(k, std::vector<double>(k, 0.0));
+  for (std::size_t j = 0; j < k; ++j) {
+    double d = a[j][j];
+    for (std::size_t m = 0; m < j; ++m)
+      d -= l[j][m] * l[j][m];
+    if (!(d > 1e-9 * a[j][j]) || a[j][j] <= 0) {
+      dropped[j] = true;
+      continue;
+    }
+    l[j][j] = std::sqrt(d);
+    for (std::size_t i = j + 1; i < k; ++i) {
+      double v = a[i][j];
+      for (std::size_t m = 0; m < j; ++m)
+        v -= l[i][m] * l[j][m];
+      l[i][j] = v / l[j][j];
+    }
+  }
+  // L z = b, then L^T x = z, over the kept columns.
+  std::vector<double> z(k, 0.0), x(k, 0.0);
+  for (std::size_t i = 0; i < k; ++i) {
+    if (dropped[i]) continue;
+    double v = b[i];
+    for (std::size_t m = 0; m < i; ++m)
+      v -= l[i][m] * z[m];
+    z[i] = v / l[i][i];
+  }
+  for (std::size_t i = k; i-- > 0;) {
+    if (dropped[i]) continue;
+    double v = z[i];
+    for (std::size_t m = i + 1; m < k; ++m)
+      v -= l[m][i] * x[m];
+    x[i] = v / l[i][i];
+  }
+  return x;
+}
+
+// A packet's features as the fit reads them: only the constant without features.
+CostFeatures feature_row(const std::vector<CostFeatures>& features, std::size_t packet) {
+  CostFeatures f{};
+  f[0] = 1.0;
+  if (!features.empty()) f = features.at(packet);
+  return f;
+}
+
+// The least-squares coefficients of every measured packet's charge on its features (k of them).
+std::vector<double> fit_charges(const std::vector<WindowCharges>& windows,
+                                const std::vector<CostFeatures>& features, std::size_t k) {
+  std::vector<std::vector<double>> a(k, std::vector<double>(k, 0.0));
+  std::vector<double> b(k, 0.0);
+  for (const WindowCharges& w : windows)
+    for (std::size_t j = 0; j < w.charges.size(); ++j) {
+      const CostFeatures f = feature_row(features, static_cast<std::size_t>(w.first) + j);
+      for (std::size_t r = 0; r < k; ++r) {
+        b[r] += f[r] * w.charges[j];
+        for (std::size_t c = 0; c < k; ++c)
+          a[r][c] += f[r] * f[c];
+      }
+    }
+  return least_squares(a, b);
+}
+
+}  // namespace
+
+FigureEstimate estimate_cycles(const std::vector<WindowCharges>& windows,
+                               const std::vector<CostFeatures>& features, double sampled_fraction,
+                               double* fit_correlation, std::vector<double>* fitted) {
   FigureEstimate e;
-  const std::size_t n = cpp.size();
+  const std::size_t n = windows.size();
   if (n == 0) return e;
-  if (strata.size() != n) throw std::logic_error("estimate_cycles: one stratum a window");
-  const bool regression = !x.empty();
-  if (regression && (x.size() != n || period_x.size() != n))
-    throw std::logic_error("estimate_cycles: one covariate a window and a period");
-  // The slope; the intercept's degree of freedom is the mean's, the slope's one more.
-  const double sxx = regression ? co_sum(x, x) : 0;
-  const double b = sxx > 0 ? co_sum(x, cpp) / sxx : 0;
-  const std::size_t fitted = regression ? 2 : 1;
+  const std::size_t k = features.empty() ? 1 : static_cast<std::size_t>(kCostFeatures);
+  const std::vector<double> beta = fit_charges(windows, features, k);
+  const auto fit = [&](std::size_t packet) {
+    const CostFeatures f = feature_row(features, packet);
+    double v = 0;
+    for (std::size_t r = 0; r < k; ++r)
+      v += beta[r] * f[r];
+    return v;
+  };
+  // The fit over the frame's packets (as many as the strata hold), and each window's residual.
   double packets = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    e.value += strata[i] * (cpp[i] + (regression ? b * (period_x[i] - x[i]) : 0.0));
-    packets += strata[i];
+  for (const WindowCharges& w : windows)
+    packets += w.stratum;
+  if (features.empty()) {
+    e.value = beta[0] * packets;
+  } else {
+    if (static_cast<double>(features.size()) != packets)
+      throw std::logic_error("estimate_cycles: one feature row a packet of the frame");
+    if (fitted != nullptr) fitted->assign(features.size(), 0.0);
+    for (std::size_t p = 0; p < features.size(); ++p) {
+      const double v = fit(p);
+      e.value += v;
+      if (fitted != nullptr) (*fitted)[p] = v;
+    }
   }
-  if (n <= fitted) return e;
-  const double my = mean_of(cpp), mx = regression ? mean_of(x) : 0;
+  std::vector<double> residual(n), measured(n), window_fit(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const WindowCharges& w = windows[i];
+    double y = 0, f = 0;
+    for (std::size_t j = 0; j < w.charges.size(); ++j) {
+      y += w.charges[j];
+      f += fit(static_cast<std::size_t>(w.first) + j);
+    }
+    const auto size = static_cast<double>(std::max<std::size_t>(w.charges.size(), 1));
+    measured[i] = y / size;
+    window_fit[i] = f / size;
+    residual[i] = measured[i] - window_fit[i];
+    e.value += w.stratum * residual[i];
+  }
+  if (fit_correlation != nullptr) *fit_correlation = correlation(measured, window_fit);
+  if (n < 2) return e;
+  const double mr = mean_of(residual);
   double ss = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double r = cpp[i] - my - (regression ? b * (x[i] - mx) : 0.0);
-    ss += r * r;
-  }
-  const auto df = static_cast<double>(n - fitted);
-  // The standard error of the mean, with the finite-population correction of sampling a share
-  // `sampled_fraction` of the frame's packets.
-  const double se =
-      std::sqrt(ss / df / static_cast<double>(n) * std::max(0.0, 1.0 - sampled_fraction));
-  const double half = student_t975(static_cast<int>(n - fitted)) * se * packets;
+  for (double r : residual)
+    ss += (r - mr) * (r - mr);
+  // The standard error of the mean residual, with the finite-population correction of sampling
+  // a share `sampled_fraction` of the frame's packets.
+  const double se = std::sqrt(ss / static_cast<double>(n - 1) / static_cast<double>(n) *
+                              std::max(0.0, 1.0 - sampled_fraction));
+  const double half = student_t975(static_cast<int>(n - 1)) * se * packets;
   e.ci = {e.value - half, e.value + half};
   return e;
 }
@@ -270,21 +405,48 @@ void check_sampled_packets(const memif::MemoryImage& image, const units::CyclePa
 namespace {
 
 // Why the windows' sample defeats the interval, or "".
-std::string defeated_because(int windows, double cov) {
-  char buf[160];
-  if (windows < kMinSampleWindows) {
-    std::snprintf(buf, sizeof buf, "only %d windows (an interval needs at least %d)", windows,
+std::string defeated_because(const SampleSummary& s) {
+  char buf[256];
+  if (s.windows < kMinSampleWindows) {
+    std::snprintf(buf, sizeof buf, "only %d windows (an interval needs at least %d)", s.windows,
                   kMinSampleWindows);
     return buf;
   }
-  if (cov > kMaxSampleCov) {
+  if (s.costly_windows < kMinCostlyWindows) {
     std::snprintf(buf, sizeof buf,
-                  "the cost is concentrated in few packets (coefficient of variation of the "
-                  "windows' cycles per packet %.2f > %.2f)",
-                  cov, kMaxSampleCov);
+                  "the cost is concentrated in few packets (half of it in %llu of %llu packets, "
+                  "which %d windows reach; an interval needs %d)",
+                  static_cast<unsigned long long>(s.costly_packets),
+                  static_cast<unsigned long long>(s.packets), s.costly_windows, kMinCostlyWindows);
     return buf;
   }
   return "";
+}
+
+// The fewest packets holding half the fitted cost of the frame, and how many windows reach them.
+void costly_packets(const std::vector<double>& fitted, const SamplePlan& plan,
+                    const SampleSpec& spec, SampleSummary& s) {
+  std::vector<std::pair<double, std::size_t>> by_cost;
+  double total = 0;
+  for (std::size_t p = 0; p < fitted.size(); ++p) {
+    by_cost.emplace_back(std::max(0.0, fitted[p]), p);
+    total += std::max(0.0, fitted[p]);
+  }
+  std::sort(by_cost.begin(), by_cost.end(), std::greater<>());
+  std::vector<bool> costly(fitted.size(), false);
+  double held = 0;
+  for (const auto& [cost, p] : by_cost) {
+    if (held >= 0.5 * total) break;
+    held += cost;
+    costly[p] = true;
+    ++s.costly_packets;
+  }
+  for (int first : plan.window_first)
+    for (int k = first; k < first + spec.window; ++k)
+      if (costly[static_cast<std::size_t>(k)]) {
+        ++s.costly_windows;
+        break;
+      }
 }
 
 double coefficient_of_variation(const std::vector<double>& v) {
@@ -297,41 +459,37 @@ double coefficient_of_variation(const std::vector<double>& v) {
   return mean > 0 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) / mean : 0;
 }
 
-// The covariate's means per window (its own packets) and per period (estimate_cycles' x and
-// period_x).
-void covariate_means(const SamplePlan& plan, const SampleSpec& spec,
-                     const std::vector<double>& cost, std::vector<double>& x,
-                     std::vector<double>& period_x) {
-  std::vector<double> prefix(cost.size() + 1, 0.0);
-  for (std::size_t k = 0; k < cost.size(); ++k)
-    prefix[k + 1] = prefix[k] + cost[k];
-  const auto mean = [&](std::size_t a, std::size_t b) {
-    b = std::min(b, cost.size());
-    return b > a ? (prefix[b] - prefix[a]) / static_cast<double>(b - a) : 0.0;
-  };
-  for (int i = 0; i < plan.windows; ++i) {
-    const auto first = static_cast<std::size_t>(plan.window_first[std::size_t(i)]);
-    x.push_back(mean(first, first + static_cast<std::size_t>(spec.window)));
-    const auto begin = static_cast<std::size_t>(i) * static_cast<std::size_t>(spec.period);
-    period_x.push_back(mean(begin, begin + static_cast<std::size_t>(plan.strata[std::size_t(i)])));
-  }
-}
-
 // The frame's figures from the run's windows and the packets' covariate into `c` (its usual
 // fields) and `s`.
 void estimate_frame(const units::CycleParams& p, const SamplePlan& plan, std::uint64_t packets,
-                    const std::vector<double>& cost, CycleFrame& c, SampleSummary& s) {
+                    const std::vector<CostFeatures>& features, CycleFrame& c, SampleSummary& s) {
   std::vector<units::FigureCounts> spans;
-  std::vector<double> cpp, x, period_x;
-  for (int i = 0; i < plan.windows; ++i) {
-    spans.push_back(units::span(c.marks[2 * std::size_t(i)], c.marks[2 * std::size_t(i) + 1]));
-    cpp.push_back(static_cast<double>(spans.back().cycle) / s.spec.window);
+  std::vector<WindowCharges> windows;
+  std::vector<double> cpp;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(plan.windows); ++i) {
+    spans.push_back(units::span(c.marks[2 * i], c.marks[2 * i + 1]));
+    // The window's packets' charged cycles: their own share of the machine.
+    WindowCharges w;
+    w.first = plan.window_first[i];
+    w.stratum = plan.strata[i];
+    w.charges.assign(c.packet_charges.begin() + plan.marks[2 * i],
+                     c.packet_charges.begin() + plan.marks[2 * i + 1]);
+    double sum = 0;
+    for (double x : w.charges)
+      sum += x;
+    cpp.push_back(sum / static_cast<double>(w.charges.size()));
+    windows.push_back(std::move(w));
   }
-  covariate_means(plan, s.spec, cost, x, period_x);
-  s.covariate_correlation = correlation(x, cpp);
   const double f = static_cast<double>(plan.windows) * s.spec.window / static_cast<double>(packets);
-  const FigureEstimate cycles = estimate_cycles(
-      cpp, std::vector<double>(plan.strata.begin(), plan.strata.end()), f, x, period_x);
+  std::vector<double> fitted;
+  FigureEstimate cycles = estimate_cycles(windows, features, f, &s.covariate_correlation, &fitted);
+  costly_packets(fitted, plan, s.spec, s);
+  // The cycles in which no packet was in flight (before the first hand-out, the frame buffer's
+  // last writes) are the frame's as the sampled run's.
+  const auto uncharged = static_cast<double>(c.uncharged_cycles);
+  cycles.value += uncharged;
+  cycles.ci.low += uncharged;
+  cycles.ci.high += uncharged;
   const double hz = p.clock_mhz * 1e6;
   // The frame's rays from the simulated packets' rays per packet (`rays` stays theirs, as the
   // per-ray counters beside it are).
@@ -352,32 +510,34 @@ void estimate_frame(const units::CycleParams& p, const SamplePlan& plan, std::ui
   // The RGS's bytes per pixel: the simulated packets' bytes over their pixels.
   c.shading_bytes_per_pixel *= static_cast<double>(packets) / static_cast<double>(c.packets);
   s.cycles_per_packet_cov = coefficient_of_variation(cpp);
-  s.defeated = defeated_because(plan.windows, s.cycles_per_packet_cov);
+  s.defeated = defeated_because(s);
 }
 
 }  // namespace
 
 CycleFrame run_sampled(const memif::MemoryImage& image, const units::CycleParams& params,
-                       const CycleRunOptions& options, const SampleSpec& spec) {
+                       const CycleRunOptions& options, const SampleSpec& requested) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto& r = image.registers();
-  const int packets =
-      units::packet_tiling(static_cast<int>(r.width), static_cast<int>(r.height), params.packet)
-          .count();
+  const units::PacketTiling tiling =
+      units::packet_tiling(static_cast<int>(r.width), static_cast<int>(r.height), params.packet);
+  const int packets = tiling.count();
+  const SampleSpec spec = resolve_sample_spec(requested, params, tiling);
   const SamplePlan plan = plan_sample(packets, spec);
-  if (plan.windows == 0 || static_cast<int>(plan.order.size()) > packets)
+  if (plan.windows == 0 || static_cast<int>(plan.order.size()) >= packets)
     return run_cycle(image, params, options);
   // The covariate of every packet, before the run and inside its host time.
   const auto tc = std::chrono::steady_clock::now();
-  std::vector<double> cost;
+  std::vector<CostFeatures> features;
   for (const RayCost& r : packet_costs(image, params.packet))
-    cost.push_back(cost_covariate(r));
+    features.push_back(cost_features(r));
   const double covariate_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
   CycleRunOptions o = options;
   o.packet_order = plan.order;
   o.marks = plan.marks;
   o.interval = 0;  // a time series of a sampled run would mix the periods
+  o.charge_packets = true;
   CycleFrame c = run_cycle(image, params, o);
   auto s = std::make_shared<SampleSummary>();
   s->spec = spec;
@@ -386,7 +546,7 @@ CycleFrame run_sampled(const memif::MemoryImage& image, const units::CycleParams
   s->packets_simulated = plan.order.size();
   s->cycles_simulated = c.cycles;
   s->covariate_seconds = covariate_seconds;
-  estimate_frame(params, plan, static_cast<std::uint64_t>(packets), cost, c, *s);
+  estimate_frame(params, plan, static_cast<std::uint64_t>(packets), features, c, *s);
   c.packets = static_cast<std::uint64_t>(packets);
   c.sampling = std::move(s);
   c.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

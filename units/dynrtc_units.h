@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <string>
+#include <vector>
 
 #include "hw/cycle_marks.h"
 #include "memif/memory_controller.h"
@@ -69,6 +70,55 @@ class IntersectionUnit : public CycleUnit {
   Fetch fetch(const Request& r) const override;
 };
 
+// What each primary packet costs the chip in cycles, for sampled simulation (docs/sampling.md
+// "Charged cycles"): every cycle is shared equally among the packets in flight then (handed out by
+// the RGC, their thread not yet freed), so a packet is charged the sum of 1/n over the cycles of
+// its residence, n the packets in flight in each. The charges of all packets add up to the cycles
+// in which any packet was in flight; a window's packets are charged for exactly their own
+// residence, whatever else shares the machine, where the span between two hand-outs would measure
+// the packets in flight around them. Kept per event (hand-out, retirement), not per cycle.
+class PacketCharges {
+ public:
+  // `packets`: the hand-outs (the RGC's ordinals); `threads`: the chip's thread ids.
+  PacketCharges(int packets, int threads)
+      : charge_(static_cast<std::size_t>(packets), 0.0),
+        start_(static_cast<std::size_t>(threads), 0.0),
+        ordinal_(static_cast<std::size_t>(threads), -1) {}
+
+  void admit(ThreadToken t, int ordinal, std::uint64_t now) {
+    advance(now);
+    ++in_flight_;
+    start_[t] = shared_;
+    ordinal_[t] = ordinal;
+  }
+  void retire(ThreadToken t, std::uint64_t now) {
+    advance(now);
+    --in_flight_;
+    charge_[static_cast<std::size_t>(ordinal_[t])] = shared_ - start_[t];
+    ordinal_[t] = -1;
+  }
+  // By the RGC's ordinal (0 for a packet not yet retired).
+  const std::vector<double>& charges() const { return charge_; }
+  // The cycles up to the last event in which no packet was in flight (before the first hand-out).
+  std::uint64_t empty_cycles() const { return empty_; }
+  std::uint64_t last_event() const { return last_; }
+
+ private:
+  void advance(std::uint64_t now) {
+    if (in_flight_ > 0)
+      shared_ += static_cast<double>(now - last_) / in_flight_;
+    else
+      empty_ += now - last_;
+    last_ = now;
+  }
+  std::vector<double> charge_;
+  std::vector<double> start_;  // by thread: the running share when its packet was handed out
+  std::vector<int> ordinal_;   // by thread: its packet's ordinal, -1 when free
+  double shared_ = 0;          // sum over cycles of 1 / packets in flight
+  int in_flight_ = 0;
+  std::uint64_t last_ = 0, empty_ = 0;
+};
+
 // The ray generation controller (paper section 3: it "schedules screen-space pixels", the dynamic
 // load balancing between DynRTPs): the frame's packets in order, to whichever pipeline asks for
 // one in a cycle it is granted. The grant goes round robin, one pipeline per cycle (D44; with one
@@ -103,8 +153,13 @@ class RayGenerationController {
   bool all_handed_out() const { return next_ == packets_; }
   int handed_out() const { return next_; }  // packets taken so far (the next one's ordinal)
   int packets() const { return packets_; }
+  // Sampled simulation: where the RaySources report each packet's hand-out and retirement (null:
+  // nowhere, the default).
+  void set_charges(PacketCharges* c) { charges_ = c; }
+  PacketCharges* charges() const { return charges_; }
 
  private:
+  PacketCharges* charges_ = nullptr;
   int packets_;
   int pipelines_;
   int next_ = 0;

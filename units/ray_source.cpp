@@ -61,6 +61,8 @@ void RaySource::retire(ThreadToken thread) {
   free_list_.push_back(thread);
   ++free_;
   ++*retired_;
+  if (PacketCharges* c = rgc_.charges()) [[unlikely]]
+    c->retire(thread, now());
 }
 
 // A request with memory accesses keeps its thread (without memory ports, as in the unit tests
@@ -100,7 +102,10 @@ int RaySource::admit() {
   const ThreadToken t = free_list_.front();
   free_list_.pop_front();
   --free_;
-  threads_.start_primary(t, rgc_.take(now()));
+  const int ordinal = rgc_.take(now());
+  threads_.start_primary(t, ordinal);
+  if (PacketCharges* c = rgc_.charges()) [[unlikely]]
+    c->admit(t, ordinal, now());
   a->push(t);
   if (observer_ != nullptr) [[unlikely]]
     observer_->queued(now(), UnitId::kTransformation, t);
