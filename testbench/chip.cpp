@@ -88,7 +88,7 @@ class Chip {
   }
   int pipelines() const { return static_cast<int>(pipes_.size()); }
   int handed_out() const { return rgc_.handed_out(); }
-  void charge_packets(units::PacketCharges* c) { rgc_.set_charges(c); }
+  void charge_packets(PacketCharges* c) { rgc_.set_charges(c); }
   DynRtp& pipeline(int i) { return *pipes_[static_cast<std::size_t>(i)]; }
   void observe(UnitObserver* o) {
     for (auto& d : pipes_)
@@ -389,6 +389,21 @@ void collect_rgs(const memif::MemoryImage& image, int bank, const FigureCounts& 
       pixels > 0 ? static_cast<double>(end.shading_bytes + end.frame_bytes) / pixels : 0.0;
 }
 
+// A sampled frame's charges (units::PacketCharges), fed by the chip's RGS, when asked for.
+std::unique_ptr<PacketCharges> charge_packets(Chip& chip, int packets, const CycleParams& p,
+                                              const CycleRunOptions& opt) {
+  if (!opt.charge_packets) return nullptr;
+  auto c = std::make_unique<PacketCharges>(packets, p.pipelines * p.threads);
+  chip.charge_packets(c.get());
+  return c;
+}
+
+// The charges at the frame's end `now`; its cycles after the last retirement are no packet's.
+void collect_charges(const PacketCharges& c, std::uint64_t now, CycleFrame& out) {
+  out.packet_charges = c.charges();
+  out.uncharged_cycles = c.empty_cycles() + (now - c.last_event());
+}
+
 // The kernel's watchdog, evaluation order and idle skipping.
 hw::KernelConfig kernel_config(const CycleParams& p, const CycleRunOptions& opt) {
   hw::KernelConfig kc;
@@ -423,11 +438,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   CycleFrame out;
   out.params = p;
   out.packets = static_cast<std::uint64_t>(threads.packets());
-  std::optional<units::PacketCharges> charges;
-  if (opt.charge_packets) {
-    charges.emplace(threads.packets(), p.pipelines * p.threads);
-    chip.charge_packets(&*charges);
-  }
+  const std::unique_ptr<PacketCharges> charges = charge_packets(chip, threads.packets(), p, opt);
   const ChipCounters counters(chip);
   const FigureCounts start = snapshot(k, counters);
   const bool uploading = upload != nullptr && start_upload(k, chip, threads, p, opt, *upload, out);
@@ -438,10 +449,7 @@ CycleFrame run_cycle_format(const memif::MemoryImage& image_in, const CycleParam
   if (opt.interval != 0)
     out.series = interval_figures(k, counters, start, opt.interval, p.clock_mhz);
   out.cycles = k.now();
-  if (charges) {
-    out.packet_charges = charges->charges();
-    out.uncharged_cycles = charges->empty_cycles() + (k.now() - charges->last_event());
-  }
+  if (charges) collect_charges(*charges, k.now(), out);
   if (uploading) finish_upload(k, chip, p, out);
 
   threads.finish();
