@@ -72,7 +72,9 @@ SampleSpec resolve_sample_spec(const SampleSpec& s, const units::CycleParams& p,
   const int t = p.threads * p.pipelines;
   const int packets = tiling.count();
   SampleSpec r = s;
-  if (r.warmup == kAuto) r.warmup = std::max(64, 2 * t);
+  // With several DynRTPs each has its own caches, and a window's packets find in them, in the
+  // frame, the items of the tile row above: the warm-up reaches back over that row too.
+  if (r.warmup == kAuto) r.warmup = std::max(64, 2 * t) + (p.pipelines > 1 ? tiling.tiles_x : 0);
   if (r.cooldown == kAuto) r.cooldown = std::max(32, t);
   if (r.window == kAuto) r.window = std::max(2 * t, tiling.tiles_x);
   if (r.period == kAuto) {

@@ -46,17 +46,18 @@ TEST(Sampling, DefaultChosenForTheMachineAndTheFrame) {
   EXPECT_EQ(sample_spec_text(resolve_sample_spec({}, p, units::packet_tiling(512, 384, 4))),
             "window=256,period=2457,warmup=128,cooldown=64");
   // 12 threads (4 x 3 DynRTPs) of 16-ray packets at 1024x768 (49,152 packets, 256 a row):
-  // warm-up 64, cool-down 32, window 256; 352 / 0.08 = 4,400 would give 11 windows, so 2,457.
+  // warm-up 64 and, with several DynRTPs, the row above, 320; cool-down 32, window 256;
+  // 608 / 0.08 = 7,600 would give 6 windows, so 2,457.
   p.threads = 4;
   p.pipelines = 3;
   p.packet = 16;
   const units::PacketTiling t16 = units::packet_tiling(1024, 768, 16);
   EXPECT_EQ(sample_spec_text(resolve_sample_spec({}, p, t16)),
-            "window=256,period=2457,warmup=64,cooldown=32");
+            "window=256,period=2457,warmup=320,cooldown=32");
   // What the SPEC gives is kept.
   EXPECT_EQ(
       sample_spec_text(resolve_sample_spec(parse_sample_spec("window=10,cooldown=0"), p, t16)),
-      "window=10,period=925,warmup=64,cooldown=0");
+      "window=10,period=2457,warmup=320,cooldown=0");
   // 256 threads (64 on each of 4 DynRTPs): windows of two thread tables, longer than a row.
   p.threads = 64;
   p.pipelines = 4;
