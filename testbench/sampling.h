@@ -1,10 +1,12 @@
 // Sampled simulation of a frame (docs/sampling.md; SMARTS, Wunderlich et al., ISCA 2003): the
 // frame's packets in the RGC's dispatch order are split into periods of `period` packets; in each
-// the cycle model runs `warmup` packets in detail (the pipeline fills with the period's packets,
-// the caches with their items) and then measures `window` packets; the rest of the period is
-// skipped. The figures of the frame are estimated from the measured windows with a 95 %
-// confidence interval from the windows' sample variance. Every simulated packet (warm-up and
-// window) is checked bit for bit against the functional model.
+// the cycle model measures a window of `window` packets, run in detail between `warmup` packets
+// before it and `cooldown` after it (the threads and caches hold the window's neighbours, as in
+// the frame); the rest is skipped. Each simulated packet is charged its share of the cycles
+// (units::PacketCharges); the frame's cycles come from a regression of the windows' charges on
+// per-packet cost features (testbench/packet_cost.h), with a 95 % confidence interval from what it
+// leaves over between windows; the other figures are the windows' pooled ratios. Every simulated
+// packet is checked bit for bit against the functional model.
 #pragma once
 
 #include <array>
