@@ -10,10 +10,6 @@
 
 namespace saarcor {
 
-double cost_covariate(const RayCost& c) {
-  return 1.0 + static_cast<double>(c.steps) + static_cast<double>(c.tests);
-}
-
 CostFeatures cost_features(const RayCost& c) {
   return {1.0,
           static_cast<double>(c.steps),

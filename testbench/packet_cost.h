@@ -1,10 +1,10 @@
 // A per-packet cost known for every packet of a frame without the cycle simulation: the work of
 // one ray through the packet's centre (four, through its quadrants', for packets of 16 rays or
 // more), traced by a plain binary32 traversal of the memory image's own kd-trees
-// (docs/sampling.md, decision D53). The sampled simulation's regression estimator
-// (testbench/sampling.h) uses it as its covariate: the windows measure cycles, this says where
-// the frame's work lies between them. It costs 0.2-3.5 % of the full cycle run, where the fp24
-// functional model over every ray costs a quarter of it.
+// (docs/sampling.md, decisions D53 and D54). The sampled simulation's regression estimator
+// (testbench/sampling.h) fits the windows' charged cycles on its features: the windows measure
+// cycles, this says where the frame's work lies between them. It costs 0.2-3.5 % of the full cycle
+// run, where the fp24 functional model over every ray costs a quarter of it.
 #pragma once
 
 #include <array>
@@ -25,10 +25,6 @@ struct RayCost {
   std::uint32_t transforms = 0;  // world -> object transformations (instances entered)
   std::uint32_t tests = 0;       // ray-triangle tests
 };
-
-// A single covariate: kd-tree steps plus triangle tests (the two kinds of work a packet's threads
-// wait for), plus one for the scene-box test every packet makes.
-double cost_covariate(const RayCost& c);
 
 // What the sampled simulation's cycles estimate is fitted on, per packet (testbench/sampling.h
 // estimate_cycles): a constant (the box test and the RGS's work every packet has), kd-tree steps,

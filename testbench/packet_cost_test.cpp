@@ -12,7 +12,8 @@ namespace {
 TEST(PacketCost, EmptyPacketCostsTheBoxTestOnly) {
   // builtin:triangle: one triangle (-1,-1,0), (1,-1,0), (0,1,0) seen from (0,0,3). Its scene box
   // is the triangle's, [-1,1] x [-1,1] x [0,0]. The top-left pixel's ray meets the plane z = 0
-  // outside it: no kd step, no test, covariate 1 (the box test every packet makes).
+  // outside it: no kd step, no test; its features the constant alone (the box test every packet
+  // makes).
   const memif::MemoryImage image = sample_check_image("builtin:triangle", "64x48");
   const PacketCostModel model(image);
   const RayCost corner = model.trace_pixel(0, 0);
@@ -21,10 +22,10 @@ TEST(PacketCost, EmptyPacketCostsTheBoxTestOnly) {
   EXPECT_EQ(corner.steps, 0u);
   EXPECT_EQ(corner.leaves, 0u);
   EXPECT_EQ(corner.tests, 0u);
-  EXPECT_EQ(cost_covariate(corner), 1.0);
+  EXPECT_EQ(cost_features(corner), (CostFeatures{1, 0, 0, 0, 0, 0, 0}));
   // The image centre's ray hits (0,0,0), inside the triangle. Both trees are single leaves (one
   // instance, one triangle): no step, two leaves, two list entries (the instance, the
-  // triangle), one transformation, one test: covariate 1 + 0 + 1 = 2.
+  // triangle), one transformation, one test, inside the box.
   const RayCost centre = model.trace_pixel(31.5, 23.5);
   EXPECT_TRUE(centre.box);
   EXPECT_TRUE(centre.hit);
@@ -33,7 +34,7 @@ TEST(PacketCost, EmptyPacketCostsTheBoxTestOnly) {
   EXPECT_EQ(centre.lists, 2u);
   EXPECT_EQ(centre.transforms, 1u);
   EXPECT_EQ(centre.tests, 1u);
-  EXPECT_EQ(cost_covariate(centre), 2.0);
+  EXPECT_EQ(cost_features(centre), (CostFeatures{1, 0, 1, 2, 2, 1, 1}));
 }
 
 TEST(PacketCost, OneRayPerPacketThroughTheTileCentre) {

@@ -171,6 +171,19 @@ std::vector<CostFeatures> frame_features(int n, const std::function<double(int)>
   return f;
 }
 
+// Four windows of 5 packets at 0, 100, 200 and 300, each standing for 100, their packets
+// charged 2 + 3 x steps(k), window 0's `noise` more.
+std::vector<WindowCharges> line_windows(const std::function<double(int)>& steps, double noise) {
+  std::vector<WindowCharges> w;
+  for (int i = 0; i < 4; ++i) {
+    WindowCharges c{{}, 100 * i, 100.0};
+    for (int k = c.first; k < c.first + 5; ++k)
+      c.charges.push_back(2 + 3 * steps(k) + (i == 0 ? noise : 0.0));
+    w.push_back(c);
+  }
+  return w;
+}
+
 TEST(Sampling, RegressionEstimateOnSyntheticData) {
   // 400 packets costing exactly 2 + 3 x steps, steps k % 7: the true total is the sum over the
   // frame. Four windows of 5 packets at 0, 100, 200, 300 fit it exactly: the estimate is exact
@@ -181,13 +194,7 @@ TEST(Sampling, RegressionEstimateOnSyntheticData) {
   double truth = 0;
   for (int k = 0; k < 400; ++k)
     truth += 2 + 3 * steps(k);
-  std::vector<WindowCharges> w;
-  for (int i = 0; i < 4; ++i) {
-    WindowCharges c{{}, 100 * i, 100.0};
-    for (int k = c.first; k < c.first + 5; ++k)
-      c.charges.push_back(2 + 3 * steps(k));
-    w.push_back(c);
-  }
+  std::vector<WindowCharges> w = line_windows(steps, 0.0);
   double r = 0;
   const FigureEstimate exact = estimate_cycles(w, f, 0.0, &r);
   EXPECT_NEAR(exact.value, truth, 1e-6);
@@ -204,13 +211,7 @@ TEST(Sampling, RegressionEstimateAgainstAClosedForm) {
   // packets.
   const auto steps = [](int k) { return static_cast<double>(k % 7); };
   const std::vector<CostFeatures> f = frame_features(400, steps);
-  std::vector<WindowCharges> w;
-  for (int i = 0; i < 4; ++i) {
-    WindowCharges c{{}, 100 * i, 100.0};
-    for (int k = c.first; k < c.first + 5; ++k)
-      c.charges.push_back(2 + 3 * steps(k) + (i == 0 ? 1 : 0));
-    w.push_back(c);
-  }
+  std::vector<WindowCharges> w = line_windows(steps, 1.0);
   double sx = 0, sy = 0;
   std::vector<std::pair<double, double>> xy;
   for (const WindowCharges& c : w)
