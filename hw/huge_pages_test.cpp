@@ -55,5 +55,30 @@ TEST(HugePages, AThresholdAboveOnePageKeepsSmallerBuffersOnTheDefaultAllocator) 
   alloc.deallocate(small, words - 1);
 }
 
+// A frame's buffers (units::FrameSink): zero bytes, nothing written by the container, a fresh
+// buffer zero again after a used one is freed, large ones 2 MiB-aligned.
+TEST(ZeroPages, BuffersStartAsZeroBytesAndResizeWritesNothing) {
+  struct Record {
+    std::uint32_t a = 7, b = 9;  // a value-initialised Record is not zero bytes
+  };
+  using Buffer = std::vector<Record, ZeroPageAllocator<Record>>;
+  const std::size_t n = 3 * kHuge / sizeof(Record) + 5;
+  for (int round = 0; round < 2; ++round) {
+    Buffer v(n);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % kHuge, 0u);
+    for (std::size_t i = 0; i < n; i += 4097)
+      ASSERT_EQ(v[i].a + v[i].b, 0u) << i;
+    EXPECT_EQ(v.back().a, 0u);
+    v[0] = Record{};  // dirty it: the next round's buffer must still start as zero bytes
+    v[n - 1] = Record{};
+    advise_pages(v.data(), n * sizeof(Record), round == 0);
+    EXPECT_EQ(v[n - 1].b, 9u);
+  }
+  Buffer small(3);  // below a huge page: calloc
+  EXPECT_EQ(small[2].a, 0u);
+  small.push_back(Record{});  // an explicit value is still constructed
+  EXPECT_EQ(small[3].b, 9u);
+}
+
 }  // namespace
 }  // namespace saarcor::hw

@@ -319,6 +319,21 @@ TEST(Sampling, SampledFrameAgainstTheFullOne) {
   EXPECT_EQ(s.packets_retired, simulated);
   EXPECT_TRUE(s.sampling->defeated.empty()) << s.sampling->defeated;
   EXPECT_NO_THROW(check_sampled_packets(image, p, {}, s));
+  // Every record of the full frame was written by its packet (no ray's t is zero bytes); the
+  // sampled run wrote its packets' pixels and no other (FrameSink: never written before the run).
+  for (const units::FrameSink::Pixel& px : full.frame.pixels)
+    ASSERT_NE(px.t, 0u);
+  std::set<std::uint32_t> handed_out;
+  const units::PacketTiling tiling = units::packet_tiling(256, 192, p.packet);
+  for (int packet : plan_sample(12288, spec).order)
+    for (std::uint32_t px : units::packet_pixels(tiling, 256, 192, packet))
+      handed_out.insert(px);
+  for (std::uint32_t i = 0; i < s.frame.pixels.size(); ++i) {
+    ASSERT_EQ(s.frame.pixels[i].t != 0u, handed_out.count(i) == 1) << "pixel " << i;
+    if (handed_out.count(i) == 0) {
+      ASSERT_EQ(s.frame.pixels[i].instance, 0u) << "pixel " << i;
+    }
+  }
   const double err = (static_cast<double>(s.cycles) - static_cast<double>(full.cycles)) /
                      static_cast<double>(full.cycles);
   EXPECT_LT(std::abs(err), 0.03) << s.cycles << " vs " << full.cycles;

@@ -83,7 +83,7 @@ FunctionalFrame run_frame(const memif::MemoryImage& image, const FunctionalParam
   PipelineUnits<F> units(params.mode);
   units.tap = tap;
   FrameSink sink;
-  sink.reset(w, h);
+  sink.reset(w, h, packets == nullptr);
   ThreadProgram<F, kMaxPacket, D> thread(image, params, units, sink);
   FunctionalFrame frame;
   frame.format = F::kFormat;

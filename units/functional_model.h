@@ -60,8 +60,9 @@ struct FunctionalFrame {
   int height = 0;
   FunctionalParams params;
   // Per pixel (row-major, row 0 at the top): the primary ray's closest hit as encodings of
-  // `format` (miss: t = +inf, instance = triangle = memif::kNone), its world ray, its counters.
-  std::vector<FrameSink::Pixel, hw::HugePageAllocator<FrameSink::Pixel>> pixels;
+  // `format` (miss: t = +inf, instance = triangle = memif::kNone), its world ray, its counters;
+  // zero bytes for a pixel whose packet the run did not trace (FrameSink).
+  FrameSink::PixelBuffer pixels;
   std::vector<std::uint8_t> rgb;                 // 3 bytes per pixel (R, G, B), row 0 at the top
   std::array<RayCounters, kRayKinds> by_kind{};  // per ray kind, summed over rays
   std::array<std::uint64_t, kRayKinds> rays_issued{};

@@ -337,19 +337,29 @@ struct FrameSink {
     std::array<std::uint32_t, 3> o{}, d{};
     RayCounters counters;
   };
-  // (hw::HugePageAllocator: a frame's buffers are first touched in 2 MiB pages.)
-  std::vector<Pixel, hw::HugePageAllocator<Pixel>> pixels;
-  std::vector<std::array<std::uint32_t, 3>, hw::HugePageAllocator<std::array<std::uint32_t, 3>>>
-      colour_sum;  // sum of weight * colour (docs 7)
+  // A pixel's record is written whole when its primary packet's rays return to the RGS
+  // (RgsStep::record_primary) and its colour sum starts at zero, so neither buffer is written
+  // before the run (hw::ZeroPageAllocator): a run touches the pages of the pixels it hands out,
+  // and the record of a pixel never handed out (a sampled run's skipped packets) is zero bytes.
+  using PixelBuffer = std::vector<Pixel, hw::ZeroPageAllocator<Pixel>>;
+  using ColourBuffer = std::vector<std::array<std::uint32_t, 3>,
+                                   hw::ZeroPageAllocator<std::array<std::uint32_t, 3>>>;
+  PixelBuffer pixels;
+  ColourBuffer colour_sum;  // sum of weight * colour (docs 7)
   std::array<RayCounters, kRayKinds> by_kind{};
   std::array<std::uint64_t, kRayKinds> rays_issued{};
   std::array<std::uint64_t, kRayKinds> rays_returned{};
 
-  void reset(int w, int h) {
+  // `every_pixel`: the run hands out every packet (huge pages) or a few (small pages: a 2 MiB page
+  // holds about 20 rows of a 1024-pixel frame).
+  void reset(int w, int h, bool every_pixel = true) {
     width = w;
     height = h;
-    pixels.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), Pixel{});
-    colour_sum.assign(pixels.size(), {0u, 0u, 0u});
+    const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+    PixelBuffer(n).swap(pixels);  // fresh zero pages: a reused buffer would keep the last frame
+    ColourBuffer(n).swap(colour_sum);
+    hw::advise_pages(pixels.data(), n * sizeof(Pixel), every_pixel);
+    hw::advise_pages(colour_sum.data(), n * sizeof(colour_sum[0]), every_pixel);
     by_kind = {};
     rays_issued = {};
     rays_returned = {};

@@ -60,7 +60,8 @@ class RecordedThreads final : public ThreadTable {
       if (p < 0 || p >= tiling_.count())
         throw std::logic_error("cycle model: packet " + std::to_string(p) + " of " +
                                std::to_string(tiling_.count()) + " in the RGC's order");
-    sink_.reset(w_, h_);
+    sink_.reset(w_, h_,
+                order_.empty() || order_.size() >= static_cast<std::size_t>(tiling_.count()));
     requests_.resize(static_cast<std::size_t>(threads));
     if (trace.any()) {
       tracing_ = true;
