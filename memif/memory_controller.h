@@ -9,7 +9,9 @@
 //     is `response_width` responses per cycle wide (add_port; 1 but for the routing's port, which
 //     is as wide as its broadcast) and holds max(port_capacity, 2 x width) responses.
 //   * Intake: per port and cycle at most one request moves into the per-bank queue of its bank
-//     (depth `queue_depth`); a full queue holds the port (head-of-line, back-pressure).
+//     (depth `queue_depth`); a full queue holds the port (head-of-line, back-pressure). Where
+//     more ports want a bank than its queue has room for, a round-robin pointer per bank decides
+//     (D55): each waits at most one turn of the others.
 //   * Banks: six 32-bit SRAM banks reading the MemoryImage. A request of w words occupies its
 //     bank for w cycles from its start cycle s; its response (all w words) is handed to the port
 //     in cycle s + w - 1 + latency.
@@ -150,6 +152,8 @@ class MemoryController : public hw::Module {
   int issue();
   int choose(const Path& path, unsigned waiting) const;  // the bank a path starts, or -1
   int accept_requests();
+  const MemRequest* front(std::size_t port) const;
+  void enqueue(std::size_t port, Bank& bank, int b);
   void start(int bank, std::uint64_t when);
 
   MemoryImage& image_;
@@ -165,6 +169,8 @@ class MemoryController : public hw::Module {
   // is its front request's arrival number and due_[b] its front read's due cycle.
   unsigned queued_ = 0, inflight_ = 0;
   std::array<std::uint64_t, kNumBanks> oldest_{}, due_{};
+  // Per bank: the port first in line when more ports want the bank than its queue has room for.
+  std::array<std::size_t, kNumBanks> intake_next_{};
   std::array<std::uint64_t, kNumBanks> free_at_{};  // first cycle a bank can start another request
   // The earliest due_ (kNever with nothing in flight): before it no read can leave, and the
   // retire stage is not entered (most cycles with reads in flight have none due).
