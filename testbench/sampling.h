@@ -42,6 +42,9 @@ struct SampleSpec {
 // what keeps the simulated share at kSampleShare and what gives kSampleWindows windows.
 inline constexpr double kSampleShare = 0.08;
 inline constexpr int kSampleWindows = 20;
+// Cache items that hold about a row of tiles' items (the default caches'): with several DynRTPs
+// the warm-up covers the share of the row above that the largest cache holds.
+inline constexpr int kRowItems = 512;
 SampleSpec resolve_sample_spec(const SampleSpec& s, const units::CycleParams& p,
                                const units::PacketTiling& tiling);
 

@@ -58,6 +58,10 @@ TEST(Sampling, DefaultChosenForTheMachineAndTheFrame) {
   EXPECT_EQ(
       sample_spec_text(resolve_sample_spec(parse_sample_spec("window=10,cooldown=0"), p, t16)),
       "window=10,period=2457,warmup=320,cooldown=0");
+  // Caches of 8 items hold 8/512 of the row above: 4 of its 256 packets.
+  for (auto& c : p.cache)
+    c.items = 8;
+  EXPECT_EQ(resolve_sample_spec({}, p, t16).warmup, 68);
   // 256 threads (64 on each of 4 DynRTPs): windows of two thread tables, longer than a row.
   p.threads = 64;
   p.pipelines = 4;
