@@ -72,7 +72,9 @@ struct HugePageAllocator {
 // out. A sampled run (testbench/sampling.h) hands out a twelfth of a frame's packets; writing
 // every pixel's empty record first took as long as simulating them (a 1024x768 frame's records
 // are 90 MB). Large buffers are fresh anonymous mappings (zero pages from the kernel), 2 MiB-
-// aligned so that advise_pages() can ask for huge pages; small ones come from calloc.
+// aligned so that advise_pages() can ask for huge pages; small ones come from calloc. Only a
+// fresh buffer is zero: a vector that shrinks and grows again within its capacity keeps the old
+// elements' bytes, so FrameSink::reset swaps in a new vector every frame.
 template <class T>
 struct ZeroPageAllocator {
   using value_type = T;
