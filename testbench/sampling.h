@@ -35,9 +35,10 @@ struct SampleSpec {
 };
 
 // The automatic choice (docs/sampling.md "The default") for a frame of `tiling`'s packets, with T
-// the chip's threads (DynRTPs x threads): warm-up max(64, 2T) packets, plus a row of tiles with
-// several DynRTPs, and cool-down max(32, T) (the threads in flight around a window are its
-// neighbours, as in the frame; several DynRTPs' caches hold the row above); window max(2T, a row
+// the chip's threads (DynRTPs x threads): warm-up max(64, 2T) packets, plus with several DynRTPs
+// the share of the row of tiles above that the largest cache holds, and cool-down max(32, T) (the
+// threads in flight around a window are its neighbours, as in the frame; several DynRTPs' caches
+// hold the row above); window max(2T, a row
 // of tiles) packets (a window then sees every column of the image once); period the shorter of
 // what keeps the simulated share at kSampleShare and what gives kSampleWindows windows.
 inline constexpr double kSampleShare = 0.08;
