@@ -574,9 +574,10 @@ int MemoryController::accept_requests() {
   // writers starved the third for 230,000 cycles of a 1.2 M-cycle frame while the other two kept
   // the frame bank's queue full.
   const std::size_t n = intake_.size();
+  fronts_.resize(n);  // each port's front request, checked once a cycle
   std::array<int, kNumBanks> want{};
   for (std::size_t p = 0; p < n; ++p)
-    if (const MemRequest* r = front(p)) ++want[r->bank];
+    if ((fronts_[p] = front(p)) != nullptr) ++want[fronts_[p]->bank];
   unsigned contended = 0;
   for (int b = 0; b < kNumBanks; ++b)
     if (want[static_cast<std::size_t>(b)] >
@@ -584,11 +585,12 @@ int MemoryController::accept_requests() {
       contended |= 1u << b;
   int accepted = 0;
   for (std::size_t p = 0; p < n; ++p) {
-    const MemRequest* r = front(p);
+    const MemRequest* r = fronts_[p];
     if (r == nullptr || (contended >> r->bank & 1u) != 0) continue;
     const int b = r->bank;
     Bank& bank = banks_[static_cast<std::size_t>(b)];
     enqueue(p, bank, b);
+    fronts_[p] = nullptr;  // one request per port and cycle
     ++accepted;
   }
   for (unsigned bits = contended; bits != 0; bits &= bits - 1) {
@@ -597,7 +599,7 @@ int MemoryController::accept_requests() {
     std::size_t& next = intake_next_[static_cast<std::size_t>(b)];
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t p = (next + k) % n;
-      const MemRequest* r = front(p);
+      const MemRequest* r = fronts_[p];
       if (r == nullptr || r->bank != b) continue;
       if (static_cast<int>(bank.queue.size()) >= config_.queue_depth) {
         stall();  // held: the queue is full (back-pressure)

@@ -171,6 +171,7 @@ class MemoryController : public hw::Module {
   std::array<std::uint64_t, kNumBanks> oldest_{}, due_{};
   // Per bank: the port first in line when more ports want the bank than its queue has room for.
   std::array<std::size_t, kNumBanks> intake_next_{};
+  std::vector<const MemRequest*> fronts_;  // accept_requests' scratch: each port's front request
   std::array<std::uint64_t, kNumBanks> free_at_{};  // first cycle a bank can start another request
   // The earliest due_ (kNever with nothing in flight): before it no read can leave, and the
   // retire stage is not entered (most cycles with reads in flight have none due).
