@@ -596,9 +596,12 @@ int MemoryController::accept_requests() {
   for (unsigned bits = contended; bits != 0; bits &= bits - 1) {
     const int b = std::countr_zero(bits);
     Bank& bank = banks_[static_cast<std::size_t>(b)];
+    // Each port once, from where the pointer stood at the cycle's start (moving the start with
+    // the pointer would visit a port twice and skip another).
     std::size_t& next = intake_next_[static_cast<std::size_t>(b)];
+    const std::size_t first = next;
     for (std::size_t k = 0; k < n; ++k) {
-      const std::size_t p = (next + k) % n;
+      const std::size_t p = (first + k) % n;
       const MemRequest* r = fronts_[p];
       if (r == nullptr || r->bank != b) continue;
       if (static_cast<int>(bank.queue.size()) >= config_.queue_depth) {
@@ -606,6 +609,7 @@ int MemoryController::accept_requests() {
         continue;
       }
       enqueue(p, bank, b);
+      fronts_[p] = nullptr;
       ++accepted;
       next = (p + 1) % n;
     }
