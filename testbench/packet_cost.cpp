@@ -7,6 +7,7 @@
 
 #include "fixedfloat/format.h"
 #include "units/functional_model.h"
+#include "units/shading.h"
 
 namespace saarcor {
 
@@ -17,7 +18,19 @@ CostFeatures cost_features(const RayCost& c) {
           static_cast<double>(c.leaves),
           static_cast<double>(c.lists),
           static_cast<double>(c.transforms),
-          c.box ? 1.0 : 0.0};
+          c.box ? 1.0 : 0.0,
+          static_cast<double>(c.shadow_rays),
+          static_cast<double>(c.shadow_steps),
+          static_cast<double>(c.shadow_tests),
+          static_cast<double>(c.secondary_rays),
+          static_cast<double>(c.secondary_steps),
+          static_cast<double>(c.secondary_tests)};
+}
+
+CostPaths cost_paths(const memif::MemoryImage& image, const units::FunctionalParams& shading) {
+  return {shading.shade && shading.shadows, shading.shade && shading.secondary,
+          shading.max_depth < 0 ? image.registers().max_depth
+                                : static_cast<std::uint32_t>(shading.max_depth)};
 }
 
 namespace {
@@ -74,6 +87,7 @@ PacketCostModel::PacketCostModel(const memif::MemoryImage& image) : image_(image
     const memif::InstanceHeader h = image.instance_header(i);
     in.root = h.root;
     in.triangle_rows = h.triangle_row_base;
+    in.shading_base = h.shading_base;
     const auto lo = image.row(base + 4), hi = image.row(base + 5);
     for (std::size_t a = 0; a < 3; ++a) {
       in.lo[a] = decode(lo[a]);
@@ -91,6 +105,13 @@ PacketCostModel::PacketCostModel(const memif::MemoryImage& image) : image_(image
     cam_d_[a] = decode(r.cam_d[a]);
     cam_p_[a] = decode(r.cam_p[a]);
   }
+  for (std::uint32_t l = 0; l < r.light_count; ++l) {
+    Vec pos{};
+    for (std::uint32_t k = 0; k < 3; ++k)
+      pos[k] = decode(image.word(memif::kShadingBank, r.light_base + memif::kLightWords * l + k));
+    lights_.push_back(pos);
+  }
+  epsilon_ = decode(r.epsilon);
 }
 
 void PacketCostModel::read_node(std::uint32_t index) const {
@@ -166,21 +187,23 @@ void PacketCostModel::traverse(std::uint32_t root, const Ray& r, float t0, float
   }
 }
 
-void PacketCostModel::trace_instance(std::uint32_t instance, const Ray& world, float& t_best,
-                                     RayCost& c) const {
+bool PacketCostModel::trace_instance(std::uint32_t instance, const Ray& world, float& t_best,
+                                     bool any_hit, RayCost& c, Hit* hit) const {
   const Instance& in = instances_[instance];
   ++c.transforms;
   const Ray r = make_ray(transform(in.world_to_object, world.o, 1.0f),
                          transform(in.world_to_object, world.d, 0.0f));
   float t0 = 0.0f, t1 = t_best;
   clip(in.lo, in.hi, r.o, r.d, t0, t1);
-  if (!(t0 <= t1)) return;
+  if (!(t0 <= t1)) return false;
+  bool ended = false;
   traverse(in.root, r, t0, t1, c, [&](const Node& leaf, float leaf_far) {
     for (std::uint32_t i = 0; i < leaf.count; ++i) {
       ++c.lists;
       ++c.tests;
-      const Row3& m =
-          triangle(in.triangle_rows + memif::kTriangleRows * image_.list_entry(leaf.child + i));
+      const std::uint32_t first =
+          in.triangle_rows + memif::kTriangleRows * image_.list_entry(leaf.child + i);
+      const Row3& m = triangle(first);
       const Vec o = transform(m, r.o, 1.0f), d = transform(m, r.d, 0.0f);
       const float t = -o[2] / d[2];
       if (!(t > 0.0f && t < t_best) || d[2] == 0.0f) continue;
@@ -188,20 +211,24 @@ void PacketCostModel::trace_instance(std::uint32_t instance, const Ray& world, f
       if (u >= 0.0f && v >= 0.0f && u + v <= 1.0f) {
         t_best = t;
         c.hit = true;
+        if (hit != nullptr) *hit = {instance, first, t};
+        if (any_hit) return ended = true;  // a shadow ray is done at its first hit (D15)
       }
     }
     return t_best < leaf_far;
   });
+  return ended;
 }
 
-RayCost PacketCostModel::trace(const Vec& origin, const Vec& direction) const {
+RayCost PacketCostModel::trace(const Vec& origin, const Vec& direction, float t_max, bool any_hit,
+                               Hit* hit) const {
   RayCost c;
   const Ray r = make_ray(origin, direction);
-  float t0 = 0.0f, t1 = std::numeric_limits<float>::infinity();
+  float t0 = 0.0f, t1 = t_max;
   clip(scene_lo_, scene_hi_, r.o, r.d, t0, t1);
   if (!(t0 <= t1) || nodes_.empty()) return c;
   c.box = true;
-  float t_best = std::numeric_limits<float>::infinity();
+  float t_best = t_max;
   // The mailbox: an instance listed in several top-level leaves is entered once per ray (a ray
   // entering more instances than it holds may enter one twice: a cost, not a result).
   std::array<std::uint32_t, 64> seen{};
@@ -214,19 +241,88 @@ RayCost PacketCostModel::trace(const Vec& origin, const Vec& direction) const {
           std::find(seen.begin(), seen.begin() + n_seen, inst) != seen.begin() + n_seen)
         continue;
       if (n_seen < seen.size()) seen[n_seen++] = inst;
-      trace_instance(inst, r, t_best, c);
+      if (trace_instance(inst, r, t_best, any_hit, c, hit)) return true;
     }
     return t_best < leaf_far;
   });
   return c;
 }
 
-RayCost PacketCostModel::trace_pixel(double x, double y) const {
+// The RGS's work on a hit (units/rgs_step.h): per light, the world normal (row 2 of the
+// triangle's matrix through the instance's M^T) faced against the ray; the light lights the hit
+// when the normal points towards it, and its shadow ray then runs from the light to the hit point
+// over t < 1 - 1/512, ending at its first hit. Then the children, each with its weight
+// (docs/shading.md section 7): reflection from t - e along D - 2 (D.n / n.n) n, transparency and
+// refraction (here straight on: its bend changes little of the work) from t + e along D.
+void PacketCostModel::shade(const Vec& o, const Vec& d, const Hit& hit, std::uint32_t weight,
+                            std::uint32_t depth, const CostPaths& paths, RayCost& c) const {
+  const Row3& m = triangle(hit.triangle_row);
+  const Instance& in = instances_[hit.instance];
+  const auto& w = in.world_to_object;
+  Vec n{}, p{};
+  float dn = 0, nn = 0;
+  for (std::size_t j = 0; j < 3; ++j) {
+    n[j] = w[0][j] * m[2][0] + w[1][j] * m[2][1] + w[2][j] * m[2][2];
+    p[j] = o[j] + hit.t * d[j];
+    dn += n[j] * d[j];
+    nn += n[j] * n[j];
+  }
+  for (const Vec& light : lights_) {
+    if (!paths.shadows) break;
+    Vec s{};
+    float lit = 0;
+    for (std::size_t j = 0; j < 3; ++j) {
+      s[j] = p[j] - light[j];
+      lit += n[j] * s[j];
+    }
+    if (!(dn > 0 ? lit > 0 : lit < 0)) continue;  // the faced normal is -n when n . D > 0
+    const RayCost r = trace(light, s, 1.0f - 1.0f / 512.0f, true);
+    ++c.shadow_rays;
+    c.shadow_steps += r.steps;
+    c.shadow_tests += r.tests;
+  }
+  if (!paths.secondary || depth >= paths.max_depth) return;
+  const std::uint32_t triangle_index = (hit.triangle_row - in.triangle_rows) / memif::kTriangleRows;
+  const auto& regs = image_.registers();
+  const std::uint32_t material =
+      image_.word(memif::kShadingBank,
+                  regs.shading_record_base +
+                      memif::kShadingRecordWords * (in.shading_base + triangle_index)) &
+      0xFFFFu;
+  const std::uint32_t mw = regs.material_base + memif::kMaterialWords * material;
+  const std::uint32_t w3 = image_.word(memif::kShadingBank, mw + 3);
+  const std::uint32_t kr = (w3 >> 8) & 255u, kt = (w3 >> 16) & 255u;
+  const std::uint32_t kf =
+      (w3 & memif::kMaterialRefracts) != 0 ? image_.word(memif::kShadingBank, mw + 4) & 255u : 0u;
+  const auto child = [&](std::uint32_t child_weight, float at, const Vec& direction) {
+    if (child_weight == 0) return;
+    Vec origin{};
+    for (std::size_t j = 0; j < 3; ++j)
+      origin[j] = o[j] + at * d[j];
+    Hit h;
+    const RayCost r = trace(origin, direction, std::numeric_limits<float>::infinity(), false, &h);
+    ++c.secondary_rays;
+    c.secondary_steps += r.steps;
+    c.secondary_tests += r.tests;
+    if (r.hit) shade(origin, direction, h, child_weight, depth + 1, paths, c);
+  };
+  Vec reflected = d;
+  for (std::size_t j = 0; j < 3; ++j)
+    reflected[j] = d[j] - 2.0f * dn / nn * n[j];
+  child(units::mul8(weight, kr), hit.t - epsilon_, reflected);
+  child(units::mul8(weight, kt), hit.t + epsilon_, d);
+  child(units::mul8(weight, kf), hit.t + epsilon_, d);
+}
+
+RayCost PacketCostModel::trace_pixel(double x, double y, const CostPaths& paths) const {
   const auto px = static_cast<float>(x), py = static_cast<float>(y);
   Vec d{};
   for (std::size_t i = 0; i < 3; ++i)
     d[i] = (cam_r_[i] * px + cam_u_[i] * py) + cam_d_[i];
-  return trace(cam_p_, d);
+  Hit hit;
+  RayCost c = trace(cam_p_, d, std::numeric_limits<float>::infinity(), false, &hit);
+  if (c.hit && (paths.shadows || paths.secondary)) shade(cam_p_, d, hit, 255u, 0, paths, c);
+  return c;
 }
 
 RayCost& operator+=(RayCost& a, const RayCost& b) {
@@ -237,10 +333,17 @@ RayCost& operator+=(RayCost& a, const RayCost& b) {
   a.lists += b.lists;
   a.transforms += b.transforms;
   a.tests += b.tests;
+  a.shadow_rays += b.shadow_rays;
+  a.shadow_steps += b.shadow_steps;
+  a.shadow_tests += b.shadow_tests;
+  a.secondary_rays += b.secondary_rays;
+  a.secondary_steps += b.secondary_steps;
+  a.secondary_tests += b.secondary_tests;
   return a;
 }
 
-std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet) {
+std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet,
+                                  const CostPaths& paths) {
   const auto& r = image.registers();
   const int w = static_cast<int>(r.width), h = static_cast<int>(r.height);
   const units::PacketTiling t = units::packet_tiling(w, h, packet);
@@ -257,7 +360,8 @@ std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet) {
       const int x0 = tx + (q % split) * pw, y0 = ty + (q / split) * ph;
       const int x1 = std::min(x0 + pw, w) - 1, y1 = std::min(y0 + ph, h) - 1;
       if (x1 < x0 || y1 < y0) continue;  // a quadrant outside the image
-      costs[static_cast<std::size_t>(i)] += model.trace_pixel(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+      costs[static_cast<std::size_t>(i)] +=
+          model.trace_pixel(0.5 * (x0 + x1), 0.5 * (y0 + y1), paths);
     }
   }
   return costs;

@@ -9,9 +9,11 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "memif/image_format.h"
+#include "units/program_types.h"
 
 namespace saarcor {
 
@@ -24,13 +26,34 @@ struct RayCost {
   std::uint32_t lists = 0;       // list entries read
   std::uint32_t transforms = 0;  // world -> object transformations (instances entered)
   std::uint32_t tests = 0;       // ray-triangle tests
+  // With shadow rays (units::FunctionalParams::shadows): the shadow rays the RGS would trace for
+  // the hits, one a light that lights a hit, and their kd steps and triangle tests (any hit).
+  std::uint32_t shadow_rays = 0;
+  std::uint32_t shadow_steps = 0;
+  std::uint32_t shadow_tests = 0;
+  // With secondary rays: the reflection, transparency and refraction rays the hits spawn (a
+  // refraction ray traced straight on), and their steps and tests.
+  std::uint32_t secondary_rays = 0;
+  std::uint32_t secondary_steps = 0;
+  std::uint32_t secondary_tests = 0;
 };
+
+// Which rays beside the primary ones a frame traces (units::FunctionalParams).
+struct CostPaths {
+  bool shadows = false;
+  bool secondary = false;
+  std::uint32_t max_depth = 0;  // secondary-ray depth bound (FrameRegisters::max_depth)
+};
+// The paths a frame rendered with `shading` traces.
+CostPaths cost_paths(const memif::MemoryImage& image, const units::FunctionalParams& shading);
 
 // What the sampled simulation's cycles estimate is fitted on, per packet (testbench/sampling.h
 // estimate_cycles): a constant (the box test and the RGS's work every packet has), kd-tree steps,
-// triangle tests, leaves, list entries, transformations, and whether the packet meets the scene's
-// box. Each kind of work takes its own unit's cycles, so each gets its own coefficient.
-inline constexpr int kCostFeatures = 7;
+// triangle tests, leaves, list entries, transformations, whether the packet meets the scene's
+// box, and the shadow and secondary rays with their steps and tests. Each kind of work takes its
+// own unit's cycles, so each gets its own coefficient (a feature without spread over the windows,
+// the shadow rays' when none are traced, drops out of the fit).
+inline constexpr int kCostFeatures = 13;
 using CostFeatures = std::array<double, kCostFeatures>;
 CostFeatures cost_features(const RayCost& c);
 
@@ -39,10 +62,22 @@ CostFeatures cost_features(const RayCost& c);
 class PacketCostModel {
  public:
   explicit PacketCostModel(const memif::MemoryImage& image);
-  // The work of the ray origin + t * direction, t > 0, to its closest hit.
-  RayCost trace(const std::array<float, 3>& origin, const std::array<float, 3>& direction) const;
-  // The ray of the (possibly fractional) pixel position (x, y) from the camera registers.
-  RayCost trace_pixel(double x, double y) const;
+  // Where a ray hit: the instance, its triangle's first matrix row and the ray's t.
+  struct Hit {
+    std::uint32_t instance = 0, triangle_row = 0;
+    float t = 0;
+  };
+  // The work of the ray origin + t * direction, 0 < t < t_max, to its closest hit (any hit: to the
+  // first, as a shadow ray). `hit`, if given, receives where it hit.
+  RayCost trace(const std::array<float, 3>& origin, const std::array<float, 3>& direction,
+                float t_max = std::numeric_limits<float>::infinity(), bool any_hit = false,
+                Hit* hit = nullptr) const;
+  // The ray of the (possibly fractional) pixel position (x, y) from the camera registers, and the
+  // rays its hit spawns on `paths`: shadow rays towards each light that lights a hit (the RGS's
+  // rule: the normal, facing the ray, points towards the light), from the light with
+  // t < 1 - 1/512; reflection, transparency and refraction children while their weight is above
+  // 0 and the depth below the bound (docs/shading.md section 7).
+  RayCost trace_pixel(double x, double y, const CostPaths& paths = {}) const;
 
  private:
   static constexpr std::uint32_t kUnread = ~0u;
@@ -56,6 +91,7 @@ class PacketCostModel {
     std::array<std::array<float, 4>, 3> world_to_object{};
     std::uint32_t root = 0;
     std::uint32_t triangle_rows = 0;
+    std::uint32_t shading_base = 0;
     std::array<float, 3> lo{}, hi{};
   };
   struct Ray {
@@ -71,7 +107,12 @@ class PacketCostModel {
   void read_node(std::uint32_t index) const;
   template <class Visit>
   void traverse(std::uint32_t root, const Ray& r, float t0, float t1, RayCost& c, Visit&& v) const;
-  void trace_instance(std::uint32_t instance, const Ray& world, float& t_best, RayCost& c) const;
+  // Returns true when a hit ends the ray (any hit).
+  bool trace_instance(std::uint32_t instance, const Ray& world, float& t_best, bool any_hit,
+                      RayCost& c, Hit* hit) const;
+  // What the RGS makes of a hit of the ray o + t d: its shadow rays and its children.
+  void shade(const std::array<float, 3>& o, const std::array<float, 3>& d, const Hit& hit,
+             std::uint32_t weight, std::uint32_t depth, const CostPaths& paths, RayCost& c) const;
   const std::array<std::array<float, 4>, 3>& triangle(std::uint32_t first_row) const;
   float decode(std::uint32_t bits) const;
 
@@ -83,6 +124,8 @@ class PacketCostModel {
   mutable std::vector<std::int32_t> slots_;
   std::array<float, 3> scene_lo_{}, scene_hi_{};
   std::array<float, 3> cam_r_{}, cam_u_{}, cam_d_{}, cam_p_{};
+  std::vector<std::array<float, 3>> lights_;  // the lights' positions
+  float epsilon_ = 0;                         // the secondary rays' offset, in units of |D|
 };
 
 // Adds b's counts to a's (box and hit: either).
@@ -90,7 +133,9 @@ RayCost& operator+=(RayCost& a, const RayCost& b);
 
 // The cost of every packet of the image's frame in the RGC's order (packets of `packet` rays,
 // units::packet_tiling): the ray through the centre of the packet's tile, clipped to the image;
-// for packets of 16 rays or more, the sum of the rays through its four quadrants' centres.
-std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet);
+// for packets of 16 rays or more, the sum of the rays through its four quadrants' centres; with
+// each the rays its hit spawns on `paths`.
+std::vector<RayCost> packet_costs(const memif::MemoryImage& image, int packet,
+                                  const CostPaths& paths = {});
 
 }  // namespace saarcor

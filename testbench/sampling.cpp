@@ -549,10 +549,11 @@ CycleFrame run_sampled(const memif::MemoryImage& image, const units::CycleParams
   // them, so where the run may use two host threads (--host-threads 2) they are traced on one of
   // their own while the chip runs, else before it. covariate_seconds is their own time either way.
   double covariate_seconds = 0;
-  const auto trace_features = [&image, &params, &covariate_seconds] {
+  const auto trace_features = [&image, &params, paths = cost_paths(image, options.shading),
+                               &covariate_seconds] {
     const auto tc = std::chrono::steady_clock::now();
     std::vector<CostFeatures> f;
-    for (const RayCost& r : packet_costs(image, params.packet))
+    for (const RayCost& r : packet_costs(image, params.packet, paths))
       f.push_back(cost_features(r));
     covariate_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
