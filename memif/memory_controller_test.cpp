@@ -249,26 +249,35 @@ TEST(MemoryController, AWideResponsePortTakesSeveralReadsPerCycle) {
 // Three ports want one bank more often than it serves (one-word reads, a word a cycle): once its
 // queue is full, a place frees each cycle and the bank's round-robin pointer gives it to each port
 // in turn (D55). Taken in port order, the third port's reads would all wait for the first two's.
-TEST(MemoryController, PortsWaitingForAFullBankQueueTakeTurns) {
-  MemoryImage img = numbered_image();
-  hw::Kernel k;
-  MemoryController mc(k, "ctrl", img);
+// Three ports p0..p2 with clients c0..c2, each pushing `reads` one-word reads of bank 3 from cycle
+// 0 (read i of port p at word 100 p + i, tag i), run until every client has all its answers.
+std::vector<std::unique_ptr<ScriptedClient>> three_reading_ports(hw::Kernel& k,
+                                                                 MemoryController& mc, int reads) {
   std::vector<std::unique_ptr<ScriptedClient>> clients;
   for (int p = 0; p < 3; ++p) {
     MemoryController::Port& port = mc.add_port("p" + std::to_string(p));
     const std::uint16_t c = mc.add_client("c" + std::to_string(p));
     std::vector<std::pair<std::uint64_t, MemRequest>> script;
-    for (int i = 0; i < 20; ++i)
-      script.push_back({0, read(c, static_cast<std::uint32_t>(i), 3, 100 * p + i, 1)});
+    for (int i = 0; i < reads; ++i)
+      script.push_back({0, read(c, static_cast<std::uint32_t>(i), 3,
+                                static_cast<std::uint32_t>(100 * p + i), 1)});
     clients.push_back(std::make_unique<ScriptedClient>(k, port, script));
   }
   k.run_to_completion(
       [&] {
         for (const auto& c : clients)
-          if (c->got.size() < 20) return false;
+          if (c->got.size() < static_cast<std::size_t>(reads)) return false;
         return true;
       },
       1000);
+  return clients;
+}
+
+TEST(MemoryController, PortsWaitingForAFullBankQueueTakeTurns) {
+  MemoryImage img = numbered_image();
+  hw::Kernel k;
+  MemoryController mc(k, "ctrl", img);
+  const auto clients = three_reading_ports(k, mc, 20);
   // Each port's i-th read is answered within four cycles of the others' (the bank's 60 reads end
   // at cycle 66, one answer a cycle from cycle 7).
   for (std::size_t i = 0; i < 20; ++i) {
@@ -286,33 +295,20 @@ TEST(MemoryController, PortsWaitingForAFullBankQueueTakeTurns) {
 }
 
 TEST(MemoryController, AContendedBankWithRoomForTwoTakesTheNextTwoPortsOnce) {
-  // Queues of 2 and three ports whose first reads reach an empty bank 0 in the same cycle: more
+  // Queues of 2 and three ports whose first reads reach an empty bank in the same cycle: more
   // want it than it has room for, so the round robin decides. From the pointer at port 0 it takes
-  // ports 0 and 1, each once, and holds port 2 (one stall). Moving the loop's start with the
-  // pointer visited port 2 twice and took its request twice.
+  // ports 0 and 1, each once, and holds port 2. Moving the loop's start with the pointer visited
+  // port 2 twice and took its request twice.
   MemoryImage img = numbered_image();
   hw::Kernel k;
   MemoryControllerConfig config;
   config.queue_depth = 2;
   MemoryController mc(k, "ctrl", img, config);
-  std::vector<std::unique_ptr<ScriptedClient>> clients;
-  for (int p = 0; p < 3; ++p) {
-    MemoryController::Port& port = mc.add_port("p" + std::to_string(p));
-    const std::uint16_t c = mc.add_client("c" + std::to_string(p));
-    clients.push_back(std::make_unique<ScriptedClient>(
-        k, port, std::vector<std::pair<std::uint64_t, MemRequest>>{{0, read(c, 0, 0, 10 * p, 1)}}));
-  }
-  k.run_to_completion(
-      [&] {
-        for (const auto& c : clients)
-          if (c->got.size() < 1) return false;
-        return true;
-      },
-      200);
-  // One read a cycle leaves bank 0 in the order taken in: ports 0 and 1 first, port 2 last.
+  const auto clients = three_reading_ports(k, mc, 1);
+  // One read a cycle leaves the bank in the order taken in: ports 0 and 1 first, port 2 last.
   EXPECT_LT(clients[0]->got[0].first, clients[2]->got[0].first);
   EXPECT_LT(clients[1]->got[0].first, clients[2]->got[0].first);
-  EXPECT_EQ(clients[2]->got[0].second.words[0], img.word(0, 20));
+  EXPECT_EQ(clients[2]->got[0].second.words[0], img.word(3, 200));
 }
 
 TEST(MemoryController, WritesLandInTheImageAndLaterReadsSeeThem) {
