@@ -267,8 +267,9 @@ void PacketCostModel::shade(const Vec& o, const Vec& d, const Hit& hit, std::uin
     dn += n[j] * d[j];
     nn += n[j] * n[j];
   }
-  for (const Vec& light : lights_) {
-    if (!paths.shadows) break;
+  const std::size_t lights = paths.shadows ? lights_.size() : 0;
+  for (std::size_t l = 0; l < lights; ++l) {
+    const Vec& light = lights_[l];
     Vec s{};
     float lit = 0;
     for (std::size_t j = 0; j < 3; ++j) {
@@ -282,18 +283,10 @@ void PacketCostModel::shade(const Vec& o, const Vec& d, const Hit& hit, std::uin
     c.shadow_tests += r.tests;
   }
   if (!paths.secondary || depth >= paths.max_depth) return;
+  // The hit triangle's material, as the RGS reads it (units/shading.h).
   const std::uint32_t triangle_index = (hit.triangle_row - in.triangle_rows) / memif::kTriangleRows;
-  const auto& regs = image_.registers();
-  const std::uint32_t material =
-      image_.word(memif::kShadingBank,
-                  regs.shading_record_base +
-                      memif::kShadingRecordWords * (in.shading_base + triangle_index)) &
-      0xFFFFu;
-  const std::uint32_t mw = regs.material_base + memif::kMaterialWords * material;
-  const std::uint32_t w3 = image_.word(memif::kShadingBank, mw + 3);
-  const std::uint32_t kr = (w3 >> 8) & 255u, kt = (w3 >> 16) & 255u;
-  const std::uint32_t kf =
-      (w3 & memif::kMaterialRefracts) != 0 ? image_.word(memif::kShadingBank, mw + 4) & 255u : 0u;
+  const memif::MaterialRecord mat = units::read_material(
+      image_, units::read_shading_record(image_, in.shading_base + triangle_index).material);
   const auto child = [&](std::uint32_t child_weight, float at, const Vec& direction) {
     if (child_weight == 0) return;
     Vec origin{};
@@ -309,9 +302,9 @@ void PacketCostModel::shade(const Vec& o, const Vec& d, const Hit& hit, std::uin
   Vec reflected = d;
   for (std::size_t j = 0; j < 3; ++j)
     reflected[j] = d[j] - 2.0f * dn / nn * n[j];
-  child(units::mul8(weight, kr), hit.t - epsilon_, reflected);
-  child(units::mul8(weight, kt), hit.t + epsilon_, d);
-  child(units::mul8(weight, kf), hit.t + epsilon_, d);
+  child(units::mul8(weight, mat.reflectivity), hit.t - epsilon_, reflected);
+  child(units::mul8(weight, mat.transparency), hit.t + epsilon_, d);
+  child(units::mul8(weight, mat.refraction), hit.t + epsilon_, d);
 }
 
 RayCost PacketCostModel::trace_pixel(double x, double y, const CostPaths& paths) const {
